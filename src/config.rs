@@ -1,0 +1,354 @@
+//! The study's configuration: one TOML file holding every parameter, each with its unit in its name.
+//!
+//! Parsing ([`Config::from_toml_str`]) rejects unknown fields; a missing field takes its default.
+//! Validation happens once, when a [`crate::model::Model`] is built from the parsed configuration,
+//! and names the offending field with its accepted range.
+
+use std::f64::consts::PI;
+use std::fmt;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::ConfigError;
+
+/// Which model produces the true position and velocity.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum TruthModel {
+    /// Closed-form integral of the acceleration profile, eq. (1) of the problem statement.
+    Analytic,
+    /// The true acceleration integrated with the accelerometer's Euler formula, eq. (4): the error
+    /// dynamics of eq. (5) are then exact.
+    Euler,
+}
+
+impl TruthModel {
+    /// Both models, in the order the report presents them.
+    pub const ALL: [TruthModel; 2] = [TruthModel::Analytic, TruthModel::Euler];
+
+    /// The lowercase name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            TruthModel::Analytic => "analytic",
+            TruthModel::Euler => "euler",
+        }
+    }
+}
+
+impl fmt::Display for TruthModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Every parameter of the study.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Config {
+    pub profile: ProfileConfig,
+    pub accelerometer: AccelerometerConfig,
+    pub gps: GpsConfig,
+    pub initial: InitialConfig,
+    pub filter: FilterConfig,
+    pub ensemble: EnsembleConfig,
+    pub checks: ChecksConfig,
+}
+
+/// The true acceleration a(t) = A·sin(ω·t) and the length of the run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ProfileConfig {
+    /// Amplitude A of the acceleration, m/s².
+    pub accel_amplitude_m_s2: f64,
+    /// Angular frequency ω of the acceleration, rad/s. The statement writes sin(2π·0.1·t) in one
+    /// place and sin(ω·t) with ω = 0.1 rad/s in another; the default 2π·0.1 rad/s follows the first.
+    pub accel_angular_freq_rad_s: f64,
+    /// Length of the run, s.
+    pub duration_s: f64,
+}
+
+impl Default for ProfileConfig {
+    fn default() -> Self {
+        Self {
+            accel_amplitude_m_s2: 10.0,
+            accel_angular_freq_rad_s: 2.0 * PI * 0.1,
+            duration_s: 30.0,
+        }
+    }
+}
+
+/// The accelerometer as it really is (the truth).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AccelerometerConfig {
+    /// Sample rate, Hz.
+    pub sample_rate_hz: f64,
+    /// Variance W of the white measurement noise w, (m/s²)².
+    pub noise_var_m2_s4: f64,
+    /// Variance of the zero-mean Gaussian prior of the constant bias b, (m/s²)².
+    pub bias_var_m2_s4: f64,
+}
+
+impl Default for AccelerometerConfig {
+    fn default() -> Self {
+        Self {
+            sample_rate_hz: 200.0,
+            noise_var_m2_s4: 0.0004,
+            bias_var_m2_s4: 0.01,
+        }
+    }
+}
+
+/// The GPS receiver as it really is (the truth).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GpsConfig {
+    /// Fix rate, Hz; must divide the accelerometer rate (fixes are synchronized with samples).
+    pub sample_rate_hz: f64,
+    /// Standard deviation of the position noise η_p, m.
+    pub position_sigma_m: f64,
+    /// Standard deviation of the velocity noise η_v, m/s.
+    pub velocity_sigma_m_s: f64,
+    /// Take a fix at t = 0 too; by default the first fix is one GPS period after the start.
+    pub fix_at_start: bool,
+}
+
+impl Default for GpsConfig {
+    fn default() -> Self {
+        Self {
+            sample_rate_hz: 5.0,
+            position_sigma_m: 1.0,
+            velocity_sigma_m_s: 0.04,
+            fix_at_start: false,
+        }
+    }
+}
+
+/// Gaussian prior of the vehicle's initial position p(0) and velocity v(0).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InitialConfig {
+    /// Mean of p(0), m; also the integration's start p_c(0).
+    pub position_mean_m: f64,
+    /// Standard deviation of p(0), m.
+    pub position_sigma_m: f64,
+    /// Mean of v(0), m/s; also the integration's start v_c(0).
+    pub velocity_mean_m_s: f64,
+    /// Standard deviation of v(0), m/s.
+    pub velocity_sigma_m_s: f64,
+}
+
+impl Default for InitialConfig {
+    fn default() -> Self {
+        Self {
+            position_mean_m: 0.0,
+            position_sigma_m: 10.0,
+            velocity_mean_m_s: 100.0,
+            velocity_sigma_m_s: 1.0,
+        }
+    }
+}
+
+/// The statistics the Kalman filter assumes. Each missing field takes the truth's value, so a
+/// mistuned filter is made by setting only the fields that differ.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FilterConfig {
+    /// Assumed accelerometer noise variance, (m/s²)².
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accel_noise_var_m2_s4: Option<f64>,
+    /// Assumed bias prior variance, (m/s²)².
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bias_var_m2_s4: Option<f64>,
+    /// Assumed GPS position noise standard deviation, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gps_position_sigma_m: Option<f64>,
+    /// Assumed GPS velocity noise standard deviation, m/s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gps_velocity_sigma_m_s: Option<f64>,
+    /// Assumed initial position standard deviation, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub initial_position_sigma_m: Option<f64>,
+    /// Assumed initial velocity standard deviation, m/s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub initial_velocity_sigma_m_s: Option<f64>,
+}
+
+/// The Monte Carlo ensemble.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EnsembleConfig {
+    /// Number of realizations N.
+    pub realizations: u64,
+    /// Seed of the random streams; realization l draws from the stream (seed, l).
+    pub seed: u64,
+    /// Truth model of the ensemble.
+    pub truth: TruthModel,
+}
+
+impl Default for EnsembleConfig {
+    fn default() -> Self {
+        Self {
+            realizations: 10_000,
+            seed: 2017,
+            truth: TruthModel::Analytic,
+        }
+    }
+}
+
+/// The statistical verdicts.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ChecksConfig {
+    /// Family-wise false-alarm rate of each check (Bonferroni over the family's members).
+    pub false_alarm_rate: f64,
+    /// The single pair (t_m, t_i), t_m < t_i, of GPS fix times whose residual correlation the
+    /// problem statement asks for, s.
+    pub residual_pair_s: [f64; 2],
+}
+
+impl Default for ChecksConfig {
+    fn default() -> Self {
+        Self {
+            false_alarm_rate: 0.01,
+            residual_pair_s: [10.0, 20.0],
+        }
+    }
+}
+
+/// The default configuration as an annotated TOML file (what `accelcal config` prints).
+pub const DEFAULT_TOML: &str = include_str!("default_config.toml");
+
+impl Config {
+    /// Parses a TOML document. Missing fields take their defaults; unknown fields are an error.
+    ///
+    /// # Errors
+    /// [`ConfigError::Parse`] with the TOML parser's message, which names the field and line.
+    pub fn from_toml_str(text: &str) -> Result<Self, ConfigError> {
+        toml::from_str(text).map_err(|e| ConfigError::Parse {
+            message: e.to_string(),
+        })
+    }
+
+    /// Reads and parses a TOML file.
+    ///
+    /// # Errors
+    /// [`ConfigError::Read`] when the file cannot be read, [`ConfigError::Parse`] when it is not a
+    /// valid configuration.
+    pub fn from_file(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ConfigError::Read {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        Self::from_toml_str(&text).map_err(|e| match e {
+            ConfigError::Parse { message } => ConfigError::Parse {
+                message: format!("{}: {message}", path.display()),
+            },
+            other => other,
+        })
+    }
+
+    /// The configuration as TOML, every field written out (the filter section only where set).
+    pub fn to_toml_string(&self) -> String {
+        toml::to_string(self).expect("a Config always serializes to TOML")
+    }
+
+    /// The filter's assumed accelerometer noise variance, (m/s²)².
+    pub fn filter_accel_noise_var_m2_s4(&self) -> f64 {
+        self.filter
+            .accel_noise_var_m2_s4
+            .unwrap_or(self.accelerometer.noise_var_m2_s4)
+    }
+
+    /// The filter's assumed bias prior variance, (m/s²)².
+    pub fn filter_bias_var_m2_s4(&self) -> f64 {
+        self.filter
+            .bias_var_m2_s4
+            .unwrap_or(self.accelerometer.bias_var_m2_s4)
+    }
+
+    /// The filter's assumed GPS position noise σ, m.
+    pub fn filter_gps_position_sigma_m(&self) -> f64 {
+        self.filter
+            .gps_position_sigma_m
+            .unwrap_or(self.gps.position_sigma_m)
+    }
+
+    /// The filter's assumed GPS velocity noise σ, m/s.
+    pub fn filter_gps_velocity_sigma_m_s(&self) -> f64 {
+        self.filter
+            .gps_velocity_sigma_m_s
+            .unwrap_or(self.gps.velocity_sigma_m_s)
+    }
+
+    /// The filter's assumed initial position σ, m.
+    pub fn filter_initial_position_sigma_m(&self) -> f64 {
+        self.filter
+            .initial_position_sigma_m
+            .unwrap_or(self.initial.position_sigma_m)
+    }
+
+    /// The filter's assumed initial velocity σ, m/s.
+    pub fn filter_initial_velocity_sigma_m_s(&self) -> f64 {
+        self.filter
+            .initial_velocity_sigma_m_s
+            .unwrap_or(self.initial.velocity_sigma_m_s)
+    }
+
+    /// True when the filter assumes exactly the truth's statistics.
+    pub fn filter_matches_truth(&self) -> bool {
+        self.filter_accel_noise_var_m2_s4() == self.accelerometer.noise_var_m2_s4
+            && self.filter_bias_var_m2_s4() == self.accelerometer.bias_var_m2_s4
+            && self.filter_gps_position_sigma_m() == self.gps.position_sigma_m
+            && self.filter_gps_velocity_sigma_m_s() == self.gps.velocity_sigma_m_s
+            && self.filter_initial_position_sigma_m() == self.initial.position_sigma_m
+            && self.filter_initial_velocity_sigma_m_s() == self.initial.velocity_sigma_m_s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn printed_default_file_parses_to_the_default() {
+        assert_eq!(
+            Config::from_toml_str(DEFAULT_TOML).unwrap(),
+            Config::default()
+        );
+    }
+
+    #[test]
+    fn missing_fields_take_defaults() {
+        let c = Config::from_toml_str("[gps]\nposition_sigma_m = 2.0\n").unwrap();
+        assert_eq!(c.gps.position_sigma_m, 2.0);
+        assert_eq!(c.gps.sample_rate_hz, 5.0);
+        assert_eq!(c.accelerometer, AccelerometerConfig::default());
+    }
+
+    #[test]
+    fn unknown_field_is_an_error_naming_it() {
+        let err = Config::from_toml_str("[gps]\nposition_sigma = 2.0\n").unwrap_err();
+        assert!(err.to_string().contains("position_sigma"), "{err}");
+    }
+
+    #[test]
+    fn filter_defaults_follow_the_truth() {
+        let c = Config::from_toml_str("[gps]\nposition_sigma_m = 3.0\n").unwrap();
+        assert_eq!(c.filter_gps_position_sigma_m(), 3.0);
+        assert!(c.filter_matches_truth());
+        let c = Config::from_toml_str("[filter]\ngps_position_sigma_m = 2.0\n").unwrap();
+        assert_eq!(c.filter_gps_position_sigma_m(), 2.0);
+        assert_eq!(c.gps.position_sigma_m, 1.0);
+        assert!(!c.filter_matches_truth());
+    }
+
+    #[test]
+    fn round_trips_through_toml() {
+        let mut c = Config::default();
+        c.filter.gps_position_sigma_m = Some(2.0);
+        c.ensemble.truth = TruthModel::Euler;
+        assert_eq!(Config::from_toml_str(&c.to_toml_string()).unwrap(), c);
+    }
+}

@@ -1,0 +1,254 @@
+//! The error-state Kalman filter.
+//!
+//! State δx = (δp, δv, b): position error (m), velocity error (m/s), accelerometer bias (m/s²),
+//! where δp = p − p_c and δv = v − v_c are the truth minus the integrated accelerometer.
+//!
+//! Its covariance and gains do not depend on the measurements, so [`FilterSchedule`] computes them
+//! once for a time grid; every realization then only propagates and updates its estimate.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::error::FilterError;
+use crate::model::{NoiseStats, Timeline};
+
+/// A 2-vector: a GPS measurement or residual (m, m/s).
+pub type Vector2 = SVector<f64, 2>;
+/// A 3-vector of the error state (m, m/s, m/s²).
+pub type Vector3 = SVector<f64, 3>;
+/// A 2×2 matrix: measurement-space covariance.
+pub type Matrix2 = SMatrix<f64, 2, 2>;
+/// A 3×3 matrix: state-space covariance or transition.
+pub type Matrix3 = SMatrix<f64, 3, 3>;
+/// Measurement matrix H, 2×3.
+pub type Matrix2x3 = SMatrix<f64, 2, 3>;
+/// Kalman gain K, 3×2.
+pub type Matrix3x2 = SMatrix<f64, 3, 2>;
+
+/// Transition Φ(τ) of the error state over τ seconds, eq. (5) composed over τ/Δt steps.
+///
+/// # Formula
+/// ```text
+/// Φ(τ) = [1  τ  −τ²/2]
+///        [0  1  −τ   ]
+///        [0  0   1   ]
+/// ```
+/// The continuous dynamics are nilpotent, so Φ(Δt)ⁿ = Φ(n·Δt) exactly.
+///
+/// # Examples
+/// ```
+/// use accelcal::filter::transition;
+/// let phi = transition(0.005);
+/// let phi40 = transition(0.2);
+/// assert!((phi.pow(40) - phi40).norm() < 1e-12);
+/// ```
+pub fn transition(tau_s: f64) -> Matrix3 {
+    Matrix3::new(
+        1.0,
+        tau_s,
+        -0.5 * tau_s * tau_s,
+        0.0,
+        1.0,
+        -tau_s,
+        0.0,
+        0.0,
+        1.0,
+    )
+}
+
+/// The linear Gaussian error-state system of eqs. (5) and (6), for one set of noise statistics.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ErrorStateModel {
+    /// One-step transition Φ(Δt).
+    pub phi: Matrix3,
+    /// Process noise covariance per step, Q = Γ·W·Γᵀ with Γ = −(Δt²/2, Δt, 0)ᵀ, (m, m/s, m/s²)².
+    pub q: Matrix3,
+    /// Measurement matrix H: GPS sees position and velocity errors.
+    pub h: Matrix2x3,
+    /// Measurement noise covariance R = diag(σ_p², σ_v²), (m, m/s)².
+    pub r: Matrix2,
+    /// Initial covariance P(0) = diag(σ_p0², σ_v0², σ_b²).
+    pub p0: Matrix3,
+}
+
+impl ErrorStateModel {
+    /// The system for sample period `dt_s` and the statistics `stats`.
+    pub fn new(dt_s: f64, stats: &NoiseStats) -> Self {
+        // eq. (5): the noise enters position with −Δt²/2 and velocity with −Δt.
+        let gamma = Vector3::new(-0.5 * dt_s * dt_s, -dt_s, 0.0);
+        Self {
+            phi: transition(dt_s),
+            q: gamma * gamma.transpose() * stats.accel_noise_var_m2_s4,
+            h: Matrix2x3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0),
+            r: Matrix2::new(
+                stats.gps_position_sigma_m.powi(2),
+                0.0,
+                0.0,
+                stats.gps_velocity_sigma_m_s.powi(2),
+            ),
+            p0: Matrix3::from_diagonal(&Vector3::new(
+                stats.initial_position_sigma_m.powi(2),
+                stats.initial_velocity_sigma_m_s.powi(2),
+                stats.bias_var_m2_s4,
+            )),
+        }
+    }
+
+    /// One propagation step P ← Φ·P·Φᵀ + Q, kept symmetric.
+    pub fn propagate(&self, p: &Matrix3) -> Matrix3 {
+        symmetrize(self.phi * p * self.phi.transpose() + self.q)
+    }
+}
+
+/// The filter's covariances and gain at one GPS fix.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FixCovariance {
+    /// Time of the fix, s.
+    pub time_s: f64,
+    /// Transition of the estimate from the previous fix (or from t = 0) to this one.
+    pub phi_from_previous: Matrix3,
+    /// A priori covariance P(t_i⁻).
+    pub p_prior: Matrix3,
+    /// A posteriori covariance P(t_i⁺).
+    pub p_post: Matrix3,
+    /// Kalman gain K = P⁻·Hᵀ·S⁻¹.
+    pub gain: Matrix3x2,
+    /// Innovation covariance S = H·P⁻·Hᵀ + R.
+    pub s: Matrix2,
+    /// S⁻¹, for the normalized innovation squared.
+    pub s_inv: Matrix2,
+    /// (P⁻)⁻¹, for the a priori normalized estimation error squared.
+    pub p_prior_inv: Matrix3,
+    /// (P⁺)⁻¹, for the a posteriori normalized estimation error squared.
+    pub p_post_inv: Matrix3,
+}
+
+/// Every covariance and gain of the filter over a time grid, computed once and shared.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilterSchedule {
+    /// The system the filter assumes.
+    pub model: ErrorStateModel,
+    /// One entry per GPS fix.
+    pub fixes: Vec<FixCovariance>,
+}
+
+impl FilterSchedule {
+    /// Runs the covariance recursion over `timeline` for the statistics `stats`: propagation at
+    /// every accelerometer sample, a Joseph-form update at every fix.
+    ///
+    /// # Errors
+    /// [`FilterError`] when S or P stops being positive definite.
+    pub fn new(timeline: &Timeline, stats: &NoiseStats) -> Result<Self, FilterError> {
+        let model = ErrorStateModel::new(timeline.dt_s, stats);
+        let mut p = model.p0;
+        let mut j = 0;
+        let mut fixes = Vec::with_capacity(timeline.fixes());
+        for &jf in &timeline.fix_steps {
+            let phi_from_previous = transition((jf - j) as f64 * timeline.dt_s);
+            while j < jf {
+                p = model.propagate(&p);
+                j += 1;
+            }
+            let time_s = timeline.time_s(jf);
+            let p_prior = p;
+            let fix = update_covariance(&model, &p_prior, time_s, phi_from_previous)?;
+            p = fix.p_post;
+            fixes.push(fix);
+        }
+        Ok(Self { model, fixes })
+    }
+
+    /// Measurement update of the estimate at fix `i`: returns the a posteriori estimate and the
+    /// residual r = δz − H·δx̂⁻.
+    #[inline]
+    pub fn update(&self, i: usize, prior: &Vector3, dz: &Vector2) -> (Vector3, Vector2) {
+        let fix = &self.fixes[i];
+        let residual = dz - self.model.h * prior;
+        (prior + fix.gain * residual, residual)
+    }
+}
+
+fn symmetrize(p: Matrix3) -> Matrix3 {
+    (p + p.transpose()) * 0.5
+}
+
+/// The measurement update of the covariance at one fix.
+fn update_covariance(
+    model: &ErrorStateModel,
+    p_prior: &Matrix3,
+    time_s: f64,
+    phi_from_previous: Matrix3,
+) -> Result<FixCovariance, FilterError> {
+    let h = &model.h;
+    let s = symmetrize2(h * p_prior * h.transpose() + model.r);
+    let s_chol = s
+        .cholesky()
+        .ok_or(FilterError::InnovationNotPositiveDefinite { time_s })?;
+    // K = P⁻Hᵀ S⁻¹, from the Cholesky solve S·Kᵀ = H·P⁻ (P⁻ symmetric).
+    let gain: Matrix3x2 = s_chol.solve(&(h * p_prior)).transpose();
+    // Joseph form: P⁺ = (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ, positive definite by construction.
+    let i_kh = Matrix3::identity() - gain * h;
+    let p_post = symmetrize(i_kh * p_prior * i_kh.transpose() + gain * model.r * gain.transpose());
+    let p_prior_inv = p_prior
+        .cholesky()
+        .ok_or(FilterError::CovarianceNotPositiveDefinite {
+            which: "a priori",
+            time_s,
+        })?
+        .inverse();
+    let p_post_inv = p_post
+        .cholesky()
+        .ok_or(FilterError::CovarianceNotPositiveDefinite {
+            which: "a posteriori",
+            time_s,
+        })?
+        .inverse();
+    Ok(FixCovariance {
+        time_s,
+        phi_from_previous,
+        p_prior: *p_prior,
+        p_post,
+        gain,
+        s,
+        s_inv: s_chol.inverse(),
+        p_prior_inv,
+        p_post_inv,
+    })
+}
+
+fn symmetrize2(s: Matrix2) -> Matrix2 {
+    (s + s.transpose()) * 0.5
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+    use crate::model::Model;
+
+    #[test]
+    fn composed_transition_is_exact() {
+        let phi = transition(0.005);
+        let mut acc = Matrix3::identity();
+        for _ in 0..40 {
+            acc = phi * acc;
+        }
+        assert!((acc - transition(0.2)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn gain_is_the_minimum_variance_gain() {
+        let m = Model::new(&Config::default()).unwrap();
+        let s = FilterSchedule::new(&m.timeline, &m.filter_stats).unwrap();
+        let f = &s.fixes[3];
+        // Optimal gain: K = P⁻Hᵀ(HP⁻Hᵀ + R)⁻¹, then P⁺ = (I − KH)P⁻ (the short form).
+        let h = s.model.h;
+        let k = f.p_prior
+            * h.transpose()
+            * (h * f.p_prior * h.transpose() + s.model.r)
+                .try_inverse()
+                .unwrap();
+        assert!((k - f.gain).norm() < 1e-12 * k.norm());
+        let short = (Matrix3::identity() - k * h) * f.p_prior;
+        assert!((short - f.p_post).norm() < 1e-9 * f.p_post.norm());
+    }
+}
