@@ -16,5 +16,5 @@ pub mod model;
 pub mod output;
 pub mod realization;
 pub mod report;
-pub mod study;
 pub mod simulation;
+pub mod study;

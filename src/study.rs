@@ -42,7 +42,11 @@ impl Study {
             .map(|&truth| {
                 let m = model.with_truth(truth);
                 let (run, verdicts) = ensemble_with_verdicts(&m, &schedule, quiet);
-                EnsembleOutcome { truth, run, verdicts }
+                EnsembleOutcome {
+                    truth,
+                    run,
+                    verdicts,
+                }
             })
             .collect();
         Ok(Self {

@@ -1,0 +1,35 @@
+//! Shared helpers of the integration tests.
+#![allow(dead_code)]
+
+use accelcal::checks::Verdicts;
+use accelcal::config::{Config, TruthModel};
+use accelcal::ensemble;
+use accelcal::filter::FilterSchedule;
+use accelcal::model::Model;
+
+/// Model and schedule of `config`.
+pub fn model_of(config: &Config) -> (Model, FilterSchedule) {
+    let model = Model::new(config).expect("valid configuration");
+    let schedule =
+        FilterSchedule::new(&model.timeline, &model.filter_stats).expect("positive definite");
+    (model, schedule)
+}
+
+/// Runs the ensemble of `config` with `truth` and evaluates its checks.
+pub fn verdicts_of(config: &Config, truth: TruthModel) -> Verdicts {
+    let (model, schedule) = model_of(config);
+    let model = model.with_truth(truth);
+    let run = ensemble::run_model(&model, &schedule, |_| {});
+    let c = &model.config.checks;
+    accelcal::checks::evaluate(
+        &run.stats,
+        &model.timeline,
+        c.false_alarm_rate,
+        c.residual_pair_s,
+    )
+}
+
+/// Path of the built binary.
+pub fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_accelcal")
+}
