@@ -164,3 +164,38 @@ pub fn realization_csv(r: &Realization, fix_times_s: &[f64]) -> String {
     }
     out
 }
+
+/// The report's `data.json`: configuration, the realization at the GPS fixes, every ensemble.
+#[derive(Serialize)]
+struct ReportData<'a> {
+    accelcal_version: &'static str,
+    config: &'a Config,
+    primary_truth: TruthModel,
+    realization: &'a Realization,
+    ensembles: Vec<EnsembleDoc<'a>>,
+}
+
+/// Serializes the report's data file.
+pub fn report_data_json(study: &crate::study::Study) -> String {
+    let ensembles = study
+        .ensembles
+        .iter()
+        .map(|e| {
+            ensemble_doc(
+                &study.model.config,
+                e.truth,
+                &study.schedule,
+                &e.run,
+                &e.verdicts,
+            )
+        })
+        .collect();
+    serde_json::to_string_pretty(&ReportData {
+        accelcal_version: env!("CARGO_PKG_VERSION"),
+        config: &study.model.config,
+        primary_truth: study.model.truth,
+        realization: &study.realization,
+        ensembles,
+    })
+    .expect("finite numbers serialize")
+}

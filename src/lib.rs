@@ -14,6 +14,7 @@ pub mod export;
 pub mod filter;
 pub mod model;
 pub mod output;
+pub mod plot;
 pub mod realization;
 pub mod report;
 pub mod simulation;

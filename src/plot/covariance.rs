@@ -1,0 +1,7 @@
+//! stub
+use super::PlotResult;
+use crate::checks::Check;
+use crate::ensemble::EnsembleStats;
+pub fn covariance(_stats: &EnsembleStats, _check: &Check) -> PlotResult {
+    Ok(String::new())
+}

@@ -1,0 +1,159 @@
+//! One realization's estimation errors against the filter's 1σ envelope.
+
+use plotters::style::Color;
+
+use super::panel::{
+    Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, extent, legend_height, max_abs,
+    padded, render, rows, time_span, y_label_area,
+};
+use super::{BLACK, BLUE, ORANGE, PlotResult, STATE_UNITS, capitalized};
+use crate::checks::STATE_NAMES;
+use crate::realization::Realization;
+
+/// Height of one state's row, px.
+const ROW_PX: u32 = 270;
+/// Width of the full-run column, px; the zoom takes the rest.
+const FULL_COLUMN_PX: u32 = 590;
+/// Length of the zoom window, s.
+const ZOOM_S: f64 = 2.0;
+
+/// The estimation error e = δx − δx̂ of one realization at every accelerometer sample, with the
+/// filter's ±1σ, and beside it a zoom on σ over two seconds, where it grows between GPS fixes and
+/// drops at each update.
+///
+/// The full-run axes are scaled to the run after its first second (or first quarter, if shorter):
+/// σ starts at the prior's 10 m, 1 m/s, 0.1 m/s² and collapses within the first fixes, which would
+/// otherwise flatten the rest of the run. The zoom plots σ alone because its sawtooth is about 1 %
+/// of σ: on an axis that also holds e, the teeth would be a pixel high.
+pub fn realization_errors(r: &Realization) -> PlotResult {
+    let t: Vec<f64> = r.samples.iter().map(|s| s.t_s).collect();
+    let (t0, t1) = time_span(t.iter().copied());
+    let settle = t0 + (1.0f64).min(0.25 * (t1 - t0));
+    let zoom = zoom_window(t0, t1);
+
+    let time = Axis::linear("time", "s", (t0, t1), 8);
+    let zoom_time = Axis::linear("time", "s", zoom, 5);
+    let error_axes: Vec<Axis> = (0..3).map(|k| error_axis(r, k, settle)).collect();
+    let sigma_axes: Vec<Axis> = (0..3).map(|k| sigma_axis(r, k, zoom)).collect();
+    let full_layout = |last: bool| Layout {
+        y_area_px: y_label_area(&error_axes.iter().collect::<Vec<_>>()),
+        x_title: last,
+        title: true,
+    };
+    let zoom_layout = |last: bool| Layout {
+        y_area_px: y_label_area(&sigma_axes.iter().collect::<Vec<_>>()),
+        x_title: last,
+        title: true,
+    };
+
+    let legend = [
+        Entry::new(Swatch::Line(BLUE, 1), "estimation error e = δx − δx̂"),
+        Entry::new(Swatch::Block(ORANGE.mix(0.35)), "filter ±1σ"),
+        Entry::new(Swatch::Line(ORANGE, 2), "filter σ (zoom)"),
+        Entry::new(Swatch::Ring(BLACK), "σ before a GPS update"),
+        Entry::new(Swatch::Dot(BLACK), "σ after it"),
+    ];
+    let legend_px = legend_height(&legend);
+    let last_row_px = ROW_PX + 24;
+    let height = legend_px + 2 * ROW_PX + last_row_px + 6;
+
+    render(height, |root| {
+        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
+        draw_legend(&parts[0], &legend)?;
+        for k in 0..3 {
+            let last = k == 2;
+            let cols = columns(&parts[k + 1], &[FULL_COLUMN_PX]);
+            let name = STATE_NAMES[k];
+
+            let full = Panel::new(
+                &cols[0],
+                &format!("{}: error and ±1σ over the run", capitalized(name)),
+                time.clone(),
+                error_axes[k].clone(),
+                full_layout(last),
+            )?;
+            let sigma: Vec<f64> = r.samples.iter().map(|s| s.sigma[k]).collect();
+            let lower: Vec<f64> = sigma.iter().map(|s| -s).collect();
+            full.band(&t, &lower, &sigma, ORANGE.mix(0.35))?;
+            full.hline(0.0, BLACK.mix(0.5).stroke_width(1))?;
+            full.line(
+                r.samples
+                    .iter()
+                    .map(|s| (s.t_s, s.delta_x[k] - s.estimate[k])),
+                BLUE.stroke_width(1),
+            )?;
+
+            let detail = Panel::new(
+                &cols[1],
+                &format!(
+                    "{} σ between fixes, {}–{} s",
+                    capitalized(name),
+                    zoom.0,
+                    zoom.1
+                ),
+                zoom_time.clone(),
+                sigma_axes[k].clone(),
+                zoom_layout(last),
+            )?;
+            detail.line(
+                r.samples
+                    .iter()
+                    .filter(|s| s.t_s >= zoom.0 && s.t_s <= zoom.1)
+                    .map(|s| (s.t_s, s.sigma[k])),
+                ORANGE.stroke_width(2),
+            )?;
+            let fixes = r
+                .fixes
+                .iter()
+                .filter(|f| f.t_s >= zoom.0 && f.t_s <= zoom.1);
+            detail.dots(
+                fixes.clone().map(|f| (f.t_s, f.sigma_prior[k])),
+                4,
+                BLACK.stroke_width(2),
+            )?;
+            detail.dots(fixes.map(|f| (f.t_s, f.sigma_post[k])), 4, BLACK.filled())?;
+        }
+        Ok(())
+    })
+}
+
+/// The two-second window the zoom shows: from two thirds into the run (20–22 s of 30 s).
+fn zoom_window(t0: f64, t1: f64) -> (f64, f64) {
+    let span = t1 - t0;
+    if span <= ZOOM_S {
+        return (t0, t1);
+    }
+    let start = (t0 + 2.0 * span / 3.0).floor().min(t1 - ZOOM_S).max(t0);
+    (start, start + ZOOM_S)
+}
+
+/// The symmetric error axis of state `k`, scaled to e and σ after `settle`.
+fn error_axis(r: &Realization, k: usize, settle: f64) -> Axis {
+    let late = r.samples.iter().filter(|s| s.t_s >= settle);
+    let m = max_abs(late.flat_map(|s| [s.sigma[k], s.delta_x[k] - s.estimate[k]]));
+    let m = if m > 0.0 { 1.3 * m } else { 1.0 };
+    Axis::linear(
+        &format!("{} error", STATE_NAMES[k]),
+        STATE_UNITS[k],
+        (-m, m),
+        7,
+    )
+}
+
+/// The σ axis of state `k` over the zoom window, fitted to σ there (prior σ at fixes included).
+fn sigma_axis(r: &Realization, k: usize, (a, b): (f64, f64)) -> Axis {
+    let inside = |t: f64| t >= a && t <= b;
+    let values = r
+        .samples
+        .iter()
+        .filter(|s| inside(s.t_s))
+        .map(|s| s.sigma[k])
+        .chain(
+            r.fixes
+                .iter()
+                .filter(|f| inside(f.t_s))
+                .flat_map(|f| [f.sigma_prior[k], f.sigma_post[k]]),
+        );
+    let range = extent(values).map_or((0.0, 1.0), |e| padded(e, 0.12));
+    Axis::linear(&format!("{} σ", STATE_NAMES[k]), STATE_UNITS[k], range, 5)
+}

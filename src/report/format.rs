@@ -1,0 +1,117 @@
+//! Number formatting for the report: the view layer's only way to turn numbers into text.
+
+const SUPERSCRIPTS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+
+fn superscript(n: i32) -> String {
+    let mut s = String::new();
+    if n < 0 {
+        s.push('⁻');
+    }
+    for d in n.unsigned_abs().to_string().bytes() {
+        s.push(SUPERSCRIPTS[(d - b'0') as usize]);
+    }
+    s
+}
+
+/// `x` with `sig` significant digits: plain between 10⁻³ and 10⁶, otherwise `m × 10ⁿ`.
+/// Uses the true minus sign.
+///
+/// # Examples
+/// ```
+/// use accelcal::report::format::sig;
+/// assert_eq!(sig(0.012345, 3), "0.0123");
+/// assert_eq!(sig(-1234.5, 3), "−1235");
+/// assert_eq!(sig(2.5e-5, 2), "2.5 × 10⁻⁵");
+/// ```
+pub fn sig(x: f64, sig: usize) -> String {
+    if !x.is_finite() {
+        return "—".to_string();
+    }
+    if x == 0.0 {
+        return "0".to_string();
+    }
+    let a = x.abs();
+    let exp = a.log10().floor() as i32;
+    let s = if (-3..6).contains(&exp) {
+        let decimals = (sig as i32 - 1 - exp).max(0) as usize;
+        format!("{a:.decimals$}")
+    } else {
+        let mant = a / 10f64.powi(exp);
+        // Rounding can carry the mantissa to 10.
+        let (mant, exp) = if format!("{mant:.*}", sig - 1).starts_with("10") {
+            (mant / 10.0, exp + 1)
+        } else {
+            (mant, exp)
+        };
+        format!("{mant:.*} × 10{}", sig - 1, superscript(exp))
+    };
+    if x < 0.0 { format!("−{s}") } else { s }
+}
+
+/// `x` with a fixed number of decimals and the true minus sign.
+pub fn fixed(x: f64, decimals: usize) -> String {
+    if !x.is_finite() {
+        return "—".to_string();
+    }
+    let s = format!("{:.decimals$}", x.abs());
+    if x < 0.0 && s.bytes().any(|b| (b'1'..=b'9').contains(&b)) {
+        format!("−{s}")
+    } else {
+        s
+    }
+}
+
+/// A whole number with thin-space thousands separators: 10 000.
+pub fn count(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push('\u{202F}');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// A probability as a percentage: 0.01 → "1 %".
+pub fn percent(p: f64) -> String {
+    format!(
+        "{}\u{202F}%",
+        sig(100.0 * p, 3)
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn significant_digits() {
+        assert_eq!(sig(1.0, 3), "1.00");
+        assert_eq!(sig(0.5, 2), "0.50");
+        assert_eq!(sig(123.456, 4), "123.5");
+        assert_eq!(sig(9.999e-7, 2), "1.0 × 10⁻⁶");
+        assert_eq!(sig(-3.0e7, 2), "−3.0 × 10⁷");
+        assert_eq!(sig(f64::NAN, 2), "—");
+        assert_eq!(sig(0.0, 2), "0");
+    }
+
+    #[test]
+    fn fixed_decimals_and_minus() {
+        assert_eq!(fixed(-0.25, 1), "−0.2");
+        assert_eq!(fixed(-0.0001, 2), "0.00");
+        assert_eq!(fixed(3.14159, 2), "3.14");
+    }
+
+    #[test]
+    fn counts_and_percentages() {
+        assert_eq!(count(10_000), "10\u{202F}000");
+        assert_eq!(count(999), "999");
+        assert_eq!(count(1_234_567), "1\u{202F}234\u{202F}567");
+        assert_eq!(percent(0.01), "1\u{202F}%");
+        assert_eq!(percent(0.05), "5\u{202F}%");
+    }
+}

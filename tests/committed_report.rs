@@ -1,0 +1,60 @@
+//! The committed `report/data.json` is what the code produces now for the default
+//! configuration; only timing and version fields may differ. Regenerate with `cargo run --release`.
+
+use accelcal::config::Config;
+use accelcal::model::Model;
+use accelcal::study::Study;
+use serde_json::Value;
+
+const VOLATILE: [&str; 3] = ["accelcal_version", "realizations_per_s", "elapsed_s"];
+
+/// Compares `a` and `b`, numbers to a relative 1e-9, skipping volatile keys; returns the first
+/// difference's path.
+fn diff(a: &Value, b: &Value, path: &str) -> Option<String> {
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+            keys.into_iter()
+                .filter(|k| !VOLATILE.contains(&k.as_str()))
+                .find_map(|k| match (x.get(k), y.get(k)) {
+                    (Some(p), Some(q)) => diff(p, q, &format!("{path}.{k}")),
+                    _ => Some(format!("{path}.{k} is only on one side")),
+                })
+        }
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
+            .iter()
+            .zip(y)
+            .enumerate()
+            .find_map(|(i, (p, q))| diff(p, q, &format!("{path}[{i}]"))),
+        (Value::Number(x), Value::Number(y)) => {
+            let (p, q) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            ((p - q).abs() > 1e-9 * p.abs().max(q.abs()) + 1e-300)
+                .then(|| format!("{path}: {p} vs {q}"))
+        }
+        _ => (a != b).then(|| format!("{path}: {a} vs {b}")),
+    }
+}
+
+#[test]
+fn committed_data_matches_the_code() {
+    let committed: Value = serde_json::from_str(
+        &std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/report/data.json"))
+            .expect("report/data.json is committed"),
+    )
+    .unwrap();
+    let model = Model::new(&Config::default()).unwrap();
+    let study = Study::run(&model, true).unwrap();
+    let now: Value = serde_json::from_str(&accelcal::export::report_data_json(&study)).unwrap();
+    if let Some(d) = diff(&committed, &now, "data") {
+        panic!("report/data.json is stale (run `cargo run --release`): first difference at {d}");
+    }
+}
+
+#[test]
+fn the_comparison_sees_a_change() {
+    let a: Value = serde_json::json!({"x": [1.0, 2.0], "elapsed_s": 1.0});
+    let b: Value = serde_json::json!({"x": [1.0, 2.000001], "elapsed_s": 9.0});
+    assert!(diff(&a, &b, "d").is_some());
+    let c: Value = serde_json::json!({"x": [1.0, 2.0], "elapsed_s": 9.0});
+    assert!(diff(&a, &c, "d").is_none());
+}

@@ -1,0 +1,250 @@
+//! End to end: `accelcal report` on a small configuration writes a self-contained page with every
+//! section, figure and equation, and a data file; its words follow the verdicts; a failed run
+//! leaves an earlier report alone.
+
+mod common;
+
+use std::path::Path;
+use std::process::Command;
+
+const SMALL: &str = "[profile]\nduration_s = 6.0\n[ensemble]\nrealizations = 400\n[checks]\nresidual_pair_s = [2.0, 4.0]\n";
+
+const SECTIONS: [&str; 7] = [
+    "abstract",
+    "introduction",
+    "problem",
+    "theory",
+    "results",
+    "conclusions",
+    "appendix",
+];
+
+const FIGURES: [&str; 13] = [
+    "fig-trajectory",
+    "fig-realization",
+    "fig-mean-error",
+    "fig-covariance",
+    "fig-orthogonality",
+    "fig-whiteness",
+    "fig-consistency",
+    "fig-truths",
+    "fig-mean-error-euler",
+    "fig-covariance-euler",
+    "fig-orthogonality-euler",
+    "fig-whiteness-euler",
+    "fig-consistency-euler",
+];
+
+fn report(dir: &Path, config: &str) -> std::process::Output {
+    std::fs::write(dir.join("c.toml"), config).unwrap();
+    Command::new(common::bin())
+        .args(["report", "--config", "c.toml", "--out", "out", "--quiet"])
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+fn page(dir: &Path) -> String {
+    std::fs::read_to_string(dir.join("out/index.html")).unwrap()
+}
+
+#[test]
+fn report_is_complete_and_self_contained() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = report(dir.path(), SMALL);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("euler truth") && stdout.contains("analytic truth"),
+        "{stdout}"
+    );
+    let html = page(dir.path());
+
+    // The page parses as XML (the report is written as well-formed, polyglot HTML).
+    let doc = roxmltree::Document::parse_with_options(
+        &html,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    )
+    .expect("index.html parses");
+
+    for id in SECTIONS {
+        let section = doc
+            .descendants()
+            .find(|n| n.has_tag_name("section") && n.attribute("id") == Some(id))
+            .unwrap_or_else(|| panic!("section {id} missing"));
+        assert!(
+            section.children().any(|c| c.has_tag_name("h2")),
+            "section {id} has no heading"
+        );
+        let text: String = section.descendants().filter_map(|n| n.text()).collect();
+        assert!(
+            text.split_whitespace().count() > 20,
+            "section {id} is nearly empty"
+        );
+    }
+
+    for id in FIGURES {
+        let figure = doc
+            .descendants()
+            .find(|n| n.has_tag_name("figure") && n.attribute("id") == Some(id))
+            .unwrap_or_else(|| panic!("figure {id} missing"));
+        let svg = figure
+            .descendants()
+            .find(|n| n.has_tag_name("svg"))
+            .unwrap_or_else(|| panic!("{id} has no svg"));
+        let texts = svg.descendants().filter(|n| n.has_tag_name("text")).count();
+        assert!(texts >= 5, "{id}: only {texts} text labels");
+        assert!(
+            figure.descendants().any(|n| n.has_tag_name("figcaption")),
+            "{id} has no caption"
+        );
+        // Each SVG parses on its own too.
+        let src = &html[svg.range()];
+        roxmltree::Document::parse(src).unwrap_or_else(|e| panic!("{id}: svg does not parse: {e}"));
+        assert!(
+            !src.contains("NaN") && !src.contains("inf\""),
+            "{id} holds a non-finite number"
+        );
+    }
+
+    // Equations are MathML, set in the embedded math font.
+    let maths: Vec<_> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("math"))
+        .collect();
+    assert!(maths.len() >= 30, "only {} equations", maths.len());
+    assert!(
+        maths
+            .iter()
+            .any(|m| m.descendants().any(|n| n.has_tag_name("mtable"))),
+        "no matrix"
+    );
+    assert!(
+        maths
+            .iter()
+            .any(|m| m.descendants().any(|n| n.has_tag_name("mfrac"))),
+        "no fraction"
+    );
+    assert!(html.contains("@font-face") && html.contains("url(data:font/woff2;base64,"));
+
+    // Nothing outside the page: no address, no external stylesheet, script, image or font.
+    for bad in [
+        "http:", "https:", "<link", "<script", "@import", "<img", "<iframe", "file:",
+    ] {
+        assert!(!html.contains(bad), "the page holds {bad:?}");
+    }
+    assert_eq!(
+        html.matches("url(").count(),
+        html.matches("url(data:").count(),
+        "a url() that is not data:"
+    );
+    for n in doc.descendants() {
+        for a in ["href", "src", "xlink:href"] {
+            if let Some(v) = n.attribute(a) {
+                assert!(v.starts_with('#'), "{a}={v:?} points outside the page");
+            }
+        }
+    }
+
+    // The verdict tables name every check of both ensembles.
+    for truth in ["analytic", "euler"] {
+        let table = doc
+            .descendants()
+            .find(|n| n.attribute("id") == Some(&*format!("checks-{truth}")))
+            .unwrap_or_else(|| panic!("no verdict table for {truth}"));
+        let text: String = table.descendants().filter_map(|n| n.text()).collect();
+        for id in [
+            "mean_error",
+            "covariance_match",
+            "orthogonality",
+            "residual_whiteness",
+            "nees",
+            "nis",
+        ] {
+            assert!(text.contains(id), "{truth} table lacks {id}");
+        }
+    }
+
+    // data.json: configuration, the realization at the fixes, both ensembles with summaries.
+    let data: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("out/data.json")).unwrap())
+            .unwrap();
+    assert_eq!(data["config"]["profile"]["duration_s"], 6.0);
+    assert_eq!(data["realization"]["fixes"].as_array().unwrap().len(), 30);
+    let truths: Vec<&str> = data["ensembles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["summary"]["truth"].as_str().unwrap())
+        .collect();
+    assert_eq!(truths, ["analytic", "euler"]);
+    for e in data["ensembles"].as_array().unwrap() {
+        assert_eq!(e["summary"]["realizations"], 400);
+        assert_eq!(e["summary"]["checks"].as_array().unwrap().len(), 6);
+    }
+}
+
+#[test]
+fn conclusions_follow_the_verdicts() {
+    let dir = tempfile::tempdir().unwrap();
+    let mistuned = format!("{SMALL}[filter]\ngps_position_sigma_m = 2.0\n");
+    let o = report(dir.path(), &mistuned);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = page(dir.path());
+    let conclusions =
+        &html[html.find("id=\"conclusions\"").unwrap()..html.find("id=\"appendix\"").unwrap()];
+    assert!(
+        conclusions.contains("With the euler truth,")
+            && conclusions.contains("does not match the filter"),
+        "{conclusions}"
+    );
+    assert!(
+        !conclusions.contains("The filter is consistent with this truth"),
+        "{conclusions}"
+    );
+    assert!(
+        conclusions.contains("deliberately given statistics that differ"),
+        "{conclusions}"
+    );
+    assert!(
+        html.contains("Even with the Euler-integrated truth"),
+        "the abstract must say the filter fails"
+    );
+
+    let o = report(dir.path(), SMALL);
+    assert!(o.status.success());
+    let html = page(dir.path());
+    let conclusions =
+        &html[html.find("id=\"conclusions\"").unwrap()..html.find("id=\"appendix\"").unwrap()];
+    assert!(
+        conclusions.contains("The filter is consistent with this truth"),
+        "{conclusions}"
+    );
+}
+
+#[test]
+fn a_failed_run_leaves_the_earlier_report_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("index.html"), "earlier report").unwrap();
+    std::fs::write(out.join("data.json"), "earlier data").unwrap();
+    let o = report(dir.path(), "[accelerometer]\nnoise_var_m2_s4 = -1.0\n");
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(
+        std::fs::read_to_string(out.join("index.html")).unwrap(),
+        "earlier report"
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("data.json")).unwrap(),
+        "earlier data"
+    );
+    assert_eq!(
+        std::fs::read_dir(&out).unwrap().count(),
+        2,
+        "temporary files left behind"
+    );
+}
