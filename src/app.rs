@@ -95,7 +95,7 @@ pub fn ensemble_with_verdicts(
         &run.stats,
         &model.timeline,
         c.false_alarm_rate,
-        c.residual_pair_s,
+        model.residual_pair_s,
     );
     (run, verdicts)
 }

@@ -204,15 +204,17 @@ pub struct ChecksConfig {
     /// Family-wise false-alarm rate of each check (Bonferroni over the family's members).
     pub false_alarm_rate: f64,
     /// The single pair (t_m, t_i), t_m < t_i, of GPS fix times whose residual correlation the
-    /// problem statement asks for, s.
-    pub residual_pair_s: [f64; 2],
+    /// problem statement asks for, s. Default: the fixes nearest one third and two thirds of
+    /// the run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residual_pair_s: Option<[f64; 2]>,
 }
 
 impl Default for ChecksConfig {
     fn default() -> Self {
         Self {
             false_alarm_rate: 0.01,
-            residual_pair_s: [10.0, 20.0],
+            residual_pair_s: None,
         }
     }
 }

@@ -22,32 +22,53 @@ pub const CHUNK: u64 = 64;
 pub struct StageSums {
     /// Σ e, e = δx − δx̂.
     pub e: Vector3,
-    /// Σ e·eᵀ.
-    pub ee: Matrix3,
+    /// Σ e·eᵀ, upper triangle in the order (00, 01, 02, 11, 12, 22).
+    pub ee: [f64; 6],
     /// Σ e·δx̂ᵀ.
     pub ex: Matrix3,
     /// Σ δx̂.
     pub x: Vector3,
-    /// Σ δx̂·δx̂ᵀ.
-    pub xx: Matrix3,
+    /// Σ δx̂_k², the diagonal of Σ δx̂·δx̂ᵀ.
+    pub xx: Vector3,
     /// Σ eᵀ·P⁻¹·e (the normalized estimation error squared).
     pub nees: f64,
 }
+
+/// Upper-triangle index pairs of a symmetric 3×3 matrix, in [`StageSums::ee`] order.
+const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
 
 impl StageSums {
     #[inline]
     fn add(&mut self, e: &Vector3, x: &Vector3, p_inv: &Matrix3) {
         self.e += e;
-        self.ee += e * e.transpose();
+        let mut nees = 0.0;
+        for (s, &(r, c)) in self.ee.iter_mut().zip(&UPPER) {
+            let prod = e[r] * e[c];
+            *s += prod;
+            // eᵀP⁻¹e over the upper triangle: off-diagonal terms count twice.
+            nees += if r == c { 1.0 } else { 2.0 } * p_inv[(r, c)] * prod;
+        }
         self.ex += e * x.transpose();
         self.x += x;
-        self.xx += x * x.transpose();
-        self.nees += e.dot(&(p_inv * e));
+        self.xx += x.component_mul(x);
+        self.nees += nees;
+    }
+
+    /// Σ e·eᵀ as a full matrix.
+    pub fn ee_matrix(&self) -> Matrix3 {
+        let mut m = Matrix3::zeros();
+        for (v, &(r, c)) in self.ee.iter().zip(&UPPER) {
+            m[(r, c)] = *v;
+            m[(c, r)] = *v;
+        }
+        m
     }
 
     fn merge(&mut self, o: &Self) {
         self.e += o.e;
-        self.ee += o.ee;
+        for (a, b) in self.ee.iter_mut().zip(&o.ee) {
+            *a += b;
+        }
         self.ex += o.ex;
         self.x += o.x;
         self.xx += o.xx;
@@ -111,24 +132,42 @@ impl Accumulator {
         }
     }
 
-    fn add_residuals(&mut self, stacked: &[f64]) {
-        let mut row = 0;
-        for (a, &ra) in stacked.iter().enumerate() {
-            // Row a of the packed triangle += r_a · ρ[0..=a]: a contiguous axpy.
-            let dst = &mut self.residual_products[row..row + a + 1];
-            for (d, &rb) in dst.iter_mut().zip(&stacked[..=a]) {
-                *d += ra * rb;
+    /// Adds Σ_q ρ_q·ρ_qᵀ over the stacked residual vectors of a batch (the first `filled` rows of
+    /// `batch`, each of length 2·fixes). Batching reads and writes the large packed triangle once
+    /// per [`BATCH`] realizations instead of once per realization.
+    fn add_residual_batch(&mut self, batch: &mut [f64], filled: usize) {
+        let m = 2 * self.fixes.len();
+        debug_assert_eq!(batch.len(), BATCH * m);
+        // Unused rows contribute nothing: zero them so the fixed-size inner loop stays exact.
+        batch[filled * m..].fill(0.0);
+        let rows: [&[f64]; BATCH] = std::array::from_fn(|q| &batch[q * m..(q + 1) * m]);
+        let mut start = 0;
+        for a in 0..m {
+            let coef: [f64; BATCH] = std::array::from_fn(|q| rows[q][a]);
+            let dst = &mut self.residual_products[start..start + a + 1];
+            let cols: [&[f64]; BATCH] = std::array::from_fn(|q| &rows[q][..=a]);
+            // Row a of the packed triangle += Σ_q ρ_q[a] · ρ_q[0..=a].
+            for (b, d) in dst.iter_mut().enumerate() {
+                let mut s = 0.0;
+                for q in 0..BATCH {
+                    s += coef[q] * cols[q][b];
+                }
+                *d += s;
             }
-            row += a + 1;
+            start += a + 1;
         }
     }
 }
+
+/// Realizations whose residual products are accumulated in one pass.
+const BATCH: usize = 8;
 
 /// Feeds one realization's fixes into an [`Accumulator`].
 struct Summer<'a> {
     acc: &'a mut Accumulator,
     schedule: &'a FilterSchedule,
-    stacked: Vec<f64>,
+    /// This realization's residuals, stacked: (r_p(t_0), r_v(t_0), r_p(t_1), …).
+    stacked: &'a mut [f64],
 }
 
 impl Observer for Summer<'_> {
@@ -154,18 +193,26 @@ pub fn accumulate(
     range: std::ops::Range<u64>,
 ) -> Accumulator {
     let fixes = model.timeline.fixes();
+    let m = 2 * fixes;
     let mut acc = Accumulator::new(fixes);
-    let mut stacked = vec![0.0; 2 * fixes];
+    let mut batch = vec![0.0; BATCH * m];
+    let mut filled = 0;
     for l in range {
         let mut summer = Summer {
             acc: &mut acc,
             schedule,
-            stacked: std::mem::take(&mut stacked),
+            stacked: &mut batch[filled * m..(filled + 1) * m],
         };
         run_realization(model, schedule, seed, l, &mut summer);
-        stacked = summer.stacked;
-        acc.add_residuals(&stacked);
         acc.count += 1;
+        filled += 1;
+        if filled == BATCH {
+            acc.add_residual_batch(&mut batch, filled);
+            filled = 0;
+        }
+    }
+    if filled > 0 {
+        acc.add_residual_batch(&mut batch, filled);
     }
     acc
 }
@@ -278,16 +325,17 @@ fn to_rows(m: &Matrix3) -> [[f64; 3]; 3] {
 fn stage_stats(s: &StageSums, p: &Matrix3, n: f64) -> StageStats {
     let mean_e = s.e / n;
     let mean_x = s.x / n;
-    let cov = (s.ee - mean_e * s.e.transpose()) / (n - 1.0);
+    let ee = s.ee_matrix();
+    let cov = (ee - mean_e * s.e.transpose()) / (n - 1.0);
     // (1/N) Σ (e − ē) x̂ᵀ = (1/N) Σ e x̂ᵀ − ē x̂̄ᵀ.
     let ortho = s.ex / n - mean_e * mean_x.transpose();
-    let var_e = (s.ee / n - mean_e * mean_e.transpose()).diagonal();
-    let var_x = (s.xx / n - mean_x * mean_x.transpose()).diagonal();
+    let var_e = (ee / n - mean_e * mean_e.transpose()).diagonal();
+    let var_x = s.xx / n - mean_x.component_mul(&mean_x);
     let corr = Matrix3::from_fn(|j, k| {
         let d = var_e[j] * var_x[k];
         // An estimate component that does not vary (e.g. the a priori estimate at a fix at t = 0)
         // has no correlation to speak of; relative tolerance because of rounding in the sums.
-        if var_x[k] > 1e-24 * (s.xx[(k, k)] / n).max(f64::MIN_POSITIVE) && d > 0.0 {
+        if var_x[k] > 1e-24 * (s.xx[k] / n).max(f64::MIN_POSITIVE) && d > 0.0 {
             ortho[(j, k)] / d.sqrt()
         } else {
             f64::NAN

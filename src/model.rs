@@ -82,6 +82,9 @@ pub struct Model {
     pub truth_stats: NoiseStats,
     /// The filter's assumed noise statistics.
     pub filter_stats: NoiseStats,
+    /// The single residual pair (t_m, t_i) of the checks, s: configured, or the fixes nearest
+    /// one third and two thirds of the run.
+    pub residual_pair_s: [f64; 2],
 }
 
 impl Model {
@@ -126,8 +129,25 @@ impl Model {
             initial_position_sigma_m: config.filter_initial_position_sigma_m(),
             initial_velocity_sigma_m_s: config.filter_initial_velocity_sigma_m_s(),
         };
+        let residual_pair_s = config.checks.residual_pair_s.unwrap_or_else(|| {
+            let n = timeline.fixes();
+            let near = |frac: f64| {
+                let t = frac * timeline.time_s(timeline.steps);
+                (0..n)
+                    .min_by(|&a, &b| {
+                        let da = (timeline.time_s(timeline.fix_steps[a]) - t).abs();
+                        let db = (timeline.time_s(timeline.fix_steps[b]) - t).abs();
+                        da.total_cmp(&db)
+                    })
+                    .expect("at least two fixes")
+            };
+            let m = near(1.0 / 3.0).min(n - 2);
+            let i = near(2.0 / 3.0).max(m + 1);
+            [timeline.time_s(timeline.fix_steps[m]), timeline.time_s(timeline.fix_steps[i])]
+        });
         Ok(Self {
             config: config.clone(),
+            residual_pair_s,
             timeline,
             truth: config.ensemble.truth,
             accel_m_s2,
@@ -328,7 +348,9 @@ fn validate(c: &Config) -> Result<(), ConfigError> {
         0.5,
         true,
     )?;
-    let [tm, ti] = k.residual_pair_s;
+    let Some([tm, ti]) = k.residual_pair_s else {
+        return Ok(());
+    };
     let period = per_fix as f64 / a.sample_rate_hz;
     let first = if g.fix_at_start { 0.0 } else { period };
     let last = (steps / per_fix) as f64 * period;
@@ -362,6 +384,10 @@ mod tests {
         assert_eq!(t.fix_steps[0], 40);
         assert_eq!(*t.fix_steps.last().unwrap(), 6000);
         assert_eq!(t.fix_index_at(10.0), Some(49));
+        assert_eq!(m.residual_pair_s, [10.0, 20.0]);
+        let mut c = Config::default();
+        c.profile.duration_s = 0.4;
+        assert_eq!(Model::new(&c).unwrap().residual_pair_s, [0.2, 0.4]);
     }
 
     #[test]
@@ -408,7 +434,7 @@ mod tests {
         c.ensemble.realizations = 1;
         assert_eq!(field_of(&c), "ensemble.realizations");
         let mut c = Config::default();
-        c.checks.residual_pair_s = [20.0, 10.0];
+        c.checks.residual_pair_s = Some([20.0, 10.0]);
         assert_eq!(field_of(&c), "checks.residual_pair_s");
         let mut c = Config::default();
         c.filter.gps_position_sigma_m = Some(0.0);

@@ -144,28 +144,28 @@ pub fn run_realization<O: Observer>(
 
     let mut estimate = Vector3::zeros();
     let mut j = 0;
-    // The integration state (p_c, v_c, p_E, v_E) advanced sample by sample up to `end`.
-    let integrate_to =
-        |end: usize, j: &mut usize, s: &mut [f64; 4], rng: &mut Stream, obs: &mut O| {
-            let [pc, vc, pe, ve] = s;
-            while *j < end {
-                if O::SAMPLES {
-                    obs.sample(&sample(*j, *pc, *vc, *pe, *ve));
-                }
-                let a = accel[*j];
-                // eq. (2): the accelerometer's output.
-                let ac = a + b + w_sigma * normal(rng);
-                // eq. (3): position uses the velocity before the step.
-                *pc += *vc * dt + ac * half_dt2;
-                *vc += ac * dt;
-                // eq. (4): the true acceleration through the same formula.
-                *pe += *ve * dt + a * half_dt2;
-                *ve += a * dt;
-                *j += 1;
+    // The integration state (p_c, v_c, p_E, v_E), advanced sample by sample from `j` to `end`.
+    // It is passed by value so that it lives in registers through the hot loop.
+    let integrate_to = |j: usize, end: usize, state: [f64; 4], rng: &mut Stream, obs: &mut O| {
+        let [mut pc, mut vc, mut pe, mut ve] = state;
+        for (k, &a) in accel[j..end].iter().enumerate() {
+            if O::SAMPLES {
+                obs.sample(&sample(j + k, pc, vc, pe, ve));
             }
-        };
+            // eq. (2): the accelerometer's output.
+            let ac = a + b + w_sigma * normal(rng);
+            // eq. (3): position uses the velocity before the step.
+            pc += vc * dt + ac * half_dt2;
+            vc += ac * dt;
+            // eq. (4): the true acceleration through the same formula.
+            pe += ve * dt + a * half_dt2;
+            ve += a * dt;
+        }
+        [pc, vc, pe, ve]
+    };
     for (i, (&jf, fix)) in tl.fix_steps.iter().zip(&schedule.fixes).enumerate() {
-        integrate_to(jf, &mut j, &mut s, &mut rng, observer);
+        s = integrate_to(j, jf, s, &mut rng, observer);
+        j = jf;
         let [pc, vc, pe, ve] = s;
         let (tp, tv) = truth_at(jf, pe, ve);
         let delta_x = Vector3::new(tp - pc, tv - vc, b);
@@ -186,9 +186,8 @@ pub fn run_realization<O: Observer>(
         });
     }
     if O::SAMPLES {
-        integrate_to(tl.steps, &mut j, &mut s, &mut rng, observer);
-        let [pc, vc, pe, ve] = s;
-        observer.sample(&sample(j, pc, vc, pe, ve));
+        let [pc, vc, pe, ve] = integrate_to(j, tl.steps, s, &mut rng, observer);
+        observer.sample(&sample(tl.steps, pc, vc, pe, ve));
     }
     draws
 }

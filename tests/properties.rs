@@ -43,7 +43,6 @@ fn config_strategy() -> impl Strategy<Value = Config> {
             c.initial.position_sigma_m = p0;
             c.initial.velocity_sigma_m_s = v0;
             c.gps.fix_at_start = at_start;
-            c.checks.residual_pair_s = [1.0 / rg, 2.0 / rg];
             c
         })
 }

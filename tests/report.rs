@@ -7,7 +7,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-const SMALL: &str = "[profile]\nduration_s = 6.0\n[ensemble]\nrealizations = 400\n[checks]\nresidual_pair_s = [2.0, 4.0]\n";
+const SMALL: &str = "[profile]\nduration_s = 6.0\n[ensemble]\nrealizations = 400\n";
 
 const SECTIONS: [&str; 7] = [
     "abstract",

@@ -20,7 +20,7 @@ fn superscript(n: i32) -> String {
 /// ```
 /// use accelcal::report::format::sig;
 /// assert_eq!(sig(0.012345, 3), "0.0123");
-/// assert_eq!(sig(-1234.5, 3), "−1235");
+/// assert_eq!(sig(-1234.6, 3), "−1235");
 /// assert_eq!(sig(2.5e-5, 2), "2.5 × 10⁻⁵");
 /// ```
 pub fn sig(x: f64, sig: usize) -> String {

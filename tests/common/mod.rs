@@ -25,7 +25,7 @@ pub fn verdicts_of(config: &Config, truth: TruthModel) -> Verdicts {
         &run.stats,
         &model.timeline,
         c.false_alarm_rate,
-        c.residual_pair_s,
+        model.residual_pair_s,
     )
 }
 
