@@ -129,7 +129,7 @@ pub fn realization_csv(r: &Realization, fix_times_s: &[f64]) -> String {
     let mut out = String::from(
         "t_s,accel_true_m_s2,p_true_m,v_true_m_s,p_computed_m,v_computed_m_s,\
          dp_true_m,dv_true_m_s,bias_true_m_s2,dp_est_m,dv_est_m_s,bias_est_m_s2,\
-         sigma_p_m,sigma_v_m_s,sigma_b_m_s2,gps_fix\n",
+         sigma_p_m,sigma_v_m_s,sigma_b_m_s2,cov_pv_m2_s,cov_pb_m2_s2,cov_vb_m2_s3,gps_fix\n",
     );
     let mut next_fix = fix_times_s.iter().peekable();
     for s in &r.samples {
@@ -156,6 +156,9 @@ pub fn realization_csv(r: &Realization, fix_times_s: &[f64]) -> String {
             s.sigma[0],
             s.sigma[1],
             s.sigma[2],
+            s.cov[0][1],
+            s.cov[0][2],
+            s.cov[1][2],
         ];
         for x in v {
             out.push_str(&format!("{x:.12e},"));

@@ -85,6 +85,9 @@ pub struct Model {
     /// The single residual pair (t_m, t_i) of the checks, s: configured, or the fixes nearest
     /// one third and two thirds of the run.
     pub residual_pair_s: [f64; 2],
+    /// The part of the closed-form truth that does not depend on p(0), v(0), at every fix:
+    /// (p(t) − p(0) − v(0)·t, v(t) − v(0)), so eq. (1) costs no trigonometry per realization.
+    pub analytic_offsets_at_fix: Vec<[f64; 2]>,
 }
 
 impl Model {
@@ -145,9 +148,15 @@ impl Model {
             let i = near(2.0 / 3.0).max(m + 1);
             [timeline.time_s(timeline.fix_steps[m]), timeline.time_s(timeline.fix_steps[i])]
         });
+        let analytic_offsets_at_fix = timeline
+            .fix_steps
+            .iter()
+            .map(|&j| analytic_offsets(config, timeline.time_s(j)))
+            .collect();
         Ok(Self {
             config: config.clone(),
             residual_pair_s,
+            analytic_offsets_at_fix,
             timeline,
             truth: config.ensemble.truth,
             accel_m_s2,
@@ -167,13 +176,24 @@ impl Model {
     /// Closed-form true position and velocity at time `t_s` for initial values `p0_m`, `v0_m_s`:
     /// eq. (1), p(t) = p0 + (v0 + A/ω)·t − (A/ω²)·sin(ωt), v(t) = v0 + (A/ω)·(1 − cos(ωt)).
     pub fn analytic_truth(&self, t_s: f64, p0_m: f64, v0_m_s: f64) -> (f64, f64) {
-        let a = self.config.profile.accel_amplitude_m_s2;
-        let w = self.config.profile.accel_angular_freq_rad_s;
-        let (s, c) = (w * t_s).sin_cos();
-        let p = p0_m + (v0_m_s + a / w) * t_s - a / (w * w) * s;
-        let v = v0_m_s + a / w * (1.0 - c);
-        (p, v)
+        let [dp, dv] = analytic_offsets(&self.config, t_s);
+        (p0_m + v0_m_s * t_s + dp, v0_m_s + dv)
     }
+
+    /// [`Model::analytic_truth`] at fix `i`, from the tabulated offsets.
+    #[inline]
+    pub fn analytic_truth_at_fix(&self, i: usize, t_s: f64, p0_m: f64, v0_m_s: f64) -> (f64, f64) {
+        let [dp, dv] = self.analytic_offsets_at_fix[i];
+        (p0_m + v0_m_s * t_s + dp, v0_m_s + dv)
+    }
+}
+
+/// The closed-form truth less its initial-value terms: ((A/ω)·t − (A/ω²)·sin ωt, (A/ω)·(1 − cos ωt)).
+fn analytic_offsets(config: &Config, t_s: f64) -> [f64; 2] {
+    let a = config.profile.accel_amplitude_m_s2;
+    let w = config.profile.accel_angular_freq_rad_s;
+    let (s, c) = (w * t_s).sin_cos();
+    [a / w * t_s - a / (w * w) * s, a / w * (1.0 - c)]
 }
 
 /// `x` rounded to the nearest whole number when it is one within [`WHOLE_TOL`].

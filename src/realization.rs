@@ -22,6 +22,8 @@ pub struct SampleRecord {
     pub estimate: [f64; 3],
     /// The filter's σ = √diag P(t_j).
     pub sigma: [f64; 3],
+    /// The filter's covariance P(t_j), row-major.
+    pub cov: [[f64; 3]; 3],
 }
 
 /// A realization at one GPS fix.
@@ -33,6 +35,10 @@ pub struct FixRecord {
     pub post: [f64; 3],
     pub sigma_prior: [f64; 3],
     pub sigma_post: [f64; 3],
+    /// A priori covariance P(t_i⁻), row-major.
+    pub cov_prior: [[f64; 3]; 3],
+    /// A posteriori covariance P(t_i⁺), row-major.
+    pub cov_post: [[f64; 3]; 3],
     /// Residual r = δz − H·δx̂⁻, (m, m/s).
     pub residual: [f64; 2],
     /// Measurement δz = z − (p_c, v_c), (m, m/s).
@@ -54,6 +60,10 @@ pub struct Realization {
 
 fn sigma(p: &Matrix3) -> [f64; 3] {
     std::array::from_fn(|k| p[(k, k)].sqrt())
+}
+
+fn rows(p: &Matrix3) -> [[f64; 3]; 3] {
+    std::array::from_fn(|r| std::array::from_fn(|c| p[(r, c)]))
 }
 
 struct Recorder<'a> {
@@ -85,6 +95,7 @@ impl Observer for Recorder<'_> {
             ],
             estimate: self.estimate.into(),
             sigma: sigma(&self.cov),
+            cov: rows(&self.cov),
         });
         // Propagate to the next sample: δx̂ ← Φ·δx̂, P ← Φ·P·Φᵀ + Q.
         let m = &self.schedule.model;
@@ -103,6 +114,8 @@ impl Observer for Recorder<'_> {
             post: f.post.into(),
             sigma_prior: sigma(&c.p_prior),
             sigma_post: sigma(&c.p_post),
+            cov_prior: rows(&c.p_prior),
+            cov_post: rows(&c.p_post),
             residual: f.residual.into(),
             dz: f.dz.into(),
         });

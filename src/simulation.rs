@@ -167,7 +167,10 @@ pub fn run_realization<O: Observer>(
         s = integrate_to(j, jf, s, &mut rng, observer);
         j = jf;
         let [pc, vc, pe, ve] = s;
-        let (tp, tv) = truth_at(jf, pe, ve);
+        let (tp, tv) = match model.truth {
+            TruthModel::Analytic => model.analytic_truth_at_fix(i, tl.time_s(jf), draws.p0_m, draws.v0_m_s),
+            TruthModel::Euler => (pe, ve),
+        };
         let delta_x = Vector3::new(tp - pc, tv - vc, b);
         let dz = Vector2::new(
             tp + eta_p_sigma * normal(&mut rng) - pc,
