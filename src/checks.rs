@@ -129,7 +129,11 @@ fn normal_check(
 ) -> Check {
     let m = members.len().max(1);
     let bound = normal_bound(alpha / m as f64);
-    let failures = members.iter().filter(|x| !(x.value.abs() <= bound)).count();
+    // A non-finite member is outside every band.
+    let failures = members
+        .iter()
+        .filter(|x| !(-bound..=bound).contains(&x.value))
+        .count();
     let worst = members
         .iter()
         .max_by(|a, b| a.value.abs().total_cmp(&b.value.abs()))
@@ -169,7 +173,7 @@ fn chi_squared_check(
     };
     let failures = members
         .iter()
-        .filter(|x| !(x.value >= lower && x.value <= upper))
+        .filter(|x| !(lower..=upper).contains(&x.value))
         .count();
     let worst = members
         .iter()
@@ -222,36 +226,33 @@ pub fn evaluate(
 ) -> Verdicts {
     let n = stats.realizations as f64;
     let mean_error = per_stage(stats, |s, t, prior, out| {
-        for j in 0..3 {
+        for (j, name) in STATE_NAMES.iter().enumerate() {
             out.push(Member {
                 value: s.mean_error[j] / (s.filter_cov[j][j] / n).sqrt(),
                 time_s: t,
-                label: format!("{} {} error", stage_name(prior), STATE_NAMES[j]),
+                label: format!("{} {name} error", stage_name(prior)),
             });
         }
     });
     let covariance = per_stage(stats, |s, t, prior, out| {
-        for j in 0..3 {
+        for (j, name) in STATE_NAMES.iter().enumerate() {
             out.push(Member {
                 value: s.ensemble_cov[j][j] / s.filter_cov[j][j],
                 time_s: t,
-                label: format!("{} {} variance", stage_name(prior), STATE_NAMES[j]),
+                label: format!("{} {name} variance", stage_name(prior)),
             });
         }
     });
     let orthogonality = per_stage(stats, |s, t, prior, out| {
-        for j in 0..3 {
-            for k in 0..3 {
-                let c = s.orthogonality_corr[j][k];
+        for (row, error_name) in s.orthogonality_corr.iter().zip(STATE_NAMES) {
+            for (&c, estimate_name) in row.iter().zip(STATE_NAMES) {
                 if c.is_finite() {
                     out.push(Member {
                         value: n.sqrt() * c,
                         time_s: t,
                         label: format!(
-                            "{} {} error × {} estimate",
-                            stage_name(prior),
-                            STATE_NAMES[j],
-                            STATE_NAMES[k]
+                            "{} {error_name} error × {estimate_name} estimate",
+                            stage_name(prior)
                         ),
                     });
                 }
@@ -278,17 +279,14 @@ pub fn evaluate(
     let mut whiteness = Vec::with_capacity(2 * fixes * fixes);
     for i in 1..fixes {
         for m in 0..i {
-            for j in 0..2 {
-                for k in 0..2 {
+            for (j, name_i) in RESIDUAL_NAMES.iter().enumerate() {
+                for (k, name_m) in RESIDUAL_NAMES.iter().enumerate() {
                     whiteness.push(Member {
                         value: residual_z(stats, 2 * i + j, 2 * m + k),
                         time_s: stats.fixes[i].time_s,
                         label: format!(
-                            "{} residual at {:.1} s × {} residual at {:.1} s",
-                            RESIDUAL_NAMES[j],
-                            stats.fixes[i].time_s,
-                            RESIDUAL_NAMES[k],
-                            stats.fixes[m].time_s
+                            "{name_i} residual at {:.1} s × {name_m} residual at {:.1} s",
+                            stats.fixes[i].time_s, stats.fixes[m].time_s
                         ),
                     });
                 }

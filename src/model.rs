@@ -146,7 +146,10 @@ impl Model {
             };
             let m = near(1.0 / 3.0).min(n - 2);
             let i = near(2.0 / 3.0).max(m + 1);
-            [timeline.time_s(timeline.fix_steps[m]), timeline.time_s(timeline.fix_steps[i])]
+            [
+                timeline.time_s(timeline.fix_steps[m]),
+                timeline.time_s(timeline.fix_steps[i]),
+            ]
         });
         let analytic_offsets_at_fix = timeline
             .fix_steps

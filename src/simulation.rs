@@ -168,7 +168,9 @@ pub fn run_realization<O: Observer>(
         j = jf;
         let [pc, vc, pe, ve] = s;
         let (tp, tv) = match model.truth {
-            TruthModel::Analytic => model.analytic_truth_at_fix(i, tl.time_s(jf), draws.p0_m, draws.v0_m_s),
+            TruthModel::Analytic => {
+                model.analytic_truth_at_fix(i, tl.time_s(jf), draws.p0_m, draws.v0_m_s)
+            }
             TruthModel::Euler => (pe, ve),
         };
         let delta_x = Vector3::new(tp - pc, tv - vc, b);

@@ -1,7 +1,144 @@
-//! stub
-use super::PlotResult;
-use crate::checks::Check;
-use crate::ensemble::EnsembleStats;
-pub fn covariance(_stats: &EnsembleStats, _check: &Check) -> PlotResult {
-    Ok(String::new())
+//! The ensemble's error variance against the filter's.
+
+use plotters::style::Color;
+
+use super::panel::{
+    Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, extent, legend_height, padded,
+    render, rows, time_span, y_label_area,
+};
+use super::{
+    BLACK, BLUE, ORANGE, PlotResult, SKY_BLUE, STATE_UNITS, VERMILLION, WIDTH_PX, capitalized,
+};
+use crate::checks::{Check, STATE_NAMES};
+use crate::ensemble::{EnsembleStats, FixStats, StageStats};
+
+/// Height of one state's row, px.
+const ROW_PX: u32 = 250;
+
+/// Per state (rows): left, the ensemble variance P_ave and the filter's P at every fix, a priori
+/// and a posteriori, on a log axis; right, their ratio P_ave/P against the check's χ² band.
+pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
+    let fixes = &stats.fixes;
+    let (t0, t1) = time_span(fixes.iter().map(|f| f.time_s));
+    let time = Axis::linear("time", "s", (t0.min(0.0), t1), 7);
+    let var = |s: &StageStats, k: usize| (s.ensemble_cov[k][k], s.filter_cov[k][k]);
+    let ratio = |s: &StageStats, k: usize| {
+        let (ens, filt) = var(s, k);
+        ens / filt
+    };
+
+    let var_axes: Vec<Axis> = (0..3)
+        .map(|k| {
+            let values = fixes.iter().flat_map(|f| {
+                let (a, b) = var(&f.prior, k);
+                let (c, d) = var(&f.post, k);
+                [a, b, c, d]
+            });
+            let (lo, hi) = extent(values.filter(|v| *v > 0.0)).unwrap_or((0.1, 10.0));
+            let unit = if k == 0 {
+                "m²".to_string()
+            } else {
+                format!("({})²", STATE_UNITS[k])
+            };
+            Axis::log10("variance", &unit, (lo, hi))
+        })
+        .collect();
+    let ratio_axes: Vec<Axis> = (0..3)
+        .map(|k| {
+            let values = fixes
+                .iter()
+                .flat_map(|f| [ratio(&f.prior, k), ratio(&f.post, k)])
+                .chain([check.lower, check.upper, 1.0]);
+            let range = extent(values).map_or((0.5, 1.5), |e| padded(e, 0.1));
+            Axis::linear("P_ave / P", "", range, 6)
+        })
+        .collect();
+    let var_area = y_label_area(&var_axes.iter().collect::<Vec<_>>());
+    let ratio_area = y_label_area(&ratio_axes.iter().collect::<Vec<_>>());
+
+    let legend = [
+        Entry::new(
+            Swatch::Line(ORANGE.mix(0.5).stroke_width(5)),
+            "filter P, a priori",
+        ),
+        Entry::new(
+            Swatch::Line(VERMILLION.stroke_width(2)),
+            "ensemble P_ave, a priori",
+        ),
+        Entry::new(
+            Swatch::Line(SKY_BLUE.mix(0.6).stroke_width(5)),
+            "filter P, a posteriori",
+        ),
+        Entry::new(
+            Swatch::Line(BLUE.stroke_width(2)),
+            "ensemble P_ave, a posteriori",
+        ),
+        Entry::new(
+            Swatch::Line(BLACK.stroke_width(1)),
+            format!("χ² band [{:.3}, {:.3}]", check.lower, check.upper),
+        ),
+    ];
+    let legend_px = legend_height(&legend);
+    let last_row_px = ROW_PX + 24;
+
+    render(legend_px + 2 * ROW_PX + last_row_px + 6, |root| {
+        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
+        draw_legend(&parts[0], &legend)?;
+        for k in 0..3 {
+            let cols = columns(&parts[k + 1], &[WIDTH_PX / 2]);
+            let layout = |y_area_px| Layout {
+                y_area_px,
+                x_title: k == 2,
+                title: true,
+            };
+            let name = STATE_NAMES[k];
+            let p = Panel::new(
+                &cols[0],
+                &format!("{}: ensemble and filter variance", capitalized(name)),
+                time.clone(),
+                var_axes[k].clone(),
+                layout(var_area),
+            )?;
+            for (stage, wide, thin) in [
+                (false, ORANGE.mix(0.5), VERMILLION.mix(1.0)),
+                (true, SKY_BLUE.mix(0.6), BLUE.mix(1.0)),
+            ] {
+                let pick = |f: &FixStats| {
+                    if stage {
+                        var(&f.post, k)
+                    } else {
+                        var(&f.prior, k)
+                    }
+                };
+                p.line(
+                    fixes.iter().map(|f| (f.time_s, pick(f).1)),
+                    wide.stroke_width(5),
+                )?;
+                p.line(
+                    fixes.iter().map(|f| (f.time_s, pick(f).0)),
+                    thin.stroke_width(1),
+                )?;
+            }
+
+            let q = Panel::new(
+                &cols[1],
+                &format!("{}: variance ratio P_ave / P", capitalized(name)),
+                time.clone(),
+                ratio_axes[k].clone(),
+                layout(ratio_area),
+            )?;
+            q.hline(1.0, BLACK.mix(0.4).stroke_width(1))?;
+            q.hline(check.lower, BLACK.stroke_width(1))?;
+            q.hline(check.upper, BLACK.stroke_width(1))?;
+            q.line(
+                fixes.iter().map(|f| (f.time_s, ratio(&f.prior, k))),
+                VERMILLION.stroke_width(2),
+            )?;
+            q.line(
+                fixes.iter().map(|f| (f.time_s, ratio(&f.post, k))),
+                BLUE.stroke_width(2),
+            )?;
+        }
+        Ok(())
+    })
 }

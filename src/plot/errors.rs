@@ -4,7 +4,7 @@ use plotters::style::Color;
 
 use super::panel::{
     Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, extent, legend_height, max_abs,
-    padded, render, rows, time_span, y_label_area,
+    padded, render, rows, settled_from, time_span, y_label_area,
 };
 use super::{BLACK, BLUE, ORANGE, PlotResult, STATE_UNITS, capitalized};
 use crate::checks::STATE_NAMES;
@@ -16,19 +16,23 @@ const ROW_PX: u32 = 270;
 const FULL_COLUMN_PX: u32 = 590;
 /// Length of the zoom window, s.
 const ZOOM_S: f64 = 2.0;
+/// The full-run axes show σ up to this multiple of its final value; earlier, larger σ (the
+/// bias's first seconds) runs off the axis rather than flattening the rest of the run.
+const SETTLED_SIGMA_RATIO: f64 = 5.0;
 
 /// The estimation error e = δx − δx̂ of one realization at every accelerometer sample, with the
 /// filter's ±1σ, and beside it a zoom on σ over two seconds, where it grows between GPS fixes and
 /// drops at each update.
 ///
-/// The full-run axes are scaled to the run after its first second (or first quarter, if shorter):
-/// σ starts at the prior's 10 m, 1 m/s, 0.1 m/s² and collapses within the first fixes, which would
+/// The full-run axes are scaled to the run after its first second (or first quarter, if shorter),
+/// and after σ has fallen to five times its final value: σ starts at the prior's 10 m, 1 m/s,
+/// 0.1 m/s² and collapses within the first fixes (the bias's over about ten seconds), which would
 /// otherwise flatten the rest of the run. The zoom plots σ alone because its sawtooth is about 1 %
 /// of σ: on an axis that also holds e, the teeth would be a pixel high.
 pub fn realization_errors(r: &Realization) -> PlotResult {
     let t: Vec<f64> = r.samples.iter().map(|s| s.t_s).collect();
     let (t0, t1) = time_span(t.iter().copied());
-    let settle = t0 + (1.0f64).min(0.25 * (t1 - t0));
+    let settle = settled_from(t0, t1);
     let zoom = zoom_window(t0, t1);
 
     let time = Axis::linear("time", "s", (t0, t1), 8);
@@ -47,11 +51,11 @@ pub fn realization_errors(r: &Realization) -> PlotResult {
     };
 
     let legend = [
-        Entry::new(Swatch::Line(BLUE, 1), "estimation error e = δx − δx̂"),
-        Entry::new(Swatch::Block(ORANGE.mix(0.35)), "filter ±1σ"),
-        Entry::new(Swatch::Line(ORANGE, 2), "filter σ (zoom)"),
-        Entry::new(Swatch::Ring(BLACK), "σ before a GPS update"),
-        Entry::new(Swatch::Dot(BLACK), "σ after it"),
+        Entry::new(Swatch::Line(BLUE.stroke_width(1)), "error e = δx − δx̂"),
+        Entry::new(Swatch::Block(ORANGE.mix(0.35).filled()), "filter ±1σ"),
+        Entry::new(Swatch::Line(ORANGE.stroke_width(2)), "filter σ"),
+        Entry::new(Swatch::Marker(BLACK.stroke_width(2)), "σ before GPS update"),
+        Entry::new(Swatch::Marker(BLACK.filled()), "σ after update"),
     ];
     let legend_px = legend_height(&legend);
     let last_row_px = ROW_PX + 24;
@@ -127,9 +131,19 @@ fn zoom_window(t0: f64, t1: f64) -> (f64, f64) {
     (start, start + ZOOM_S)
 }
 
-/// The symmetric error axis of state `k`, scaled to e and σ after `settle`.
+/// The symmetric error axis of state `k`, scaled to e and σ after `settle` or, if later, after σ
+/// has come within [`SETTLED_SIGMA_RATIO`] of its final value (at most halfway through the run).
 fn error_axis(r: &Realization, k: usize, settle: f64) -> Axis {
-    let late = r.samples.iter().filter(|s| s.t_s >= settle);
+    let (t0, t1) = time_span(r.samples.iter().map(|s| s.t_s));
+    let last = r.samples.last().map_or(f64::NAN, |s| s.sigma[k]);
+    let converged = r
+        .samples
+        .iter()
+        .rposition(|s| s.sigma[k] > SETTLED_SIGMA_RATIO * last || s.sigma[k].is_nan())
+        .and_then(|i| r.samples.get(i + 1))
+        .map_or(t0, |s| s.t_s);
+    let from = settle.max(converged.min(0.5 * (t0 + t1)));
+    let late = r.samples.iter().filter(|s| s.t_s >= from);
     let m = max_abs(late.flat_map(|s| [s.sigma[k], s.delta_x[k] - s.estimate[k]]));
     let m = if m > 0.0 { 1.3 * m } else { 1.0 };
     Axis::linear(

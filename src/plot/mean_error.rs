@@ -1,7 +1,127 @@
-//! stub
-use super::PlotResult;
-use crate::checks::Check;
-use crate::ensemble::EnsembleStats;
-pub fn mean_error(_stats: &EnsembleStats, _check: &Check) -> PlotResult {
-    Ok(String::new())
+//! The ensemble mean error against its acceptance band.
+
+use plotters::style::Color;
+
+use super::panel::{
+    Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, legend_height, max_abs, render, rows,
+    settled_from, time_span, y_label_area,
+};
+use super::{BLACK, BLUE, ORANGE, PlotError, PlotResult, STATE_UNITS, capitalized};
+use crate::checks::{Check, STATE_NAMES};
+use crate::ensemble::{EnsembleStats, FixStats, StageStats};
+
+/// Height of one state's row, px.
+const ROW_PX: u32 = 240;
+/// Width of the full-run column, px; the enlarged second half takes the rest.
+const FULL_COLUMN_PX: u32 = 590;
+
+/// Per state, the ensemble mean error e_ave at every fix, a posteriori and a priori, against the
+/// check's band ±bound·σ/√N, where σ² is the filter's variance of that stage; beside it the
+/// second half of the run, enlarged.
+///
+/// The full-run axes are fitted to the statistics after the first second (or first quarter, if the
+/// run is shorter), where the prior's large σ would otherwise set the scale. The band narrows as
+/// σ does (a hundredfold for the bias over the default run), so the enlarged half keeps the
+/// late mean error from looking like zero.
+pub fn mean_error(stats: &EnsembleStats, check: &Check) -> PlotResult {
+    let fixes = &stats.fixes;
+    let n = stats.realizations as f64;
+    let (t0, t1) = time_span(fixes.iter().map(|f| f.time_s));
+    let settle = settled_from(t0, t1);
+    let half = 0.5 * (t0.min(0.0) + t1);
+    let band = |s: &StageStats, k: usize| check.bound * (s.filter_cov[k][k] / n).sqrt();
+    // Symmetric axis of component k fitted to the fixes at or after `from`.
+    let axis = |k: usize, from: f64| {
+        let m = max_abs(fixes.iter().filter(|f| f.time_s >= from).flat_map(|f| {
+            [
+                f.post.mean_error[k],
+                f.prior.mean_error[k],
+                band(&f.post, k),
+                band(&f.prior, k),
+            ]
+        }));
+        let m = if m > 0.0 { 1.15 * m } else { 1.0 };
+        Axis::linear("e_ave", STATE_UNITS[k], (-m, m), 7)
+    };
+    let full_axes: Vec<Axis> = (0..3).map(|k| axis(k, settle)).collect();
+    let half_axes: Vec<Axis> = (0..3).map(|k| axis(k, half)).collect();
+    let full_area = y_label_area(&full_axes.iter().collect::<Vec<_>>());
+    let half_area = y_label_area(&half_axes.iter().collect::<Vec<_>>());
+    let full_time = Axis::linear("time", "s", (t0.min(0.0), t1), 8);
+    let half_time = Axis::linear("time", "s", (half, t1), 5);
+
+    let legend = [
+        Entry::new(Swatch::Line(BLUE.stroke_width(2)), "a posteriori e_ave"),
+        Entry::new(Swatch::Line(ORANGE.stroke_width(2)), "a priori e_ave"),
+        Entry::new(
+            Swatch::Block(BLUE.mix(0.15).filled()),
+            format!("±{:.2}·σ/√N, a posteriori", check.bound),
+        ),
+        Entry::new(
+            Swatch::Line(ORANGE.mix(0.7).stroke_width(1)),
+            "the same, a priori",
+        ),
+    ];
+    let legend_px = legend_height(&legend);
+    let last_row_px = ROW_PX + 24;
+
+    render(legend_px + 2 * ROW_PX + last_row_px + 6, |root| {
+        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
+        draw_legend(&parts[0], &legend)?;
+        for k in 0..3 {
+            let cols = columns(&parts[k + 1], &[FULL_COLUMN_PX]);
+            let name = capitalized(STATE_NAMES[k]);
+            let layout = |y_area_px| Layout {
+                y_area_px,
+                x_title: k == 2,
+                title: true,
+            };
+            let full = Panel::new(
+                &cols[0],
+                &format!("{name}: ensemble mean error, N = {}", stats.realizations),
+                full_time.clone(),
+                full_axes[k].clone(),
+                layout(full_area),
+            )?;
+            draw(&full, fixes, k, &band)?;
+            let late = Panel::new(
+                &cols[1],
+                &format!("{name}: second half, enlarged"),
+                half_time.clone(),
+                half_axes[k].clone(),
+                layout(half_area),
+            )?;
+            draw(&late, fixes, k, &band)?;
+        }
+        Ok(())
+    })
+}
+
+/// The band, the zero line and both mean errors of component `k`.
+fn draw(
+    p: &Panel<'_>,
+    fixes: &[FixStats],
+    k: usize,
+    band: &dyn Fn(&StageStats, usize) -> f64,
+) -> Result<(), PlotError> {
+    let t: Vec<f64> = fixes.iter().map(|f| f.time_s).collect();
+    let upper: Vec<f64> = fixes.iter().map(|f| band(&f.post, k)).collect();
+    let lower: Vec<f64> = upper.iter().map(|b| -b).collect();
+    p.band(&t, &lower, &upper, BLUE.mix(0.15))?;
+    for sign in [1.0, -1.0] {
+        p.line(
+            fixes.iter().map(|f| (f.time_s, sign * band(&f.prior, k))),
+            ORANGE.mix(0.7).stroke_width(1),
+        )?;
+    }
+    p.hline(0.0, BLACK.mix(0.5).stroke_width(1))?;
+    p.line(
+        fixes.iter().map(|f| (f.time_s, f.prior.mean_error[k])),
+        ORANGE.stroke_width(2),
+    )?;
+    p.line(
+        fixes.iter().map(|f| (f.time_s, f.post.mean_error[k])),
+        BLUE.stroke_width(2),
+    )?;
+    Ok(())
 }

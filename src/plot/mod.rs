@@ -10,6 +10,9 @@
 //! Non-finite values are never handed to plotters; lines break where data is missing or leave the
 //! axes.
 //!
+//! Each document is [`WIDTH_PX`] wide with a `viewBox`, so a page scales it into its column with
+//! `max-width: 100%; height: auto`.
+//!
 //! [`Realization`]: crate::realization::Realization
 //! [`EnsembleStats`]: crate::ensemble::EnsembleStats
 //! [`Check`]: crate::checks::Check

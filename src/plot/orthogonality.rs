@@ -1,7 +1,90 @@
-//! stub
-use super::PlotResult;
-use crate::checks::Check;
-use crate::ensemble::EnsembleStats;
-pub fn orthogonality(_stats: &EnsembleStats, _check: &Check) -> PlotResult {
-    Ok(String::new())
+//! Orthogonality of the estimation error and the estimate.
+
+use plotters::style::Color;
+
+use super::panel::{
+    Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, legend_height, max_abs, render, rows,
+    time_span, y_label_area,
+};
+use super::{BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotResult, WIDTH_PX, capitalized};
+use crate::checks::{Check, STATE_NAMES};
+use crate::ensemble::{EnsembleStats, StageStats};
+
+/// Height of one error component's row, px.
+const ROW_PX: u32 = 230;
+/// Colour of each estimate component k.
+const COLORS: [plotters::style::RGBColor; 3] = [BLUE, ORANGE, BLUISH_GREEN];
+
+/// The normalized correlations √N·corr(e_j − e_ave,j, δx̂_k) of every component pair at every fix
+/// against ±bound: one row per error component j, a priori on the left and a posteriori on the
+/// right, one colour per estimate component k. Undefined correlations (an estimate component
+/// that does not vary over the ensemble) are left out.
+pub fn orthogonality(stats: &EnsembleStats, check: &Check) -> PlotResult {
+    let fixes = &stats.fixes;
+    let root_n = (stats.realizations as f64).sqrt();
+    let z = |s: &StageStats, j: usize, k: usize| root_n * s.orthogonality_corr[j][k];
+    let (t0, t1) = time_span(fixes.iter().map(|f| f.time_s));
+    let time = Axis::linear("time", "s", (t0.min(0.0), t1), 7);
+    let m = max_abs(
+        fixes
+            .iter()
+            .flat_map(|f| [&f.prior, &f.post])
+            .flat_map(|s| (0..9).map(move |i| z(s, i / 3, i % 3)))
+            .chain([check.bound]),
+    );
+    let y = Axis::linear("√N · correlation", "", (-1.15 * m, 1.15 * m), 7);
+    let y_area_px = y_label_area(&[&y]);
+
+    let mut legend: Vec<Entry> = (0..3)
+        .map(|k| {
+            Entry::new(
+                Swatch::Line(COLORS[k].stroke_width(2)),
+                format!("{} estimate", STATE_NAMES[k]),
+            )
+        })
+        .collect();
+    legend.push(Entry::new(
+        Swatch::Line(BLACK.stroke_width(1)),
+        format!("±{:.2} bound", check.bound),
+    ));
+    let legend_px = legend_height(&legend);
+    let last_row_px = ROW_PX + 24;
+
+    render(legend_px + 2 * ROW_PX + last_row_px + 6, |root| {
+        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
+        draw_legend(&parts[0], &legend)?;
+        for j in 0..3 {
+            let cols = columns(&parts[j + 1], &[WIDTH_PX / 2]);
+            for (c, prior) in [(0, true), (1, false)] {
+                let p = Panel::new(
+                    &cols[c],
+                    &format!(
+                        "{} error vs the estimates, {}",
+                        capitalized(STATE_NAMES[j]),
+                        if prior { "a priori" } else { "a posteriori" }
+                    ),
+                    time.clone(),
+                    y.clone(),
+                    Layout {
+                        y_area_px,
+                        x_title: j == 2,
+                        title: true,
+                    },
+                )?;
+                p.hline(0.0, BLACK.mix(0.5).stroke_width(1))?;
+                p.hline(check.bound, BLACK.stroke_width(1))?;
+                p.hline(-check.bound, BLACK.stroke_width(1))?;
+                for (k, color) in COLORS.iter().enumerate() {
+                    p.line(
+                        fixes.iter().map(|f| {
+                            let s = if prior { &f.prior } else { &f.post };
+                            (f.time_s, z(s, j, k))
+                        }),
+                        color.stroke_width(1),
+                    )?;
+                }
+            }
+        }
+        Ok(())
+    })
 }

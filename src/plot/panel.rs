@@ -30,11 +30,13 @@ pub(crate) type Point = (f64, f64);
 /// sans-serif faces (DejaVu Sans digits are 0.64 em, Arial's 0.56 em).
 const CHAR_EM: f64 = 0.6;
 /// Height of a panel's title strip, px.
-pub(crate) const TITLE_STRIP_PX: u32 = 28;
+const TITLE_STRIP_PX: u32 = 28;
 /// Length of the tick marks, px; plotters keeps labels two tick lengths from the axis.
 const TICK_PX: i32 = 4;
+/// Space left of a panel's label area, px: keeps the rotated y-axis title off the edge.
+const LEFT_PAD_PX: u32 = 4;
 /// Space right of a panel's plotting area, px.
-const RIGHT_PAD_PX: u32 = 14;
+const RIGHT_PAD_PX: u32 = 22;
 /// Space above a panel's plotting area (below its title), px.
 const TOP_PAD_PX: u32 = 4;
 /// Height of one legend row, px.
@@ -146,6 +148,19 @@ impl Axis {
             range: a..b,
             log10: true,
             max_ticks: (decades + 1).min(8),
+            exponent: 0,
+            decimals: 0,
+        }
+    }
+
+    /// An axis over `[lo, hi]` without ticks, labels or title.
+    pub(crate) fn bare((lo, hi): (f64, f64)) -> Self {
+        Axis {
+            name: String::new(),
+            unit: String::new(),
+            range: sane_range(lo, hi),
+            log10: false,
+            max_ticks: 0,
             exponent: 0,
             decimals: 0,
         }
@@ -295,8 +310,14 @@ fn superscript(k: i32) -> String {
 /// in `axes`: panels stacked in one column share it so that their plotting areas line up.
 pub(crate) fn y_label_area(axes: &[&Axis]) -> u32 {
     let labels = axes.iter().map(|a| a.label_width()).fold(0.0, f64::max);
+    let titled = axes.iter().any(|a| !a.title().is_empty());
     // Rotated title (one line), a gap, the labels, and the tick-to-label distance.
-    (AXIS_LABEL_PX * 1.3 + 8.0 + labels + 2.0 * TICK_PX as f64 + 2.0).ceil() as u32
+    let title = if titled {
+        AXIS_LABEL_PX * 1.3 + 8.0
+    } else {
+        6.0
+    };
+    (title + labels + 2.0 * TICK_PX as f64 + 2.0).ceil() as u32
 }
 
 /// Height of the bottom label area: tick labels, and the axis title when it is shown.
@@ -344,14 +365,28 @@ impl<'b> Panel<'b> {
             strip.draw_text(
                 title,
                 &font(TITLE_PX).pos(Pos::new(HPos::Left, VPos::Center)),
-                (layout.y_area_px as i32, TITLE_STRIP_PX as i32 / 2 + 2),
+                (
+                    (LEFT_PAD_PX + layout.y_area_px) as i32,
+                    TITLE_STRIP_PX as i32 / 2 + 2,
+                ),
             )?;
             body
         } else {
             area.clone()
         };
+        // A rotated y-axis title much longer than the plot is tall would run into the next
+        // panel: it then takes the tick labels' size. (The width estimate is generous, hence the
+        // slack; sizes stay whole pixels.)
+        let plot_height =
+            body.dim_in_pixel().1 as f64 - (TOP_PAD_PX + x_label_area(layout.x_title)) as f64;
+        let y_title_px = if text_width(&y.title(), AXIS_LABEL_PX) <= 1.15 * plot_height {
+            AXIS_LABEL_PX
+        } else {
+            TICK_LABEL_PX
+        };
         let mut chart = ChartBuilder::on(&body)
             .margin_top(TOP_PAD_PX)
+            .margin_left(LEFT_PAD_PX)
             .margin_right(RIGHT_PAD_PX)
             .y_label_area_size(layout.y_area_px)
             .x_label_area_size(x_label_area(layout.x_title))
@@ -360,7 +395,6 @@ impl<'b> Panel<'b> {
             let x_fmt = |v: &f64| x.label(*v);
             let y_fmt = |v: &f64| y.label(*v);
             let x_title = x.title();
-            let y_title = y.title();
             let mut mesh = chart.configure_mesh();
             mesh.x_labels(x.max_ticks)
                 .y_labels(y.max_ticks)
@@ -369,13 +403,23 @@ impl<'b> Panel<'b> {
                 .axis_style(GREY.stroke_width(1))
                 .set_all_tick_mark_size(TICK_PX)
                 .label_style(font(TICK_LABEL_PX))
-                .axis_desc_style(font(AXIS_LABEL_PX))
                 .x_label_formatter(&x_fmt)
-                .y_label_formatter(&y_fmt)
-                .y_desc(y_title);
-            if layout.x_title {
-                mesh.x_desc(x_title);
+                .y_label_formatter(&y_fmt);
+            if layout.x_title && !x_title.is_empty() {
+                mesh.axis_desc_style(font(AXIS_LABEL_PX)).x_desc(x_title);
             }
+            mesh.draw()?;
+        }
+        if !y.title().is_empty() {
+            // Drawn as a second mesh pass without ticks or grid, so that it can take its own size.
+            let y_title = y.title();
+            let mut mesh = chart.configure_mesh();
+            mesh.disable_mesh()
+                .disable_axes()
+                .x_labels(0)
+                .y_labels(0)
+                .axis_desc_style(font(y_title_px))
+                .y_desc(y_title);
             mesh.draw()?;
         }
         let (xr, yr) = (x.range(), y.range());
@@ -395,6 +439,11 @@ impl<'b> Panel<'b> {
         self.area().dim_in_pixel().0.max(1) as usize
     }
 
+    /// The pixel column that plotters draws abscissa `x` (plot coordinates) in.
+    fn column(&self, x: f64) -> i64 {
+        i64::from(self.area().map_coordinate(&(x, self.y.range.start)).0)
+    }
+
     /// Maps data points to plot coordinates (NaN where the y axis cannot show them).
     fn mapped(&self, points: impl IntoIterator<Item = Point>) -> Vec<Point> {
         points
@@ -412,7 +461,7 @@ impl<'b> Panel<'b> {
     ) -> Result<(), PlotError> {
         let pts = self.mapped(points);
         for run in clip_polyline(&pts, &self.x.range, &self.y.range) {
-            let run = thin(&run, &self.x.range, self.width_px());
+            let run = thin(&run, self.width_px(), |x| self.column(x));
             self.area().draw(&PathElement::new(run, style))?;
         }
         Ok(())
@@ -450,8 +499,8 @@ impl<'b> Panel<'b> {
             if top.len() < 2 {
                 continue;
             }
-            let mut outline = thin(&top, &self.x.range, width);
-            let mut lower = thin(&bottom, &self.x.range, width);
+            let mut outline = thin(&top, width, |x| self.column(x));
+            let mut lower = thin(&bottom, width, |x| self.column(x));
             lower.reverse();
             outline.extend(lower);
             self.area().draw(&Polygon::new(outline, color.filled()))?;
@@ -620,14 +669,14 @@ fn clip_segment(
     ))
 }
 
-/// Thins a run ordered in x to at most four points per pixel column (the first, lowest, highest
-/// and last, in their original order), which draws the same picture.
-fn thin(run: &[Point], xr: &Range<f64>, columns: usize) -> Vec<Point> {
-    if run.len() <= 4 * columns {
+/// Thins a run ordered in x, drawn `columns` pixels wide, to what the pixels can show: one point
+/// per pixel column (`column(x)`) where the run is monotone across it, and its extremes where it
+/// turns inside it (noise, or a sawtooth's drop). Coordinates are whole pixels in the SVG, so the
+/// dropped points would only have drawn a staircase of vertical steps.
+fn thin(run: &[Point], columns: usize, column: impl Fn(f64) -> i64) -> Vec<Point> {
+    if run.len() <= columns {
         return run.to_vec();
     }
-    let span = xr.end - xr.start;
-    let column = |x: f64| (((x - xr.start) / span * columns as f64).floor() as i64).max(0);
     let mut out = Vec::with_capacity(4 * columns + 4);
     let mut start = 0;
     while start < run.len() {
@@ -646,16 +695,25 @@ fn thin(run: &[Point], xr: &Range<f64>, columns: usize) -> Vec<Point> {
                 hi = i;
             }
         }
-        let mut keep = [0, lo, hi, bucket.len() - 1];
-        keep.sort_unstable();
-        let mut last = usize::MAX;
-        for k in keep {
-            if k != last {
-                out.push(bucket[k]);
-                last = k;
+        let last = bucket.len() - 1;
+        let monotone = (lo == 0 && hi == last) || (hi == 0 && lo == last);
+        if monotone {
+            out.push(bucket[0]);
+        } else {
+            let mut keep = [0, lo, hi, last];
+            keep.sort_unstable();
+            let mut previous = usize::MAX;
+            for k in keep {
+                if k != previous {
+                    out.push(bucket[k]);
+                    previous = k;
+                }
             }
         }
         start = end;
+    }
+    if out.last() != run.last() {
+        out.extend(run.last());
     }
     out
 }
@@ -688,6 +746,13 @@ pub(crate) fn padded((lo, hi): (f64, f64), frac: f64) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// Where a run of `[t0, t1]` has left the prior behind: after its first second, or its first
+/// quarter if shorter. Axes fitted to the data from here on are not set by the prior's σ
+/// (10 m, 1 m/s, 0.1 m/s²), which the first GPS fixes collapse.
+pub(crate) fn settled_from(t0: f64, t1: f64) -> f64 {
+    t0 + (1.0f64).min(0.25 * (t1 - t0))
+}
+
 /// The first and last finite abscissa of `values`, or `[0, 1]`.
 pub(crate) fn time_span(times: impl IntoIterator<Item = f64>) -> (f64, f64) {
     extent(times).unwrap_or((0.0, 1.0))
@@ -696,17 +761,15 @@ pub(crate) fn time_span(times: impl IntoIterator<Item = f64>) -> (f64, f64) {
 // ---------------------------------------------------------------------------------------------
 // Legends
 
-/// What a legend entry shows before its label.
+/// What a legend entry shows before its label, in the style the figure draws it with.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Swatch {
-    /// A line segment of the given colour and width.
-    Line(RGBColor, u32),
-    /// A filled block: a band or a cell colour.
-    Block(RGBAColor),
-    /// A filled circle.
-    Dot(RGBColor),
-    /// An open circle.
-    Ring(RGBColor),
+    /// A line segment.
+    Line(ShapeStyle),
+    /// A block: a band or a cell colour.
+    Block(ShapeStyle),
+    /// A circle, filled or open.
+    Marker(ShapeStyle),
 }
 
 /// One legend entry.
@@ -778,25 +841,18 @@ pub(crate) fn draw_legend(area: &Area<'_>, entries: &[Entry]) -> Result<(), Plot
 }
 
 fn draw_swatch(area: &Area<'_>, swatch: Swatch, x: i32, y: i32) -> Result<(), PlotError> {
-    let mid = x + SWATCH_PX / 2;
     match swatch {
-        Swatch::Line(c, width) => {
-            area.draw(&PathElement::new(
-                vec![(x, y), (x + SWATCH_PX, y)],
-                c.stroke_width(width),
-            ))?;
+        Swatch::Line(style) => {
+            area.draw(&PathElement::new(vec![(x, y), (x + SWATCH_PX, y)], style))?;
         }
-        Swatch::Block(c) => {
+        Swatch::Block(style) => {
             area.draw(&Rectangle::new(
                 [(x, y - 7), (x + SWATCH_PX, y + 7)],
-                c.filled(),
+                style.filled(),
             ))?;
         }
-        Swatch::Dot(c) => {
-            area.draw(&Circle::new((mid, y), 4, c.filled()))?;
-        }
-        Swatch::Ring(c) => {
-            area.draw(&Circle::new((mid, y), 4, c.stroke_width(2)))?;
+        Swatch::Marker(style) => {
+            area.draw(&Circle::new((x + SWATCH_PX / 2, y), 4, style))?;
         }
     }
     Ok(())
@@ -848,7 +904,7 @@ mod tests {
         let run: Vec<Point> = (0..1000)
             .map(|i| (i as f64 / 1000.0, if i == 501 { 9.0 } else { 0.0 }))
             .collect();
-        let thin = thin(&run, &(0.0..1.0), 10);
+        let thin = thin(&run, 10, |x| (x * 10.0).floor() as i64);
         assert!(thin.len() <= 40);
         assert!(thin.contains(&(0.501, 9.0)));
         assert!(thin.windows(2).all(|w| w[0].0 <= w[1].0));

@@ -1,11 +1,248 @@
-//! stub
-use super::PlotResult;
-use crate::checks::{Check, ResidualPair};
+//! Whiteness of the residuals: the normalized correlation of r(t_i) and r(t_m), t_m < t_i.
+
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::{Color, RGBColor};
+
+use super::panel::{
+    Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, font, format_number, legend_height,
+    render, rows, y_label_area,
+};
+use super::{BLACK, BLUE, GRID, PlotResult, TICK_LABEL_PX, VERMILLION};
+use crate::checks::{Check, ResidualPair, residual_z};
 use crate::ensemble::EnsembleStats;
-pub fn residual_whiteness(
-    _stats: &EnsembleStats,
-    _check: &Check,
-    _pair: &ResidualPair,
-) -> PlotResult {
-    Ok(String::new())
+
+/// Cells per side of the map at most: fixes are grouped so the map holds ≤ 50 × 50 cells.
+const MAX_CELLS: usize = 50;
+/// Colour levels between |z| = 0 and the bound.
+const LEVELS: usize = 8;
+/// Width of the map's column, px.
+const MAP_COLUMN_PX: u32 = 600;
+/// Height of the map panel, px.
+const MAP_PX: u32 = 600;
+/// Height of the colour scale, px.
+const SCALE_PX: u32 = 96;
+/// Colour of |z| = 0 and of |z| just below the bound.
+const LOW: RGBColor = RGBColor(0xF1, 0xF6, 0xFB);
+const HIGH: RGBColor = RGBColor(0x00, 0x45, 0x7A);
+
+/// Left: every pair of fixes t_m < t_i, coloured by the largest |z| of its four component pairs,
+/// z = √N·corr(r_a(t_i), r_b(t_m)); the fixes are grouped into at most 50 × 50 cells, each showing
+/// its largest |z|, with |z| beyond `check.bound` in vermillion. Right: the four z of the
+/// statement's pair against `pair.bound`.
+pub fn residual_whiteness(stats: &EnsembleStats, check: &Check, pair: &ResidualPair) -> PlotResult {
+    let times: Vec<f64> = stats.fixes.iter().map(|f| f.time_s).collect();
+    let n = times.len();
+    let per_cell = n.div_ceil(MAX_CELLS).max(1);
+    let cells = n.div_ceil(per_cell);
+    let period = if n >= 2 {
+        (times[n - 1] - times[0]) / (n - 1) as f64
+    } else {
+        1.0
+    };
+    let (first, last) = match (times.first(), times.last()) {
+        (Some(&a), Some(&b)) => (a - 0.5 * period, b + 0.5 * period),
+        _ => (0.0, 1.0),
+    };
+    // Edges of cell c along either axis: from half a period before its first fix to half a
+    // period after its last.
+    let edges = |c: usize| {
+        let a = c * per_cell;
+        let b = ((c + 1) * per_cell).min(n) - 1;
+        (times[a] - 0.5 * period, times[b] + 0.5 * period)
+    };
+    // Largest |z| of each cell (row = block of t_i, column = block of t_m), NaN where empty.
+    let cell_max = |ci: usize, cm: usize| {
+        let mut worst = f64::NAN;
+        for i in ci * per_cell..((ci + 1) * per_cell).min(n) {
+            for m in cm * per_cell..((cm + 1) * per_cell).min(i) {
+                for a in 0..2 {
+                    for b in 0..2 {
+                        let z = residual_z(stats, 2 * i + a, 2 * m + b).abs();
+                        if z.is_finite() {
+                            worst = z.max(worst);
+                        }
+                    }
+                }
+            }
+        }
+        worst
+    };
+    let level = |z: f64| -> Option<usize> {
+        if !z.is_finite() {
+            None
+        } else if z >= check.bound {
+            Some(LEVELS)
+        } else {
+            Some(((z / check.bound * LEVELS as f64).floor() as usize).min(LEVELS - 1))
+        }
+    };
+
+    let map_x = Axis::linear("t_m", "s", (first, last), 7);
+    let map_y = Axis::linear("t_i", "s", (first, last), 7);
+    let scale_top = 1.25 * check.bound;
+    let scale_x = Axis::linear("largest |z| in the cell", "", (0.0, scale_top), 8);
+    let scale_y = Axis::bare((-0.5, 0.5));
+    let map_area = y_label_area(&[&map_y]);
+
+    let names = ["r_p", "r_v"];
+    // In pair.z's order: (position, position), (position, velocity), (velocity, position), ….
+    let categories: Vec<String> = (0..4)
+        .map(|c| format!("{}(t_i)·{}(t_m)", names[c / 2], names[c % 2]))
+        .collect();
+    let zs = pair.z.iter().flatten().copied().collect::<Vec<_>>();
+    let reach = zs
+        .iter()
+        .filter(|z| z.is_finite())
+        .fold(pair.bound, |m, z| m.max(z.abs()));
+    let pair_x = Axis::linear("z = √N · correlation", "", (-1.2 * reach, 1.2 * reach), 5);
+    let pair_y = Axis::bare((-0.5, 3.6));
+    let pair_area = y_label_area(&[&pair_y]);
+
+    let pairs = n * n.saturating_sub(1) / 2;
+    let map_title = if per_cell == 1 {
+        format!("All {pairs} pairs t_m < t_i")
+    } else {
+        format!("All {pairs} pairs t_m < t_i, in cells of {per_cell} × {per_cell} fixes")
+    };
+
+    let legend = [
+        Entry::new(Swatch::Marker(BLACK.stroke_width(2)), "statement's pair"),
+        Entry::new(Swatch::Marker(BLUE.filled()), "z of that pair"),
+        Entry::new(Swatch::Marker(VERMILLION.filled()), "beyond the bound"),
+        Entry::new(
+            Swatch::Line(BLACK.stroke_width(1)),
+            format!("±{:.2} bound of the pair", pair.bound),
+        ),
+    ];
+    let legend_px = legend_height(&legend);
+
+    render(legend_px + MAP_PX + SCALE_PX + 6, |root| {
+        let parts = rows(root, &[legend_px, MAP_PX + SCALE_PX]);
+        draw_legend(&parts[0], &legend)?;
+        let cols = columns(&parts[1], &[MAP_COLUMN_PX]);
+        let left = rows(&cols[0], &[MAP_PX]);
+
+        let map = Panel::new(
+            &left[0],
+            &map_title,
+            map_x,
+            map_y,
+            Layout {
+                y_area_px: map_area,
+                x_title: true,
+                title: true,
+            },
+        )?;
+        for ci in 0..cells {
+            let (y0, y1) = edges(ci);
+            // Runs of equal colour along the row are drawn as one rectangle.
+            let mut run: Option<(usize, usize, usize)> = None;
+            for cm in 0..=ci {
+                let l = level(cell_max(ci, cm));
+                match (run, l) {
+                    (Some((start, end, lv)), Some(l)) if lv == l && end + 1 == cm => {
+                        run = Some((start, cm, lv));
+                    }
+                    _ => {
+                        if let Some((start, end, lv)) = run.take() {
+                            map.rect(
+                                (edges(start).0, y0),
+                                (edges(end).1, y1),
+                                level_color(lv).filled(),
+                            )?;
+                        }
+                        run = l.map(|l| (cm, cm, l));
+                    }
+                }
+            }
+            if let Some((start, end, lv)) = run {
+                map.rect(
+                    (edges(start).0, y0),
+                    (edges(end).1, y1),
+                    level_color(lv).filled(),
+                )?;
+            }
+        }
+        map.dots([(pair.t_m_s, pair.t_i_s)], 7, BLACK.stroke_width(2))?;
+
+        let scale = Panel::new(
+            &left[1],
+            "",
+            scale_x,
+            scale_y,
+            Layout {
+                y_area_px: map_area,
+                x_title: true,
+                title: false,
+            },
+        )?;
+        for l in 0..=LEVELS {
+            let lo = check.bound * l as f64 / LEVELS as f64;
+            let hi = if l == LEVELS {
+                scale_top
+            } else {
+                check.bound * (l + 1) as f64 / LEVELS as f64
+            };
+            scale.rect((lo, -0.5), (hi, 0.5), level_color(l).filled())?;
+        }
+        scale.text(
+            (check.bound, 0.0),
+            &format!(" ≥ {}", format_number(check.bound, 2)),
+            &font(TICK_LABEL_PX).color(&plotters::style::WHITE),
+            Pos::new(HPos::Left, VPos::Center),
+        )?;
+
+        let p = Panel::new(
+            &cols[1],
+            &format!(
+                "Pair t_m = {} s, t_i = {} s",
+                format_number(pair.t_m_s, 1),
+                format_number(pair.t_i_s, 1)
+            ),
+            pair_x,
+            pair_y,
+            Layout {
+                y_area_px: pair_area,
+                x_title: true,
+                title: true,
+            },
+        )?;
+        p.vline(0.0, BLACK.mix(0.5).stroke_width(1))?;
+        p.vline(pair.bound, BLACK.stroke_width(1))?;
+        p.vline(-pair.bound, BLACK.stroke_width(1))?;
+        // One row per component pair, top to bottom, named above its line.
+        let left = -1.2 * reach * 0.97;
+        for (idx, (&z, name)) in zs.iter().zip(&categories).enumerate() {
+            let y = (3 - idx) as f64;
+            p.hline(y, GRID.stroke_width(1))?;
+            let value = if z.is_finite() {
+                format!("{name}: z = {}", format_number(z, 2))
+            } else {
+                format!("{name}: undefined")
+            };
+            p.text(
+                (left, y + 0.14),
+                &value,
+                &font(TICK_LABEL_PX),
+                Pos::new(HPos::Left, VPos::Bottom),
+            )?;
+            let color = if z.abs() > pair.bound {
+                VERMILLION
+            } else {
+                BLUE
+            };
+            p.dots([(z, y)], 6, color.filled())?;
+        }
+        Ok(())
+    })
+}
+
+/// Colour of level `l`: a ramp from light to dark blue below the bound, vermillion at it.
+fn level_color(l: usize) -> RGBColor {
+    if l >= LEVELS {
+        return VERMILLION;
+    }
+    let f = (l as f64 + 0.5) / LEVELS as f64;
+    let mix = |a: u8, b: u8| (a as f64 + (b as f64 - a as f64) * f).round() as u8;
+    RGBColor(mix(LOW.0, HIGH.0), mix(LOW.1, HIGH.1), mix(LOW.2, HIGH.2))
 }

@@ -15,7 +15,7 @@ fn small_study() -> &'static Study {
         let mut c = Config::default();
         c.profile.duration_s = 4.0;
         c.ensemble.realizations = 200;
-        c.checks.residual_pair_s = [1.0, 3.0];
+        c.checks.residual_pair_s = Some([1.0, 3.0]);
         Study::run(&Model::new(&c).unwrap(), true).unwrap()
     })
 }
@@ -26,9 +26,15 @@ fn check<'a>(study: &'a Study, id: &str) -> &'a Check {
 
 /// Every figure of `study`, by name.
 fn figures(study: &Study) -> Vec<(&'static str, String)> {
-    let p = study.primary();
+    figures_of(study, study.model.truth)
+}
+
+/// Every figure of `study`, the ensemble figures drawn for truth model `truth`.
+fn figures_of(study: &Study, truth: TruthModel) -> Vec<(&'static str, String)> {
+    let p = study.ensemble(truth);
     let s = &p.run.stats;
     let v = &p.verdicts;
+    let check = |_: &Study, id: &str| v.get(id).unwrap();
     vec![
         (
             "realization_errors",
@@ -81,28 +87,35 @@ fn every_figure_is_well_formed_and_labelled() {
     let expected: [(&str, &[&str]); 8] = [
         (
             "realization_errors",
-            &["time (s)", "position error (m)", "velocity error (m/s)"],
+            &[
+                "time (s)",
+                "position error (",
+                "velocity error (",
+                "bias σ (",
+            ],
         ),
         (
             "trajectory",
             &["time (s)", "acceleration (m/s²)", "position (m)"],
         ),
-        ("mean_error", &["time (s)"]),
-        ("covariance", &["time (s)", "variance / filter variance"]),
+        ("mean_error", &["time (s)", "e_ave ("]),
+        ("covariance", &["time (s)", "variance (m²)", "P_ave / P"]),
         ("orthogonality", &["time (s)", "√N · correlation"]),
         ("residual_whiteness", &["t_m (s)", "t_i (s)"]),
         ("consistency", &["time (s)", "average NEES", "average NIS"]),
-        ("truth_models", &["time (s)"]),
+        ("truth_models", &["time (s)", "e_ave / σ"]),
     ];
     let figs = figures(small_study());
     for ((name, svg), (expected_name, labels)) in figs.iter().zip(expected) {
         assert_eq!(*name, expected_name);
         let texts = texts(svg);
         for label in labels {
-            assert!(
-                texts.iter().any(|t| t == label),
-                "{name}: no text {label:?} among {texts:?}"
-            );
+            // A label ending in "(" stands for any unit that follows, which may carry a power of
+            // ten chosen from the data.
+            let found = texts
+                .iter()
+                .any(|t| t == label || (label.ends_with('(') && t.starts_with(label)));
+            assert!(found, "{name}: no text {label:?} among {texts:?}");
         }
         assert!(!svg.contains("NaN"), "{name} holds NaN");
         assert!(!svg.contains("inf"), "{name} holds inf");
@@ -136,6 +149,44 @@ fn non_finite_statistics_are_skipped() {
     }
 }
 
+#[test]
+fn figures_survive_statistics_that_are_all_undefined() {
+    let study = small_study();
+    let mut stats = study.primary().run.stats.clone();
+    for f in &mut stats.fixes {
+        for s in [&mut f.prior, &mut f.post] {
+            s.mean_error = [f64::NAN; 3];
+            s.ensemble_cov = [[f64::NAN; 3]; 3];
+            s.filter_cov = [[f64::INFINITY; 3]; 3];
+            s.orthogonality_corr = [[f64::NAN; 3]; 3];
+            s.nees_avg = f64::NAN;
+        }
+        f.nis_avg = f64::NAN;
+    }
+    stats.residual_corr.iter_mut().for_each(|x| *x = f64::NAN);
+    let mut r = study.realization.clone();
+    for s in &mut r.samples {
+        s.sigma = [f64::NAN; 3];
+        s.estimate = [f64::INFINITY; 3];
+    }
+    let c = check(study, "mean_error");
+    let mut pair = study.primary().verdicts.residual_pair.clone();
+    pair.z = [[f64::NAN; 2]; 2];
+    for svg in [
+        realization_errors(&r).unwrap(),
+        trajectory(&r).unwrap(),
+        mean_error(&stats, c).unwrap(),
+        covariance(&stats, c).unwrap(),
+        orthogonality(&stats, c).unwrap(),
+        residual_whiteness(&stats, c, &pair).unwrap(),
+        consistency(&stats, c, c).unwrap(),
+        truth_models(&stats, &stats).unwrap(),
+    ] {
+        texts(&svg);
+        assert!(!svg.contains("NaN") && !svg.contains("inf"));
+    }
+}
+
 /// Writes every figure of the default configuration to /tmp/figs for a look:
 /// `cargo test --release --lib plot::tests::render_default_figures -- --ignored`.
 #[test]
@@ -144,12 +195,16 @@ fn render_default_figures() {
     let study = Study::run(&Model::new(&Config::default()).unwrap(), true).unwrap();
     let dir = std::path::Path::new("/tmp/figs");
     std::fs::create_dir_all(dir).unwrap();
-    for (name, svg) in figures(&study) {
-        if svg.is_empty() {
-            continue;
+    let small = small_study();
+    for (suffix, study, truth) in [
+        ("", &study, TruthModel::Analytic),
+        ("_euler", &study, TruthModel::Euler),
+        ("_small", small, TruthModel::Analytic),
+    ] {
+        for (name, svg) in figures_of(study, truth) {
+            texts(&svg);
+            std::fs::write(dir.join(format!("{name}{suffix}.svg")), &svg).unwrap();
+            println!("{name}{suffix}: {:.0} KB", svg.len() as f64 / 1024.0);
         }
-        texts(&svg);
-        std::fs::write(dir.join(format!("{name}.svg")), &svg).unwrap();
-        println!("{name}: {:.0} KB", svg.len() as f64 / 1024.0);
     }
 }

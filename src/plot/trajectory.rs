@@ -1,6 +1,140 @@
-//! stub
-use super::PlotResult;
-use crate::realization::Realization;
-pub fn trajectory(_r: &Realization) -> PlotResult {
-    Ok(String::new())
+//! The vehicle's motion in one realization, and the drift of the integrated accelerometer that the
+//! filter estimates.
+
+use plotters::style::Color;
+
+use super::panel::{
+    Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, extent, legend_height, padded,
+    render, rows, settled_from, time_span, y_label_area,
+};
+use super::{BLUE, ORANGE, PlotResult, VERMILLION, WIDTH_PX};
+use crate::realization::{Realization, SampleRecord};
+
+/// Height of one row, px.
+const ROW_PX: u32 = 250;
+
+/// Left: the true acceleration a(t), and the true velocity and position with the integrated
+/// accelerometer's (eq. 3) on top. Right: what separates them — the accelerometer bias and the
+/// drifts δv = v − v_c, δp = p − p_c — each with the filter's estimate.
+///
+/// The estimates start at zero, far from a truth drawn from the prior, so the right-hand axes are
+/// fitted to the truth over the run and to the estimates after the first second.
+pub fn trajectory(r: &Realization) -> PlotResult {
+    let s = &r.samples;
+    let (t0, t1) = time_span(s.iter().map(|x| x.t_s));
+    let settle = settled_from(t0, t1);
+    let time = Axis::linear("time", "s", (t0, t1), 7);
+
+    let fitted = |name: &str, unit: &str, values: Vec<f64>| {
+        let range = extent(values).map_or((-1.0, 1.0), |e| padded(e, 0.06));
+        Axis::linear(name, unit, range, 6)
+    };
+    let left = [
+        fitted(
+            "acceleration",
+            "m/s²",
+            s.iter().map(|x| x.accel_m_s2).collect(),
+        ),
+        fitted(
+            "velocity",
+            "m/s",
+            s.iter()
+                .flat_map(|x| [x.truth_v_m_s, x.computed_v_m_s])
+                .collect(),
+        ),
+        fitted(
+            "position",
+            "m",
+            s.iter()
+                .flat_map(|x| [x.truth_p_m, x.computed_p_m])
+                .collect(),
+        ),
+    ];
+    let drift_axis = |k: usize, name: &str, unit: &str| {
+        let values = s
+            .iter()
+            .map(|x| x.delta_x[k])
+            .chain(s.iter().filter(|x| x.t_s >= settle).map(|x| x.estimate[k]))
+            .collect::<Vec<_>>();
+        let range = extent(values).map_or((-1.0, 1.0), |e| padded(e, 0.12));
+        Axis::linear(name, unit, range, 6)
+    };
+    let right = [
+        drift_axis(2, "bias", "m/s²"),
+        drift_axis(1, "velocity drift", "m/s"),
+        drift_axis(0, "position drift", "m"),
+    ];
+    let left_area = y_label_area(&left.iter().collect::<Vec<_>>());
+    let right_area = y_label_area(&right.iter().collect::<Vec<_>>());
+
+    let legend = [
+        Entry::new(Swatch::Line(BLUE.stroke_width(2)), "truth"),
+        Entry::new(
+            Swatch::Line(ORANGE.stroke_width(2)),
+            "integrated accelerometer",
+        ),
+        Entry::new(Swatch::Line(VERMILLION.stroke_width(2)), "filter estimate"),
+    ];
+    let legend_px = legend_height(&legend);
+    let last_row_px = ROW_PX + 24;
+
+    render(legend_px + 2 * ROW_PX + last_row_px + 6, |root| {
+        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
+        draw_legend(&parts[0], &legend)?;
+        let titles_left = [
+            "True acceleration a(t)",
+            "Velocity: truth v and integrated v_c",
+            "Position: truth p and integrated p_c",
+        ];
+        let titles_right = [
+            "Accelerometer bias b and its estimate",
+            "Velocity drift δv = v − v_c and estimate",
+            "Position drift δp = p − p_c and estimate",
+        ];
+        type Series = fn(&SampleRecord) -> f64;
+        let truth: [Series; 3] = [|x| x.accel_m_s2, |x| x.truth_v_m_s, |x| x.truth_p_m];
+        let computed: [Option<Series>; 3] =
+            [None, Some(|x| x.computed_v_m_s), Some(|x| x.computed_p_m)];
+        let drift_index = [2, 1, 0];
+        for row in 0..3 {
+            let cols = columns(&parts[row + 1], &[WIDTH_PX / 2]);
+            let layout = |y_area_px| Layout {
+                y_area_px,
+                x_title: row == 2,
+                title: true,
+            };
+            let p = Panel::new(
+                &cols[0],
+                titles_left[row],
+                time.clone(),
+                left[row].clone(),
+                layout(left_area),
+            )?;
+            if let Some(c) = computed[row] {
+                p.line(s.iter().map(|x| (x.t_s, c(x))), ORANGE.stroke_width(2))?;
+            }
+            p.line(
+                s.iter().map(|x| (x.t_s, truth[row](x))),
+                BLUE.stroke_width(2),
+            )?;
+
+            let k = drift_index[row];
+            let q = Panel::new(
+                &cols[1],
+                titles_right[row],
+                time.clone(),
+                right[row].clone(),
+                layout(right_area),
+            )?;
+            q.line(
+                s.iter().map(|x| (x.t_s, x.delta_x[k])),
+                BLUE.stroke_width(2),
+            )?;
+            q.line(
+                s.iter().map(|x| (x.t_s, x.estimate[k])),
+                VERMILLION.stroke_width(1),
+            )?;
+        }
+        Ok(())
+    })
 }

@@ -66,7 +66,7 @@ pub fn count(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
             out.push('\u{202F}');
         }
         out.push(c);
@@ -103,7 +103,7 @@ mod tests {
     fn fixed_decimals_and_minus() {
         assert_eq!(fixed(-0.25, 1), "−0.2");
         assert_eq!(fixed(-0.0001, 2), "0.00");
-        assert_eq!(fixed(3.14159, 2), "3.14");
+        assert_eq!(fixed(1.23456, 2), "1.23");
     }
 
     #[test]
