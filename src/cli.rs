@@ -46,7 +46,7 @@ pub struct ModelArgs {
     pub quiet: bool,
 }
 
-#[derive(Debug, Args, Default)]
+#[derive(Debug, Args)]
 pub struct ReportArgs {
     #[command(flatten)]
     pub model: ModelArgs,
@@ -54,8 +54,22 @@ pub struct ReportArgs {
     #[arg(long, value_name = "N")]
     pub realizations: Option<u64>,
     /// Directory that receives index.html and data.json.
-    #[arg(long, value_name = "DIR", default_value = "report")]
+    #[arg(long, value_name = "DIR", default_value = DEFAULT_REPORT_DIR)]
     pub out: PathBuf,
+}
+
+/// Where the report goes unless `--out` says otherwise.
+pub const DEFAULT_REPORT_DIR: &str = "report";
+
+/// The arguments of a bare `accelcal`: the default report into [`DEFAULT_REPORT_DIR`].
+impl Default for ReportArgs {
+    fn default() -> Self {
+        Self {
+            model: ModelArgs::default(),
+            realizations: None,
+            out: PathBuf::from(DEFAULT_REPORT_DIR),
+        }
+    }
 }
 
 #[derive(Debug, Args)]

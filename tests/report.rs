@@ -248,3 +248,17 @@ fn a_failed_run_leaves_the_earlier_report_alone() {
         "temporary files left behind"
     );
 }
+
+#[test]
+fn bare_command_and_report_subcommand_share_their_defaults() {
+    use clap::Parser;
+    let bare = accelcal::cli::Cli::parse_from(["accelcal"]);
+    assert!(bare.command.is_none());
+    let explicit = accelcal::cli::Cli::parse_from(["accelcal", "report"]);
+    let Some(accelcal::cli::Command::Report(args)) = explicit.command else {
+        panic!("report subcommand")
+    };
+    let default = accelcal::cli::ReportArgs::default();
+    assert_eq!(args.out, default.out);
+    assert_eq!(default.out, std::path::Path::new("report"));
+}
