@@ -147,8 +147,10 @@ pub fn render(study: &Study, command: &str) -> Result<(String, ReportView)> {
             1,
             "Acceleration profile and true trajectory",
             format!(
-                "The true acceleration a(t), velocity and position of realization {} (seed {}), and the accelerometer's integration from the prior means.",
-                r.index, r.seed
+                "Left: the true acceleration a(t), velocity and position of realization {} (seed {}, {} truth), with the accelerometer's integration from the prior means. Right: the realization's bias, velocity drift δv = v − v_c and position drift δp = p − p_c, with the filter's estimates of each.",
+                r.index,
+                r.seed,
+                study.model.truth
             ),
             plot::trajectory(r),
         )?,
