@@ -9,7 +9,7 @@ use crate::checks::{self, Verdicts};
 use crate::cli::{Cli, Command, EnsembleArgs, ModelArgs, ReportArgs, SimulateArgs};
 use crate::config::{Config, DEFAULT_TOML, TruthModel};
 use crate::ensemble::{self, EnsembleRun};
-use crate::error::ConfigError;
+use crate::error::{ConfigError, FilterError};
 use crate::export;
 use crate::filter::FilterSchedule;
 use crate::model::Model;
@@ -18,7 +18,12 @@ use crate::realization;
 
 /// Exit code for `err`: 2 for bad input (configuration, command line), 1 otherwise.
 pub fn exit_code(err: &anyhow::Error) -> u8 {
-    if err.chain().any(|e| e.is::<ConfigError>()) {
+    // The filter's covariance depends on the configuration alone: when it fails, the
+    // configured statistics are to blame.
+    if err
+        .chain()
+        .any(|e| e.is::<ConfigError>() || e.is::<FilterError>())
+    {
         2
     } else {
         1
@@ -59,8 +64,11 @@ pub fn load_model(args: &ModelArgs, realizations: Option<u64>) -> Result<Model> 
 
 /// The filter schedule of `model`.
 pub fn schedule_of(model: &Model) -> Result<FilterSchedule> {
-    FilterSchedule::new(&model.timeline, &model.filter_stats)
-        .context("the filter's covariance recursion failed")
+    FilterSchedule::new(&model.timeline, &model.filter_stats).context(
+        "the filter's covariance recursion failed: check the [filter] statistics \
+             (accel_noise_var_m2_s4, bias_var_m2_s4, gps_position_sigma_m, gps_velocity_sigma_m_s, \
+             initial_position_sigma_m, initial_velocity_sigma_m_s)",
+    )
 }
 
 /// A progress bar on standard error when it is a terminal and not silenced, hidden otherwise.
@@ -114,11 +122,11 @@ pub fn verdict_lines(truth: TruthModel, run: &EnsembleRun, v: &Verdicts) -> Stri
     );
     for c in &v.checks {
         s.push_str(&format!(
-            "  {:<19} {}  worst {:>10.4}  bound {:>10.4}  ({} of {} members outside)\n",
+            "  {:<19} {}  worst {:>10}  bound {:>10}  ({} of {} members outside)\n",
             c.id,
             if c.passed { "pass" } else { "FAIL" },
-            c.worst,
-            c.bound,
+            crate::report::format::sig(c.worst, 5),
+            crate::report::format::sig(c.bound, 5),
             c.failures,
             c.members
         ));

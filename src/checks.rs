@@ -110,49 +110,136 @@ pub fn chi_squared_band(dof: f64, scale: f64, alpha_member: f64) -> (f64, f64) {
     )
 }
 
+/// Which member of a family a value belongs to; turned into words only for the worst member,
+/// so that families with millions of members stay cheap.
+#[derive(Clone, Copy, Debug)]
+enum Tag {
+    /// A state component of one stage: the mean error or the variance.
+    Component {
+        prior: bool,
+        j: u8,
+        what: &'static str,
+    },
+    /// Error component j against estimate component k.
+    Pair {
+        prior: bool,
+        j: u8,
+        k: u8,
+    },
+    /// The NEES of one stage.
+    Nees {
+        prior: bool,
+    },
+    Nis,
+    /// Residual component j at fix i against residual component k at fix m.
+    Residual {
+        i: u32,
+        m: u32,
+        j: u8,
+        k: u8,
+    },
+}
+
+impl Tag {
+    fn label(self, stats: &EnsembleStats) -> String {
+        match self {
+            Tag::Component { prior, j, what } => {
+                format!("{} {} {what}", stage_name(prior), STATE_NAMES[j as usize])
+            }
+            Tag::Pair { prior, j, k } => format!(
+                "{} {} error × {} estimate",
+                stage_name(prior),
+                STATE_NAMES[j as usize],
+                STATE_NAMES[k as usize]
+            ),
+            Tag::Nees { prior } => format!("{} NEES", stage_name(prior)),
+            Tag::Nis => "NIS".to_string(),
+            Tag::Residual { i, m, j, k } => format!(
+                "{} residual at {:.1} s × {} residual at {:.1} s",
+                RESIDUAL_NAMES[j as usize],
+                stats.fixes[i as usize].time_s,
+                RESIDUAL_NAMES[k as usize],
+                stats.fixes[m as usize].time_s
+            ),
+        }
+    }
+}
+
 /// One member's value and where it sits.
 struct Member {
     value: f64,
     time_s: f64,
-    label: String,
+    tag: Tag,
 }
 
 fn stage_name(prior: bool) -> &'static str {
     if prior { "a priori" } else { "a posteriori" }
 }
 
+/// A family's verdict once its band is known: counts the members outside [lower, upper] (a
+/// non-finite member is outside every band) and finds the worst by `excursion`.
+#[allow(clippy::too_many_arguments)]
+fn verdict(
+    id: &'static str,
+    statistic: &'static str,
+    kind: Kind,
+    alpha: f64,
+    (lower, upper): (f64, f64),
+    members: &[Member],
+    excursion: impl Fn(f64) -> f64,
+    stats: &EnsembleStats,
+) -> Check {
+    let failures = members
+        .iter()
+        .filter(|x| !(lower..=upper).contains(&x.value))
+        .count();
+    let worst = members.iter().max_by(|a, b| {
+        let (ea, eb) = (excursion(a.value), excursion(b.value));
+        // NaN sorts above every number, so a non-finite member is the worst.
+        ea.is_nan().cmp(&eb.is_nan()).then(ea.total_cmp(&eb))
+    });
+    let (worst_value, worst_time_s, worst_member) = match worst {
+        Some(w) => (w.value, w.time_s, w.tag.label(stats)),
+        // A family can be empty (no estimate varies over the ensemble): nothing to reject.
+        None => (0.0, 0.0, "no member could be tested".to_string()),
+    };
+    Check {
+        id,
+        statistic,
+        kind,
+        members: members.len(),
+        false_alarm_rate: alpha,
+        worst: worst_value,
+        bound: upper,
+        lower,
+        upper,
+        passed: failures == 0,
+        failures,
+        worst_time_s,
+        worst_member,
+    }
+}
+
 fn normal_check(
     id: &'static str,
     statistic: &'static str,
     alpha: f64,
-    members: Vec<Member>,
+    members: &[Member],
+    stats: &EnsembleStats,
 ) -> Check {
-    let m = members.len().max(1);
-    let bound = normal_bound(alpha / m as f64);
-    // A non-finite member is outside every band.
-    let failures = members
-        .iter()
-        .filter(|x| !(-bound..=bound).contains(&x.value))
-        .count();
-    let worst = members
-        .iter()
-        .max_by(|a, b| a.value.abs().total_cmp(&b.value.abs()))
-        .expect("a check has members");
-    Check {
+    let bound = normal_bound(alpha / members.len().max(1) as f64);
+    let mut c = verdict(
         id,
         statistic,
-        kind: Kind::Normal,
-        members: members.len(),
-        false_alarm_rate: alpha,
-        worst: worst.value.abs(),
-        bound,
-        lower: -bound,
-        upper: bound,
-        passed: failures == 0,
-        failures,
-        worst_time_s: worst.time_s,
-        worst_member: worst.label.clone(),
-    }
+        Kind::Normal,
+        alpha,
+        (-bound, bound),
+        members,
+        f64::abs,
+        stats,
+    );
+    c.worst = c.worst.abs();
+    c
 }
 
 fn chi_squared_check(
@@ -160,9 +247,10 @@ fn chi_squared_check(
     statistic: &'static str,
     alpha: f64,
     (dof, scale): (f64, f64),
-    members: Vec<Member>,
+    members: &[Member],
+    stats: &EnsembleStats,
 ) -> Check {
-    let (lower, upper) = chi_squared_band(dof, scale, alpha / members.len() as f64);
+    let (lower, upper) = chi_squared_band(dof, scale, alpha / members.len().max(1) as f64);
     let median = ChiSquared::new(dof).expect("positive dof").inverse_cdf(0.5) / scale;
     let excursion = |x: f64| {
         if x >= median {
@@ -171,32 +259,22 @@ fn chi_squared_check(
             (median - x) / (median - lower)
         }
     };
-    let failures = members
-        .iter()
-        .filter(|x| !(lower..=upper).contains(&x.value))
-        .count();
-    let worst = members
-        .iter()
-        .max_by(|a, b| excursion(a.value).total_cmp(&excursion(b.value)))
-        .expect("a check has members");
-    Check {
+    let mut c = verdict(
         id,
         statistic,
-        kind: Kind::ChiSquared,
-        members: members.len(),
-        false_alarm_rate: alpha,
-        worst: worst.value,
-        bound: if worst.value >= median { upper } else { lower },
-        lower,
-        upper,
-        passed: failures == 0,
-        failures,
-        worst_time_s: worst.time_s,
-        worst_member: worst.label.clone(),
-    }
+        Kind::ChiSquared,
+        alpha,
+        (lower, upper),
+        members,
+        excursion,
+        stats,
+    );
+    // The bound on the worst member's side.
+    c.bound = if c.worst >= median { upper } else { lower };
+    c
 }
 
-/// For every fix and both stages, `f(stage stats, is_prior)` → per-component members.
+/// For every fix and both stages, `f(stage stats, time, is_prior, out)` pushes members.
 fn per_stage(
     stats: &EnsembleStats,
     mut f: impl FnMut(&StageStats, f64, bool, &mut Vec<Member>),
@@ -226,34 +304,42 @@ pub fn evaluate(
 ) -> Verdicts {
     let n = stats.realizations as f64;
     let mean_error = per_stage(stats, |s, t, prior, out| {
-        for (j, name) in STATE_NAMES.iter().enumerate() {
+        for j in 0..3u8 {
+            let k = j as usize;
             out.push(Member {
-                value: s.mean_error[j] / (s.filter_cov[j][j] / n).sqrt(),
+                value: s.mean_error[k] / (s.filter_cov[k][k] / n).sqrt(),
                 time_s: t,
-                label: format!("{} {name} error", stage_name(prior)),
+                tag: Tag::Component {
+                    prior,
+                    j,
+                    what: "error",
+                },
             });
         }
     });
     let covariance = per_stage(stats, |s, t, prior, out| {
-        for (j, name) in STATE_NAMES.iter().enumerate() {
+        for j in 0..3u8 {
+            let k = j as usize;
             out.push(Member {
-                value: s.ensemble_cov[j][j] / s.filter_cov[j][j],
+                value: s.ensemble_cov[k][k] / s.filter_cov[k][k],
                 time_s: t,
-                label: format!("{} {name} variance", stage_name(prior)),
+                tag: Tag::Component {
+                    prior,
+                    j,
+                    what: "variance",
+                },
             });
         }
     });
     let orthogonality = per_stage(stats, |s, t, prior, out| {
-        for (row, error_name) in s.orthogonality_corr.iter().zip(STATE_NAMES) {
-            for (&c, estimate_name) in row.iter().zip(STATE_NAMES) {
+        for (j, row) in (0u8..).zip(&s.orthogonality_corr) {
+            for (k, &c) in (0u8..).zip(row) {
+                // NaN marks an estimate component that does not vary: nothing to test.
                 if c.is_finite() {
                     out.push(Member {
                         value: n.sqrt() * c,
                         time_s: t,
-                        label: format!(
-                            "{} {error_name} error × {estimate_name} estimate",
-                            stage_name(prior)
-                        ),
+                        tag: Tag::Pair { prior, j, k },
                     });
                 }
             }
@@ -263,7 +349,7 @@ pub fn evaluate(
         out.push(Member {
             value: s.nees_avg,
             time_s: t,
-            label: format!("{} NEES", stage_name(prior)),
+            tag: Tag::Nees { prior },
         })
     });
     let nis: Vec<Member> = stats
@@ -272,22 +358,24 @@ pub fn evaluate(
         .map(|f| Member {
             value: f.nis_avg,
             time_s: f.time_s,
-            label: "NIS".to_string(),
+            tag: Tag::Nis,
         })
         .collect();
     let fixes = stats.fixes.len();
     let mut whiteness = Vec::with_capacity(2 * fixes * fixes);
     for i in 1..fixes {
         for m in 0..i {
-            for (j, name_i) in RESIDUAL_NAMES.iter().enumerate() {
-                for (k, name_m) in RESIDUAL_NAMES.iter().enumerate() {
+            for j in 0..2u8 {
+                for k in 0..2u8 {
                     whiteness.push(Member {
-                        value: residual_z(stats, 2 * i + j, 2 * m + k),
+                        value: residual_z(stats, 2 * i + j as usize, 2 * m + k as usize),
                         time_s: stats.fixes[i].time_s,
-                        label: format!(
-                            "{name_i} residual at {:.1} s × {name_m} residual at {:.1} s",
-                            stats.fixes[i].time_s, stats.fixes[m].time_s
-                        ),
+                        tag: Tag::Residual {
+                            i: i as u32,
+                            m: m as u32,
+                            j,
+                            k,
+                        },
                     });
                 }
             }
@@ -299,40 +387,46 @@ pub fn evaluate(
             "mean_error",
             "e_ave / √(P/N), each component, a priori and a posteriori",
             alpha,
-            mean_error,
+            &mean_error,
+            stats,
         ),
         chi_squared_check(
             "covariance_match",
             "P_ave / P, each diagonal element, a priori and a posteriori; (N−1)·ratio ~ χ²(N−1)",
             alpha,
             (n - 1.0, n - 1.0),
-            covariance,
+            &covariance,
+            stats,
         ),
         normal_check(
             "orthogonality",
             "√N · correlation of (e − e_ave) and δx̂, every component pair, a priori and a posteriori",
             alpha,
-            orthogonality,
+            &orthogonality,
+            stats,
         ),
         normal_check(
             "residual_whiteness",
             "√N · correlation of r(t_i) and r(t_m), every pair t_m < t_i and component pair",
             alpha,
-            whiteness,
+            &whiteness,
+            stats,
         ),
         chi_squared_check(
             "nees",
             "average eᵀP⁻¹e, a priori and a posteriori; N·average ~ χ²(3N)",
             alpha,
             (3.0 * n, n),
-            nees,
+            &nees,
+            stats,
         ),
         chi_squared_check(
             "nis",
             "average rᵀS⁻¹r; N·average ~ χ²(2N)",
             alpha,
             (2.0 * n, n),
-            nis,
+            &nis,
+            stats,
         ),
     ];
 
@@ -362,6 +456,70 @@ pub fn evaluate(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn empty_stats() -> EnsembleStats {
+        EnsembleStats {
+            realizations: 10,
+            fixes: Vec::new(),
+            residual_corr: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn an_empty_family_passes_and_a_non_finite_member_fails() {
+        let stats = empty_stats();
+        let c = normal_check("x", "", 0.01, &[], &stats);
+        assert!(c.passed && c.members == 0 && c.worst.is_finite());
+        let members = [
+            Member {
+                value: 0.5,
+                time_s: 1.0,
+                tag: Tag::Nis,
+            },
+            Member {
+                value: f64::NAN,
+                time_s: 2.0,
+                tag: Tag::Nis,
+            },
+        ];
+        let c = normal_check("x", "", 0.01, &members, &stats);
+        assert!(!c.passed && c.failures == 1 && c.worst_time_s == 2.0);
+        let members = [
+            Member {
+                value: 3.0,
+                time_s: 1.0,
+                tag: Tag::Nis,
+            },
+            Member {
+                value: f64::NAN,
+                time_s: 2.0,
+                tag: Tag::Nis,
+            },
+        ];
+        let c = chi_squared_check("x", "", 0.01, (30.0, 10.0), &members, &stats);
+        assert!(!c.passed && c.failures == 1 && c.worst_time_s == 2.0);
+    }
+
+    #[test]
+    fn chi_squared_worst_takes_the_bound_of_its_side() {
+        let stats = empty_stats();
+        let members = [
+            Member {
+                value: 2.95,
+                time_s: 1.0,
+                tag: Tag::Nis,
+            },
+            Member {
+                value: 2.2,
+                time_s: 2.0,
+                tag: Tag::Nis,
+            },
+        ];
+        let c = chi_squared_check("nees", "", 0.01, (3000.0, 1000.0), &members, &stats);
+        assert_eq!(c.worst, 2.2);
+        assert_eq!(c.bound, c.lower);
+        assert!(!c.passed);
+    }
 
     #[test]
     fn normal_bound_is_the_two_sided_quantile() {

@@ -17,6 +17,9 @@ use crate::simulation::{FixState, Observer, run_realization};
 /// Realizations summed sequentially into one accumulator before it is merged.
 pub const CHUNK: u64 = 64;
 
+/// Memory the chunk accumulators in flight may take together, bytes.
+const WINDOW_BYTES: u64 = 256 << 20;
+
 /// Running sums over realizations of one estimate stage (a priori or a posteriori) at one fix.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StageSums {
@@ -228,8 +231,15 @@ pub fn run(
 ) -> Accumulator {
     let chunks = n.div_ceil(CHUNK);
     // A window of chunks in flight at once; only its size depends on the thread count, never the
-    // chunk boundaries nor the merge order.
-    let window = 4 * rayon::current_num_threads() as u64;
+    // chunk boundaries nor the merge order. At most WINDOW_BYTES of accumulators are alive.
+    let acc_bytes = 8 * Accumulator::new(model.timeline.fixes())
+        .residual_products
+        .len()
+        .max(1) as u64;
+    let threads = rayon::current_num_threads() as u64;
+    let window = (4 * threads)
+        .min((WINDOW_BYTES / acc_bytes).max(threads))
+        .max(1);
     let mut total = Accumulator::new(model.timeline.fixes());
     let mut first = 0;
     while first < chunks {
@@ -405,6 +415,17 @@ mod tests {
         for (a, b) in whole.residual_products.iter().zip(&parts.residual_products) {
             assert!((a - b).abs() <= 1e-9 * a.abs().max(1.0));
         }
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(1.0);
+        for (a, b) in whole.fixes.iter().zip(&parts.fixes) {
+            for (x, y) in [(&a.prior, &b.prior), (&a.post, &b.post)] {
+                assert!(x.e.iter().zip(y.e.iter()).all(|(p, q)| close(*p, *q)));
+                assert!(x.ee.iter().zip(&y.ee).all(|(p, q)| close(*p, *q)));
+                assert!(x.ex.iter().zip(y.ex.iter()).all(|(p, q)| close(*p, *q)));
+                assert!(x.xx.iter().zip(y.xx.iter()).all(|(p, q)| close(*p, *q)));
+                assert!(close(x.nees, y.nees));
+            }
+            assert!(close(a.nis, b.nis));
+        }
     }
 
     #[test]
@@ -448,6 +469,19 @@ mod tests {
         let got = &stats.fixes[i].post;
         approx::assert_relative_eq!(got.mean_error[1], mean[1], max_relative = 1e-9);
         approx::assert_relative_eq!(got.ensemble_cov[1][1], var_v, max_relative = 1e-9);
+        // Orthogonality (1/N) Σ (e − ē) x̂ᵀ, entry (velocity error, bias estimate).
+        let xs: Vec<Vector3> = runs.iter().map(|r| r[i].post).collect();
+        let ortho = errs
+            .iter()
+            .zip(&xs)
+            .map(|(e, x)| (e[1] - mean[1]) * x[2])
+            .sum::<f64>()
+            / n as f64;
+        approx::assert_relative_eq!(got.orthogonality[1][2], ortho, max_relative = 1e-8);
+        // NEES (1/N) Σ eᵀ P⁻¹ e with the filter's a posteriori P.
+        let p_inv = s.fixes[i].p_post.try_inverse().unwrap();
+        let nees = errs.iter().map(|e| e.dot(&(p_inv * e))).sum::<f64>() / n as f64;
+        approx::assert_relative_eq!(got.nees_avg, nees, max_relative = 1e-8);
         let r = |l: usize, a: usize| runs[l][a / 2].residual[a % 2];
         let m12: f64 = (0..n as usize).map(|l| r(l, 7) * r(l, 2)).sum::<f64>() / n as f64;
         approx::assert_relative_eq!(stats.residual_moment(2, 7), m12, max_relative = 1e-9);

@@ -7,9 +7,12 @@ use crate::error::ConfigError;
 /// Largest number of accelerometer samples in a run.
 pub const MAX_STEPS: usize = 10_000_000;
 /// Largest number of GPS fixes in a run (the residual-pair statistics grow with its square).
-pub const MAX_FIXES: usize = 2_000;
+pub const MAX_FIXES: usize = 1_000;
 /// Largest ensemble.
 pub const MAX_REALIZATIONS: u64 = 100_000_000;
+
+/// Smallest variance or standard deviation the filter may assume.
+pub const FILTER_FLOOR: f64 = 1e-12;
 
 /// Relative tolerance used to decide that a ratio of rates or times is a whole number.
 const WHOLE_TOL: f64 = 1e-9;
@@ -191,18 +194,43 @@ impl Model {
     }
 }
 
-/// The closed-form truth less its initial-value terms: ((A/ω)·t − (A/ω²)·sin ωt, (A/ω)·(1 − cos ωt)).
+/// The closed-form truth less its initial-value terms: ((A/ω)·t − (A/ω²)·sin ωt, (A/ω)·(1 − cos ωt)),
+/// written as (A·t²·(x − sin x)/x², A·t·2·sin²(x/2)/x) with x = ωt so that no large terms cancel
+/// when ωt is small.
 fn analytic_offsets(config: &Config, t_s: f64) -> [f64; 2] {
     let a = config.profile.accel_amplitude_m_s2;
-    let w = config.profile.accel_angular_freq_rad_s;
-    let (s, c) = (w * t_s).sin_cos();
-    [a / w * t_s - a / (w * w) * s, a / w * (1.0 - c)]
+    let x = config.profile.accel_angular_freq_rad_s * t_s;
+    if x == 0.0 {
+        return [0.0, 0.0];
+    }
+    // (x − sin x)/x²: its Taylor series below 0.5 rad, where the difference would lose digits.
+    let g = if x.abs() < 0.5 {
+        let x2 = x * x;
+        x / 6.0
+            * (1.0
+                - x2 / 20.0
+                    * (1.0
+                        - x2 / 42.0 * (1.0 - x2 / 72.0 * (1.0 - x2 / 110.0 * (1.0 - x2 / 156.0)))))
+    } else {
+        (x - x.sin()) / (x * x)
+    };
+    let h = 2.0 * (0.5 * x).sin().powi(2) / x;
+    [a * t_s * t_s * g, a * t_s * h]
 }
 
 /// `x` rounded to the nearest whole number when it is one within [`WHOLE_TOL`].
 fn whole(x: f64) -> Option<u64> {
     let r = x.round();
     (x.is_finite() && r >= 0.0 && (x - r).abs() <= WHOLE_TOL * r.max(1.0)).then_some(r as u64)
+}
+
+/// A number as a person would write it: exponent notation when it is very small or large.
+fn show(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e7).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
 }
 
 fn finite_in(
@@ -219,8 +247,12 @@ fn finite_in(
         let open = if lo_open { "(" } else { "[" };
         Err(ConfigError::invalid(
             field,
-            x,
-            format!("must be a finite number in {open}{lo}, {hi}]"),
+            show(x),
+            format!(
+                "must be a finite number in {open}{}, {}]",
+                show(lo),
+                show(hi)
+            ),
         ))
     }
 }
@@ -237,10 +269,12 @@ fn non_negative(field: &'static str, x: f64, hi: f64) -> Result<(), ConfigError>
 fn validate(c: &Config) -> Result<(), ConfigError> {
     let p = &c.profile;
     non_negative("profile.accel_amplitude_m_s2", p.accel_amplitude_m_s2, 1e4)?;
-    positive(
+    finite_in(
         "profile.accel_angular_freq_rad_s",
         p.accel_angular_freq_rad_s,
+        1e-9,
         1e4,
+        false,
     )?;
     positive("profile.duration_s", p.duration_s, 1e5)?;
 
@@ -327,9 +361,11 @@ fn validate(c: &Config) -> Result<(), ConfigError> {
             f.initial_velocity_sigma_m_s,
         ),
     ];
+    // Floors keep S and P well inside double precision; below them the covariance recursion
+    // cannot stay positive definite.
     for (field, value) in filter_fields {
         if let Some(x) = value {
-            positive(field, x, 1e6)?;
+            finite_in(field, x, FILTER_FLOOR, 1e6, false)?;
         }
     }
     let resolved: [(&'static str, f64); 4] = [
@@ -345,11 +381,13 @@ fn validate(c: &Config) -> Result<(), ConfigError> {
         ),
     ];
     for (name, x) in resolved {
-        if x <= 0.0 {
+        if x < FILTER_FLOOR {
             return Err(ConfigError::invalid(
                 "filter",
                 format!("{name} = {x} (taken from the truth)"),
-                format!("the filter needs {name} > 0; set filter.{name} to a positive value"),
+                format!(
+                    "the filter needs {name} ≥ {FILTER_FLOOR}; set filter.{name} to a value in [{FILTER_FLOOR}, 1000000]"
+                ),
             ));
         }
     }
@@ -377,10 +415,14 @@ fn validate(c: &Config) -> Result<(), ConfigError> {
     let period = per_fix as f64 / a.sample_rate_hz;
     let first = if g.fix_at_start { 0.0 } else { period };
     let last = (steps / per_fix) as f64 * period;
-    let is_fix = |t: f64| {
-        t.is_finite() && t >= first - 1e-9 && t <= last + 1e-9 && whole(t / period).is_some()
+    // The index of the fix at `t`, when `t` is a fix time of the run.
+    let fix_index = |t: f64| {
+        (t.is_finite() && t >= first - 1e-9 && t <= last + 1e-9)
+            .then(|| whole(t / period))
+            .flatten()
     };
-    if !(is_fix(tm) && is_fix(ti) && tm < ti) {
+    let ordered = matches!((fix_index(tm), fix_index(ti)), (Some(m), Some(i)) if m < i);
+    if !ordered {
         return Err(ConfigError::invalid(
             "checks.residual_pair_s",
             format!("[{tm}, {ti}]"),
@@ -423,6 +465,32 @@ mod tests {
     }
 
     #[test]
+    fn analytic_truth_is_accurate_for_small_angles() {
+        let mut c = Config::default();
+        c.profile.accel_angular_freq_rad_s = 1e-9;
+        let m = Model::new(&c).unwrap();
+        // For ωt → 0 the profile is a ≈ A·ω·t: v = A·ω·t²/2, p = A·ω·t³/6.
+        let (p, v) = m.analytic_truth(30.0, 0.0, 0.0);
+        approx::assert_relative_eq!(v, 10.0 * 1e-9 * 900.0 / 2.0, max_relative = 1e-9);
+        approx::assert_relative_eq!(p, 10.0 * 1e-9 * 27000.0 / 6.0, max_relative = 1e-9);
+        // Both branches of the series agree where they meet.
+        let c = Config::default();
+        let w = c.profile.accel_angular_freq_rad_s;
+        let below = analytic_offsets(&c, 0.4999999 / w);
+        let above = analytic_offsets(&c, 0.5000001 / w);
+        approx::assert_relative_eq!(below[0], above[0], max_relative = 1e-5);
+    }
+
+    #[test]
+    fn residual_pair_must_name_two_different_fixes() {
+        let mut c = Config::default();
+        c.checks.residual_pair_s = Some([10.0, 10.000_000_000_1]);
+        assert_eq!(field_of(&c), "checks.residual_pair_s");
+        c.checks.residual_pair_s = Some([10.0, 10.2]);
+        assert!(Model::new(&c).is_ok());
+    }
+
+    #[test]
     fn analytic_truth_integrates_the_profile() {
         let m = Model::new(&Config::default()).unwrap();
         let (p0, v0) = m.analytic_truth(0.0, 3.0, 100.0);
@@ -436,9 +504,10 @@ mod tests {
     }
 
     fn field_of(c: &Config) -> &'static str {
-        match Model::new(c).unwrap_err() {
-            ConfigError::Invalid { field, .. } => field,
-            e => panic!("unexpected {e}"),
+        match Model::new(c) {
+            Err(ConfigError::Invalid { field, .. }) => field,
+            Err(e) => panic!("unexpected {e}"),
+            Ok(_) => panic!("accepted an invalid configuration"),
         }
     }
 
@@ -465,5 +534,11 @@ mod tests {
         let mut c = Config::default();
         c.accelerometer.noise_var_m2_s4 = 0.0;
         assert_eq!(field_of(&c), "filter");
+        let mut c = Config::default();
+        c.filter.gps_position_sigma_m = Some(1e-200);
+        assert_eq!(field_of(&c), "filter.gps_position_sigma_m");
+        let mut c = Config::default();
+        c.profile.accel_angular_freq_rad_s = 1e-300;
+        assert_eq!(field_of(&c), "profile.accel_angular_freq_rad_s");
     }
 }

@@ -21,7 +21,7 @@ const RATES: [(f64, f64); 5] = [
 fn config_strategy() -> impl Strategy<Value = Config> {
     (
         0..RATES.len(),
-        2u32..=30,
+        2u32..=20,
         1e-8f64..1.0,
         1e-6f64..1.0,
         1e-3f64..100.0,

@@ -209,9 +209,19 @@ fn conclusions_follow_the_verdicts() {
         conclusions.contains("deliberately given statistics that differ"),
         "{conclusions}"
     );
+    let abstract_ =
+        &html[html.find("id=\"abstract\"").unwrap()..html.find("id=\"introduction\"").unwrap()];
     assert!(
-        html.contains("Even with the Euler-integrated truth"),
-        "the abstract must say the filter fails"
+        abstract_.contains("deliberately assumes statistics that differ"),
+        "{abstract_}"
+    );
+    assert!(
+        abstract_.contains("the checks detect the mistuning"),
+        "{abstract_}"
+    );
+    assert!(
+        abstract_.contains("the covariance check below finds"),
+        "the σ it quotes are not trustworthy: {abstract_}"
     );
 
     let o = report(dir.path(), SMALL);
@@ -222,6 +232,49 @@ fn conclusions_follow_the_verdicts() {
     assert!(
         conclusions.contains("The filter is consistent with this truth"),
         "{conclusions}"
+    );
+}
+
+#[test]
+fn a_short_run_quotes_only_times_within_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = report(
+        dir.path(),
+        "[profile]\nduration_s = 0.4\n[ensemble]\nrealizations = 50\n",
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = page(dir.path());
+    assert!(
+        !html.contains("after 1 s") && !html.contains("after 5 s"),
+        "milestones beyond the run"
+    );
+    assert!(
+        html.contains("at the end (0.4 s)"),
+        "the end of the run is 0.4 s"
+    );
+}
+
+#[test]
+fn an_output_that_cannot_be_replaced_leaves_the_earlier_report_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(out.join("data.json")).unwrap();
+    std::fs::write(out.join("index.html"), "earlier report").unwrap();
+    let o = report(dir.path(), SMALL);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "an output problem is not bad input"
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("directory"));
+    assert_eq!(
+        std::fs::read_to_string(out.join("index.html")).unwrap(),
+        "earlier report"
+    );
+    assert_eq!(
+        std::fs::read_dir(&out).unwrap().count(),
+        2,
+        "temporary files left behind"
     );
 }
 

@@ -61,6 +61,15 @@ pub fn fixed(x: f64, decimals: usize) -> String {
     }
 }
 
+/// `x` with up to 4 significant digits and no trailing zeros: 5 → "5", 0.6283185 → "0.6283".
+pub fn short(x: f64) -> String {
+    let s = sig(x, 4);
+    if s.contains('×') || !s.contains('.') {
+        return s;
+    }
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 /// A whole number with thin-space thousands separators: 10 000.
 pub fn count(n: u64) -> String {
     let digits = n.to_string();
@@ -104,6 +113,15 @@ mod tests {
         assert_eq!(fixed(-0.25, 1), "−0.2");
         assert_eq!(fixed(-0.0001, 2), "0.00");
         assert_eq!(fixed(1.23456, 2), "1.23");
+    }
+
+    #[test]
+    fn short_drops_trailing_zeros() {
+        assert_eq!(short(5.0), "5");
+        assert_eq!(short(200.0), "200");
+        assert_eq!(short(0.005), "0.005");
+        assert_eq!(short(0.6283185307179586), "0.6283");
+        assert_eq!(short(30.0), "30");
     }
 
     #[test]

@@ -158,7 +158,7 @@ pub fn render(study: &Study, command: &str) -> Result<(String, ReportView)> {
             "fig-realization",
             2,
             "Estimation error of one realization",
-            "The error δx − δx̂ of position, velocity and bias at every accelerometer sample, with the filter's ±1σ. Left: the whole run; right: a two-second window where the covariance grows between fixes and drops at each fix.".to_string(),
+            "The error δx − δx̂ of position, velocity and bias at every accelerometer sample, with the filter's ±1σ. Left: the whole run; right: the filter's σ over a short window, growing between fixes and dropping at each fix (open circles before the update, dots after).".to_string(),
             plot::realization_errors(r),
         )?,
         mean_error: next(),
