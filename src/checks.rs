@@ -103,11 +103,41 @@ pub fn normal_bound(alpha_member: f64) -> f64 {
 
 /// Two-sided band of χ²(dof)/scale at per-member rate `alpha_member`.
 pub fn chi_squared_band(dof: f64, scale: f64, alpha_member: f64) -> (f64, f64) {
-    let chi = ChiSquared::new(dof).expect("positive degrees of freedom");
     (
-        chi.inverse_cdf(alpha_member / 2.0) / scale,
-        chi.inverse_cdf(1.0 - alpha_member / 2.0) / scale,
+        chi_squared_quantile(dof, alpha_member / 2.0, false) / scale,
+        chi_squared_quantile(dof, alpha_member / 2.0, true) / scale,
     )
+}
+
+/// The χ²(dof) quantile with lower-tail probability `p` (or upper-tail `p` when `upper`).
+///
+/// statrs' inverse CDF is the starting point; it is then refined by bisection in log space on the
+/// tail probability itself, which stays accurate far into either tail and for one or two degrees
+/// of freedom, where the inverse alone can be off by a large factor.
+pub fn chi_squared_quantile(dof: f64, p: f64, upper: bool) -> f64 {
+    let chi = ChiSquared::new(dof).expect("positive degrees of freedom");
+    let start = chi.inverse_cdf(if upper { 1.0 - p } else { p });
+    // tail(x) − p changes sign once: increasing for the lower tail, decreasing for the upper.
+    let miss = |x: f64| if upper { p - chi.sf(x) } else { chi.cdf(x) - p };
+    let (mut lo, mut hi) = (start.max(f64::MIN_POSITIVE), start.max(f64::MIN_POSITIVE));
+    while miss(lo) > 0.0 && lo > 1e-300 {
+        lo /= 4.0;
+    }
+    while miss(hi) < 0.0 && hi < 1e300 {
+        hi *= 4.0;
+    }
+    for _ in 0..200 {
+        let mid = (lo * hi).sqrt();
+        if miss(mid) < 0.0 {
+            lo = mid
+        } else {
+            hi = mid
+        }
+        if hi / lo - 1.0 < 1e-14 {
+            break;
+        }
+    }
+    (lo * hi).sqrt()
 }
 
 /// Which member of a family a value belongs to; turned into words only for the worst member,
@@ -526,6 +556,29 @@ mod tests {
         approx::assert_relative_eq!(
             normal_bound(0.05),
             1.959_963_984_540_054,
+            max_relative = 1e-9
+        );
+    }
+
+    #[test]
+    fn chi_squared_quantiles_are_exact_for_one_and_two_degrees_of_freedom() {
+        let p = 5.5e-6;
+        // χ²(1) is the square of a standard normal: its p-quantile is Φ⁻¹((1 + p)/2)².
+        let exact = Normal::standard().inverse_cdf(0.5 + p / 2.0).powi(2);
+        approx::assert_relative_eq!(
+            chi_squared_quantile(1.0, p, false),
+            exact,
+            max_relative = 1e-6
+        );
+        // χ²(2) is exponential with mean 2.
+        approx::assert_relative_eq!(
+            chi_squared_quantile(2.0, p, false),
+            -2.0 * (-p).ln_1p(),
+            max_relative = 1e-9
+        );
+        approx::assert_relative_eq!(
+            chi_squared_quantile(2.0, p, true),
+            -2.0 * p.ln(),
             max_relative = 1e-9
         );
     }

@@ -95,7 +95,8 @@ fn normal(rng: &mut Stream) -> f64 {
 }
 
 /// Runs realization `index` of `model` under `seed` through the filter `schedule`, reporting to
-/// `observer`. Draw order: p(0), v(0), b, then w at every sample, then (η_p, η_v) at every fix.
+/// `observer`. Draw order: p(0), v(0), b; then, fix by fix, w at every sample up to the fix and
+/// (η_p, η_v) at the fix; then, for an observer that records samples, w after the last fix.
 pub fn run_realization<O: Observer>(
     model: &Model,
     schedule: &FilterSchedule,
