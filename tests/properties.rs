@@ -21,7 +21,7 @@ const RATES: [(f64, f64); 5] = [
 fn config_strategy() -> impl Strategy<Value = Config> {
     (
         0..RATES.len(),
-        2u32..=20,
+        2u32..=500,
         1e-8f64..1.0,
         1e-6f64..1.0,
         1e-3f64..100.0,
@@ -30,12 +30,13 @@ fn config_strategy() -> impl Strategy<Value = Config> {
         1e-3f64..10.0,
         any::<bool>(),
     )
-        .prop_map(|(rate, dur, w, bvar, sp, sv, p0, v0, at_start)| {
+        .prop_map(|(rate, fixes, w, bvar, sp, sv, p0, v0, at_start)| {
             let mut c = Config::default();
             let (ra, rg) = RATES[rate];
             c.accelerometer.sample_rate_hz = ra;
             c.gps.sample_rate_hz = rg;
-            c.profile.duration_s = f64::from(dur);
+            // A whole number of GPS periods, within the fix limit whatever fix_at_start says.
+            c.profile.duration_s = f64::from(fixes) / rg;
             c.accelerometer.noise_var_m2_s4 = w;
             c.accelerometer.bias_var_m2_s4 = bvar;
             c.gps.position_sigma_m = sp;
