@@ -6,6 +6,21 @@ mod common;
 
 use accelcal::config::{Config, TruthModel};
 
+/// A filter whose noise statistics are wrong has the wrong gain and the wrong covariance: every
+/// check that looks at spread or correlation must fail.
+fn assert_mistuning_detected(v: &accelcal::checks::Verdicts) {
+    let f = failed(v);
+    for id in [
+        "covariance_match",
+        "nees",
+        "nis",
+        "orthogonality",
+        "residual_whiteness",
+    ] {
+        assert!(f.contains(&id), "{id} should fail, failed: {f:?}");
+    }
+}
+
 fn failed(v: &accelcal::checks::Verdicts) -> Vec<&'static str> {
     v.checks
         .iter()
@@ -26,16 +41,7 @@ fn filter_assuming_twice_the_gps_position_noise_fails() {
     let mut c = Config::default();
     c.filter.gps_position_sigma_m = Some(2.0);
     let v = common::verdicts_of(&c, TruthModel::Euler);
-    let f = failed(&v);
-    for id in [
-        "covariance_match",
-        "nees",
-        "nis",
-        "orthogonality",
-        "residual_whiteness",
-    ] {
-        assert!(f.contains(&id), "{id} should fail, failed: {f:?}");
-    }
+    assert_mistuning_detected(&v);
     // The filter stays unbiased: its mean error is still zero.
     assert!(v.get("mean_error").unwrap().passed);
 }
@@ -45,16 +51,7 @@ fn filter_assuming_100_times_the_accelerometer_noise_fails() {
     let mut c = Config::default();
     c.filter.accel_noise_var_m2_s4 = Some(100.0 * c.accelerometer.noise_var_m2_s4);
     let v = common::verdicts_of(&c, TruthModel::Euler);
-    let f = failed(&v);
-    for id in [
-        "covariance_match",
-        "nees",
-        "nis",
-        "orthogonality",
-        "residual_whiteness",
-    ] {
-        assert!(f.contains(&id), "{id} should fail, failed: {f:?}");
-    }
+    assert_mistuning_detected(&v);
 }
 
 #[test]
