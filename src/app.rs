@@ -79,7 +79,7 @@ pub fn progress_bar(len: u64, label: &str, quiet: bool) -> ProgressBar {
     let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
     bar.set_style(
         ProgressStyle::with_template(
-            "{prefix:>9} [{bar:40}] {pos}/{len} realizations, {per_sec}, eta {eta}",
+            "{prefix:>9} [{bar:40}] {pos}/{len} realizations, {elapsed} elapsed, eta {eta}",
         )
         .expect("valid template")
         .progress_chars("=> "),
