@@ -122,7 +122,7 @@ pub fn verdict_lines(truth: TruthModel, run: &EnsembleRun, v: &Verdicts) -> Stri
     );
     for c in &v.checks {
         s.push_str(&format!(
-            "  {:<19} {}  worst {:>10}  bound {:>10}  ({} of {} members outside)\n",
+            "  {:<22} {}  worst {:>10}  bound {:>10}  ({} of {} members outside)\n",
             c.id,
             if c.passed { "pass" } else { "FAIL" },
             crate::report::format::sig(c.worst, 5),

@@ -8,6 +8,7 @@
 //! |----|------------------|----------------------------------------|
 //! | `mean_error` | z = e_ave / √(P/N) | N(0, 1) |
 //! | `covariance_match` | P_ave / P (diagonal) | χ²(N−1)/(N−1) |
+//! | `covariance_correlation` | z = √(N−3)·(atanh r − atanh ρ), r and ρ the off-diagonal correlations of P_ave and P | ≈ N(0, 1) |
 //! | `orthogonality` | z = √N · corr(e − e_ave, δx̂) | ≈ N(0, 1) |
 //! | `residual_whiteness` | z = √N · Σr_i r_m / √(Σr_i² Σr_m²), t_m < t_i | ≈ N(0, 1) |
 //! | `nees` | (1/N) Σ eᵀP⁻¹e | χ²(3N)/N |
@@ -156,6 +157,12 @@ enum Tag {
         j: u8,
         k: u8,
     },
+    /// The correlation of error components j and k.
+    Correlation {
+        prior: bool,
+        j: u8,
+        k: u8,
+    },
     /// The NEES of one stage.
     Nees {
         prior: bool,
@@ -178,6 +185,12 @@ impl Tag {
             }
             Tag::Pair { prior, j, k } => format!(
                 "{} {} error × {} estimate",
+                stage_name(prior),
+                STATE_NAMES[j as usize],
+                STATE_NAMES[k as usize]
+            ),
+            Tag::Correlation { prior, j, k } => format!(
+                "{} {}–{} error correlation",
                 stage_name(prior),
                 STATE_NAMES[j as usize],
                 STATE_NAMES[k as usize]
@@ -361,6 +374,21 @@ pub fn evaluate(
             });
         }
     });
+    // Fisher's transformation: for bivariate normal errors atanh(r) is close to normal with mean
+    // atanh(ρ) and variance 1/(N − 3).
+    let fisher_scale = (n - 3.0).max(1.0).sqrt();
+    let correlation = per_stage(stats, |s, t, prior, out| {
+        for (j, k) in [(0u8, 1u8), (0, 2), (1, 2)] {
+            let (a, b) = (j as usize, k as usize);
+            let r = s.ensemble_cov[a][b] / (s.ensemble_cov[a][a] * s.ensemble_cov[b][b]).sqrt();
+            let rho = s.filter_cov[a][b] / (s.filter_cov[a][a] * s.filter_cov[b][b]).sqrt();
+            out.push(Member {
+                value: fisher_scale * (r.atanh() - rho.atanh()),
+                time_s: t,
+                tag: Tag::Correlation { prior, j, k },
+            });
+        }
+    });
     let orthogonality = per_stage(stats, |s, t, prior, out| {
         for (j, row) in (0u8..).zip(&s.orthogonality_corr) {
             for (k, &c) in (0u8..).zip(row) {
@@ -426,6 +454,13 @@ pub fn evaluate(
             alpha,
             (n - 1.0, n - 1.0),
             &covariance,
+            stats,
+        ),
+        normal_check(
+            "covariance_correlation",
+            "√(N−3) · (atanh r − atanh ρ), r and ρ the correlations of P_ave and P, each off-diagonal pair, a priori and a posteriori",
+            alpha,
+            &correlation,
             stats,
         ),
         normal_check(

@@ -215,6 +215,7 @@ fn same_seed_gives_the_same_json_on_one_and_two_threads() {
         [
             "mean_error",
             "covariance_match",
+            "covariance_correlation",
             "orthogonality",
             "residual_whiteness",
             "nees",

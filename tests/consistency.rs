@@ -12,6 +12,7 @@ fn assert_mistuning_detected(v: &accelcal::checks::Verdicts) {
     let f = failed(v);
     for id in [
         "covariance_match",
+        "covariance_correlation",
         "nees",
         "nis",
         "orthogonality",

@@ -159,6 +159,7 @@ fn report_is_complete_and_self_contained() {
         for id in [
             "mean_error",
             "covariance_match",
+            "covariance_correlation",
             "orthogonality",
             "residual_whiteness",
             "nees",
@@ -183,7 +184,7 @@ fn report_is_complete_and_self_contained() {
     assert_eq!(truths, ["analytic", "euler"]);
     for e in data["ensembles"].as_array().unwrap() {
         assert_eq!(e["summary"]["realizations"], 400);
-        assert_eq!(e["summary"]["checks"].as_array().unwrap().len(), 6);
+        assert_eq!(e["summary"]["checks"].as_array().unwrap().len(), 7);
     }
 }
 

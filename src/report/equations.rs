@@ -85,6 +85,7 @@ equations! {
     p_ave: block => r"P^{\mathrm{ave}}(t_i) = \frac{1}{N-1} \sum_{l=1}^{N} \left(e^l - e^{\mathrm{ave}}\right)\left(e^l - e^{\mathrm{ave}}\right)\T, \qquad (N-1)\,\frac{P^{\mathrm{ave}}_{kk}}{P_{kk}} \sim \chi^2(N-1)",
     orthogonality: block => r"C(t_i) = \frac{1}{N} \sum_{l=1}^{N} \left(e^l(t_i) - e^{\mathrm{ave}}(t_i)\right) \dxhat^l(t_i)\T, \qquad z_{jk} = \sqrt{N}\, \frac{C_{jk}}{\sigma(e_j)\, \sigma(\widehat{\delta x}_k)} \approx \mathcal{N}(0, 1)",
     whiteness: block => r"\frac{1}{N} \sum_{l=1}^{N} r^l(t_i)\, r^l(t_m)\T, \qquad z_{jk} = \sqrt{N}\, \frac{\sum_l r^l_j(t_i)\, r^l_k(t_m)}{\sqrt{\sum_l r^l_j(t_i)^2 \sum_l r^l_k(t_m)^2}} \approx \mathcal{N}(0, 1), \quad t_m < t_i",
+    fisher: block => r"r_{jk} = \frac{P^{\mathrm{ave}}_{jk}}{\sqrt{P^{\mathrm{ave}}_{jj} P^{\mathrm{ave}}_{kk}}}, \quad \rho_{jk} = \frac{P_{jk}}{\sqrt{P_{jj} P_{kk}}}, \qquad z = \sqrt{N-3}\,\left(\operatorname{atanh} r_{jk} - \operatorname{atanh} \rho_{jk}\right) \approx \mathcal{N}(0, 1)",
     nees: block => r"\bar{\epsilon}(t_i) = \frac{1}{N} \sum_{l=1}^{N} e^l(t_i)\T P(t_i)^{-1} e^l(t_i), \qquad N \bar{\epsilon} \sim \chi^2(3N)",
     nis: block => r"\bar{\nu}(t_i) = \frac{1}{N} \sum_{l=1}^{N} r^l(t_i)\T S(t_i)^{-1} r^l(t_i), \qquad N \bar{\nu} \sim \chi^2(2N)",
     bonferroni: block => r"|z| \le \Phi_{\mathcal{N}}^{-1}\!\left(1 - \frac{\alpha}{2M}\right), \qquad \chi^2_{\alpha/(2M)} \le \chi^2 \le \chi^2_{1 - \alpha/(2M)}",

@@ -165,6 +165,7 @@ fn what(id: &str) -> &'static str {
     match id {
         "mean_error" => "mean error is zero",
         "covariance_match" => "ensemble variance equals the filter's P",
+        "covariance_correlation" => "ensemble correlations equal those of P",
         "orthogonality" => "error is orthogonal to the estimate",
         "residual_whiteness" => "residuals are white",
         "nees" => "average NEES is 3",
@@ -177,6 +178,7 @@ fn statistic(id: &str) -> &'static str {
     match id {
         "mean_error" => "z = eᵃᵛᵉ / √(P/N)",
         "covariance_match" => "Pᵃᵛᵉ / P (diagonal)",
+        "covariance_correlation" => "z = √(N−3)·(atanh r − atanh ρ)",
         "orthogonality" => "z = √N · corr(e, δx̂)",
         "residual_whiteness" => "z = √N · corr(r(tᵢ), r(tₘ))",
         "nees" => "(1/N) Σ eᵀP⁻¹e",
@@ -249,6 +251,11 @@ fn failure_sentence(c: &Check) -> String {
             sig(c.lower, 4),
             sig(c.upper, 4),
             sig(c.worst, 3)
+        ),
+        "covariance_correlation" => format!(
+            "The correlations between error components differ from those of the filter's P: {outside} exceed |z| = {}, up to {} ({at}).",
+            fixed(c.bound, 2),
+            fixed(c.worst, 1)
         ),
         "orthogonality" => format!(
             "Errors are correlated with estimates: {outside} exceed |z| = {}, up to {} ({at}). The gain is not the minimum-variance gain for the simulated system.",
