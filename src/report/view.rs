@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::format::{count, fixed, percent, short, sig};
-use crate::checks::{Check, Kind, STATE_NAMES};
+use crate::checks::{Check, Kind};
 use crate::config::TruthModel;
 use crate::ensemble::EnsembleStats;
 use crate::study::{EnsembleOutcome, Study};
@@ -31,22 +31,6 @@ pub struct Figures {
     pub whiteness: FigureView,
     pub consistency: FigureView,
     pub truths: FigureView,
-}
-
-impl Figures {
-    /// Every figure, in order.
-    pub fn all(&self) -> [&FigureView; 8] {
-        [
-            &self.trajectory,
-            &self.realization,
-            &self.mean_error,
-            &self.covariance,
-            &self.orthogonality,
-            &self.whiteness,
-            &self.consistency,
-            &self.truths,
-        ]
-    }
 }
 
 /// A row of the parameter table.
@@ -765,13 +749,4 @@ pub fn build(
         config_toml: c.to_toml_string(),
         command,
     }
-}
-
-/// Names of the error-state components, capitalized for headings.
-pub fn state_heading(k: usize) -> String {
-    let s = STATE_NAMES[k];
-    let mut c = s.chars();
-    c.next()
-        .map(|f| f.to_uppercase().collect::<String>() + c.as_str())
-        .unwrap_or_default()
 }
