@@ -75,7 +75,6 @@ pub struct EnsembleView {
     pub table_number: usize,
     pub heading: String,
     pub realizations: String,
-    pub all_passed: bool,
     pub verdict: String,
     pub passed_count: String,
     pub checks: Vec<CheckRow>,
@@ -97,7 +96,6 @@ pub struct ReportView {
     pub realizations: String,
     pub fixes: String,
     pub steps: String,
-    pub duration: String,
     pub accel_rate: String,
     pub gps_rate: String,
     pub steps_per_fix: String,
@@ -111,7 +109,6 @@ pub struct ReportView {
     // One realization.
     pub bias_true: String,
     pub bias_estimate: String,
-    pub bias_sigma: String,
     pub bias_error_sigmas: String,
     pub bias_prior_sigma: String,
     /// Time of the last fix, s.
@@ -128,12 +125,9 @@ pub struct ReportView {
     /// What the euler ensemble's mean error says, chosen from its verdict.
     pub euler_mean_sentence: String,
     // Ensembles.
-    pub primary: EnsembleView,
-    pub other: EnsembleView,
     pub ensembles: Vec<EnsembleView>,
     pub euler_velocity_drift: String,
     pub threads: String,
-    pub total_rate: String,
     // Figures.
     pub fig: Figures,
     pub other_figures: Vec<FigureView>,
@@ -296,7 +290,6 @@ fn ensemble_view(e: &EnsembleOutcome) -> EnsembleView {
         table_number,
         heading: format!("{} truth", e.truth.name()),
         realizations: count(e.run.stats.realizations),
-        all_passed: v.all_passed(),
         verdict: if v.all_passed() {
             "every check passes".to_string()
         } else {
@@ -533,20 +526,12 @@ pub fn build(
         Some((end, rest)) => format!("{} and {end}", rest.join(", ")),
         None => String::new(),
     };
-    let primary = ensemble_view(study.primary());
     let other_truth = TruthModel::ALL
         .into_iter()
         .find(|t| *t != model.truth)
         .expect("two truth models");
-    let other = ensemble_view(study.ensemble(other_truth));
     let ensembles: Vec<EnsembleView> = study.ensembles.iter().map(ensemble_view).collect();
     let bias_err = (last.post[2] - r.bias_m_s2) / last.sigma_post[2];
-    let total: u64 = study
-        .ensembles
-        .iter()
-        .map(|e| e.run.stats.realizations)
-        .sum();
-    let total_s: f64 = study.ensembles.iter().map(|e| e.run.elapsed_s).sum();
     let differences = filter_differences(study);
 
     // The velocity lag of the Euler (left Riemann) sum behind the integral of a(t): about
@@ -641,8 +626,7 @@ pub fn build(
         sig(r.bias_m_s2, 3),
         if sigma_caveat.is_empty() { String::new() } else { format!(" {sigma_caveat}") }
     ));
-    for e in &study.ensembles {
-        let v = ensemble_view(e);
+    for (e, v) in study.ensembles.iter().zip(&ensembles) {
         if e.verdicts.all_passed() {
             conclusions.push(format!(
                 "With the {} truth, all checks pass over N = {} realizations at a {} family-wise false-alarm rate each: the mean error is zero within its bounds, the ensemble variance matches P, errors are orthogonal to estimates, the residuals are white over all {} pairs of fixes, and NEES and NIS stay in their χ² bands. The filter is consistent with this truth.",
@@ -711,7 +695,6 @@ pub fn build(
         realizations: count(c.ensemble.realizations),
         fixes: count(tl.fixes() as u64),
         steps: count(tl.steps as u64),
-        duration: short(c.profile.duration_s),
         accel_rate: short(c.accelerometer.sample_rate_hz),
         gps_rate: short(c.gps.sample_rate_hz),
         steps_per_fix: tl.steps_per_fix.to_string(),
@@ -724,7 +707,6 @@ pub fn build(
         choices,
         bias_true: sig(r.bias_m_s2, 3),
         bias_estimate: sig(last.post[2], 3),
-        bias_sigma: sig(last.sigma_post[2], 2),
         bias_error_sigmas: fixed(bias_err, 2),
         bias_prior_sigma: sig(c.filter_bias_var_m2_s4().sqrt(), 2),
         end_time: short(end_s),
@@ -736,12 +718,9 @@ pub fn build(
         bias_sigma_progress,
         sigma_caveat,
         euler_mean_sentence,
-        primary,
-        other,
         ensembles,
         euler_velocity_drift,
         threads: rayon::current_num_threads().to_string(),
-        total_rate: count((total as f64 / total_s).round() as u64),
         fig,
         other_figures,
         abstract_verdict,

@@ -3,7 +3,6 @@
 
 use accelcal::checks::Verdicts;
 use accelcal::config::{Config, TruthModel};
-use accelcal::ensemble;
 use accelcal::filter::FilterSchedule;
 use accelcal::model::Model;
 
@@ -18,15 +17,7 @@ pub fn model_of(config: &Config) -> (Model, FilterSchedule) {
 /// Runs the ensemble of `config` with `truth` and evaluates its checks.
 pub fn verdicts_of(config: &Config, truth: TruthModel) -> Verdicts {
     let (model, schedule) = model_of(config);
-    let model = model.with_truth(truth);
-    let run = ensemble::run_model(&model, &schedule, |_| {});
-    let c = &model.config.checks;
-    accelcal::checks::evaluate(
-        &run.stats,
-        &model.timeline,
-        c.false_alarm_rate,
-        model.residual_pair_s,
-    )
+    accelcal::app::ensemble_with_verdicts(&model.with_truth(truth), &schedule, true).1
 }
 
 /// Path of the built binary.
