@@ -2,9 +2,9 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{ArgGroup, Args, Parser, Subcommand};
 
-use crate::config::TruthModel;
+use accelcal::config::{AccelerometerOutput, TruthModel};
 
 /// Calibrates an accelerometer's bias with GPS through a Kalman filter, checks the filter with a
 /// Monte Carlo ensemble, and writes the study as a self-contained HTML report.
@@ -19,12 +19,19 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Run one realization and the ensembles, and write index.html and data.json.
+    /// Run every case's ensemble and one realization, and write index.html, data.json and view.json.
     Report(ReportArgs),
     /// Run one ensemble and write its statistics and verdicts as JSON.
     Ensemble(EnsembleArgs),
-    /// Run one realization and write it at every accelerometer sample as CSV.
+    /// Run one realization: write it at every accelerometer sample as CSV, and/or its sensor logs.
     Simulate(SimulateArgs),
+    /// Merge the partial files of every shard of one ensemble into its JSON summary.
+    Merge(MergeArgs),
+    /// Vary each statistic the filter assumes: exact actual accuracy, predicted and measured
+    /// detection by the checks.
+    Sensitivity(SensitivityArgs),
+    /// Calibrate the bias from an accelerometer log and a GPS log: filter, smoother, NIS test.
+    Calibrate(CalibrateArgs),
     /// Print the default configuration file.
     Config,
 }
@@ -35,9 +42,6 @@ pub struct ModelArgs {
     /// Configuration file (TOML); missing fields take their defaults (see `accelcal config`).
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
-    /// Truth model, overriding ensemble.truth.
-    #[arg(long, value_enum, value_name = "MODEL")]
-    pub truth: Option<TruthModel>,
     /// Seed of the random streams, overriding ensemble.seed.
     #[arg(long, value_name = "S")]
     pub seed: Option<u64>,
@@ -46,6 +50,19 @@ pub struct ModelArgs {
     pub quiet: bool,
 }
 
+/// The simulated case, for commands that run one.
+#[derive(Debug, Args, Default, Clone)]
+pub struct CaseArgs {
+    /// Truth model, overriding ensemble.truth.
+    #[arg(long, value_enum, value_name = "MODEL")]
+    pub truth: Option<TruthModel>,
+    /// What the accelerometer reports, overriding accelerometer.output.
+    #[arg(long, value_enum, value_name = "OUTPUT")]
+    pub accelerometer_output: Option<AccelerometerOutput>,
+}
+
+/// Options of `report`: it runs every case of the study (euler truth with point samples, the
+/// closed-form truth with point samples and with interval means).
 #[derive(Debug, Args)]
 pub struct ReportArgs {
     #[command(flatten)]
@@ -76,22 +93,116 @@ impl Default for ReportArgs {
 pub struct EnsembleArgs {
     #[command(flatten)]
     pub model: ModelArgs,
+    #[command(flatten)]
+    pub case: CaseArgs,
     /// Number of realizations, overriding ensemble.realizations.
     #[arg(long, value_name = "N")]
     pub realizations: Option<u64>,
+    /// Write the JSON here instead of to standard output.
+    #[arg(long, value_name = "FILE", conflicts_with = "shard")]
+    pub json: Option<PathBuf>,
+    /// Run only shard K of M (K counted from 1) and write its sums to --partial.
+    #[arg(long, value_name = "K/M", requires = "partial")]
+    pub shard: Option<String>,
+    /// Where a shard writes its partial sums (see `accelcal merge`).
+    #[arg(long, value_name = "FILE", requires = "shard")]
+    pub partial: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct SensitivityArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Factors on the assumed standard deviations (a variance is scaled by the square),
+    /// overriding sensitivity.factors (default 0.25,0.5,2,4).
+    #[arg(
+        long,
+        value_name = "F,…",
+        value_delimiter = ',',
+        num_args = 1,
+        allow_negative_numbers = true
+    )]
+    pub factors: Option<Vec<f64>>,
+    /// The [filter] statistics to vary (default: all six).
+    #[arg(long, value_name = "KEY,…", value_delimiter = ',')]
+    pub parameters: Vec<String>,
+    /// Realizations per Monte Carlo ensemble, overriding ensemble.realizations.
+    #[arg(long, value_name = "N")]
+    pub realizations: Option<u64>,
+    /// Independent Monte Carlo ensembles per statistic and factor (0: no Monte Carlo),
+    /// overriding sensitivity.ensembles.
+    #[arg(long, value_name = "K")]
+    pub ensembles: Option<u64>,
     /// Write the JSON here instead of to standard output.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The partial files, one per shard, in any order.
+    #[arg(value_name = "FILE", required = true)]
+    pub files: Vec<PathBuf>,
+    /// Write the JSON here instead of to standard output.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+#[derive(Debug, Args)]
+#[command(group(ArgGroup::new("output").required(true).multiple(true).args(["csv", "logs"])))]
 pub struct SimulateArgs {
     #[command(flatten)]
     pub model: ModelArgs,
+    #[command(flatten)]
+    pub case: CaseArgs,
     /// Index of the realization to simulate (its random stream is (seed, index)).
     #[arg(long, value_name = "L", default_value_t = 0)]
     pub realization: u64,
-    /// Write the CSV here.
+    /// Write the realization at every sample (truth, integration, estimate, covariance) here.
     #[arg(long, value_name = "FILE")]
-    pub csv: PathBuf,
+    pub csv: Option<PathBuf>,
+    /// Write the sensor logs into this directory: accelerometer.csv, gps.csv and truth.csv.
+    #[arg(long, value_name = "DIR")]
+    pub logs: Option<PathBuf>,
+}
+
+/// Options of `calibrate`.
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    /// The accelerometer log: CSV with columns t_s,accel_m_s2.
+    #[arg(long, value_name = "FILE")]
+    pub accel: PathBuf,
+    /// The GPS log: CSV with columns t_s,position_m,velocity_m_s.
+    #[arg(long, value_name = "FILE")]
+    pub gps: PathBuf,
+    /// Configuration file (TOML): prior means, [filter] statistics, the nominal rate and α.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Directory that receives estimates.csv, summary.json and index.html.
+    #[arg(long, value_name = "DIR", default_value = "calibration")]
+    pub out: PathBuf,
+    /// Print nothing but the result.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bare_command_and_report_subcommand_share_their_defaults() {
+        let bare = Cli::parse_from(["accelcal"]);
+        assert!(bare.command.is_none());
+        let explicit = Cli::parse_from(["accelcal", "report"]);
+        let Some(Command::Report(args)) = explicit.command else {
+            panic!("report subcommand")
+        };
+        let default = ReportArgs::default();
+        assert_eq!(args.out, default.out);
+        assert_eq!(default.out, std::path::Path::new("report"));
+    }
 }

@@ -24,6 +24,58 @@ pub type Matrix2x3 = SMatrix<f64, 2, 3>;
 /// Kalman gain K, 3×2.
 pub type Matrix3x2 = SMatrix<f64, 3, 2>;
 
+/// A component of the error state δx = (δp, δv, b); the first two are also the components of a
+/// GPS measurement and of a residual.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Component {
+    /// Position error δp, m.
+    Position,
+    /// Velocity error δv, m/s.
+    Velocity,
+    /// Accelerometer bias b, m/s².
+    Bias,
+}
+
+impl Component {
+    /// The state components, in state order.
+    pub const STATE: [Component; 3] = [Component::Position, Component::Velocity, Component::Bias];
+    /// The measured components, in measurement order.
+    pub const MEASURED: [Component; 2] = [Component::Position, Component::Velocity];
+
+    /// Index in the state vector.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The unit of the component.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Component::Position => "m",
+            Component::Velocity => "m/s",
+            Component::Bias => "m/s²",
+        }
+    }
+}
+
+/// Before or after the measurement update at a fix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Stage {
+    /// A priori, t_i⁻: propagated from the previous fix.
+    Prior,
+    /// A posteriori, t_i⁺: after the update with the fix.
+    Posterior,
+}
+
+impl Stage {
+    /// Both stages, in time order.
+    pub const ALL: [Stage; 2] = [Stage::Prior, Stage::Posterior];
+}
+
+/// The entries of `m`, row by row.
+pub fn rows<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> [[f64; C]; R] {
+    std::array::from_fn(|r| std::array::from_fn(|c| m[(r, c)]))
+}
+
 /// Transition Φ(τ) of the error state over τ seconds, eq. (5) composed over τ/Δt steps.
 ///
 /// # Formula
@@ -32,7 +84,7 @@ pub type Matrix3x2 = SMatrix<f64, 3, 2>;
 ///        [0  1  −τ   ]
 ///        [0  0   1   ]
 /// ```
-/// The continuous dynamics are nilpotent, so Φ(Δt)ⁿ = Φ(n·Δt) exactly.
+/// Φ is unipotent (Φ − I is nilpotent), so Φ(Δt)ⁿ = Φ(n·Δt) exactly.
 ///
 /// # Examples
 /// ```
@@ -55,9 +107,24 @@ pub fn transition(tau_s: f64) -> Matrix3 {
     )
 }
 
+/// Process noise covariance Q(τ) = Γ·W·Γᵀ of one accelerometer step of τ seconds, (m, m/s, m/s²)².
+///
+/// # Formula
+/// Γ = −(τ²/2, τ, 0)ᵀ (eq. 5: the noise enters position with −τ²/2 and velocity with −τ), W the
+/// accelerometer's white-noise variance `accel_noise_var_m2_s4`.
+pub fn process_noise(tau_s: f64, accel_noise_var_m2_s4: f64) -> Matrix3 {
+    let gamma = Vector3::new(-0.5 * tau_s * tau_s, -tau_s, 0.0);
+    gamma * gamma.transpose() * accel_noise_var_m2_s4
+}
+
 /// The linear Gaussian error-state system of eqs. (5) and (6), for one set of noise statistics.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ErrorStateModel {
+    /// The nominal accelerometer step Δt that [`ErrorStateModel::phi`] and
+    /// [`ErrorStateModel::q`] are computed for, s.
+    pub dt_s: f64,
+    /// Accelerometer white-noise variance W the filter assumes, (m/s²)²; gives Q for any step.
+    pub accel_noise_var_m2_s4: f64,
     /// One-step transition Φ(Δt).
     pub phi: Matrix3,
     /// Process noise covariance per step, Q = Γ·W·Γᵀ with Γ = −(Δt²/2, Δt, 0)ᵀ, (m, m/s, m/s²)².
@@ -73,11 +140,11 @@ pub struct ErrorStateModel {
 impl ErrorStateModel {
     /// The system for sample period `dt_s` and the statistics `stats`.
     pub fn new(dt_s: f64, stats: &NoiseStats) -> Self {
-        // eq. (5): the noise enters position with −Δt²/2 and velocity with −Δt.
-        let gamma = Vector3::new(-0.5 * dt_s * dt_s, -dt_s, 0.0);
         Self {
+            dt_s,
+            accel_noise_var_m2_s4: stats.accel_noise_var_m2_s4,
             phi: transition(dt_s),
-            q: gamma * gamma.transpose() * stats.accel_noise_var_m2_s4,
+            q: process_noise(dt_s, stats.accel_noise_var_m2_s4),
             h: Matrix2x3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0),
             r: Matrix2::new(
                 stats.gps_position_sigma_m.powi(2),
@@ -96,6 +163,42 @@ impl ErrorStateModel {
     /// One propagation step P ← Φ·P·Φᵀ + Q, kept symmetric.
     pub fn propagate(&self, p: &Matrix3) -> Matrix3 {
         symmetrize(self.phi * p * self.phi.transpose() + self.q)
+    }
+
+    /// One propagation step over a step of its own length `tau_s`, as a log with irregular time
+    /// stamps needs: P ← Φ(τ)·P·Φ(τ)ᵀ + Q(τ), kept symmetric.
+    pub fn propagate_over(&self, p: &Matrix3, tau_s: f64) -> Matrix3 {
+        let phi = transition(tau_s);
+        symmetrize(phi * p * phi.transpose() + process_noise(tau_s, self.accel_noise_var_m2_s4))
+    }
+
+    /// The measurement update of the covariance at a fix at `time_s` whose a priori covariance is
+    /// `p_prior`: Cholesky gain, Joseph-form P⁺, and the inverses the statistics use.
+    /// `phi_from_previous` is stored with it: the transition of the estimate since the previous
+    /// fix.
+    ///
+    /// # Errors
+    /// [`FilterError`] when S, P⁻ or P⁺ is not positive definite.
+    pub fn update_covariance(
+        &self,
+        p_prior: &Matrix3,
+        time_s: f64,
+        phi_from_previous: Matrix3,
+    ) -> Result<FixCovariance, FilterError> {
+        update_covariance(self, p_prior, time_s, phi_from_previous)
+    }
+
+    /// Measurement update of the estimate with the gain of `fix`: returns the a posteriori
+    /// estimate δx̂⁺ = δx̂⁻ + K·r and the residual r = δz − H·δx̂⁻.
+    #[inline]
+    pub fn update_estimate(
+        &self,
+        fix: &FixCovariance,
+        prior: &Vector3,
+        dz: &Vector2,
+    ) -> (Vector3, Vector2) {
+        let residual = dz - self.h * prior;
+        (prior + fix.gain * residual, residual)
     }
 }
 
@@ -161,14 +264,13 @@ impl FilterSchedule {
     /// residual r = δz − H·δx̂⁻.
     #[inline]
     pub fn update(&self, i: usize, prior: &Vector3, dz: &Vector2) -> (Vector3, Vector2) {
-        let fix = &self.fixes[i];
-        let residual = dz - self.model.h * prior;
-        (prior + fix.gain * residual, residual)
+        self.model.update_estimate(&self.fixes[i], prior, dz)
     }
 }
 
-fn symmetrize(p: Matrix3) -> Matrix3 {
-    (p + p.transpose()) * 0.5
+/// (M + Mᵀ)/2: removes the asymmetry rounding leaves in a covariance.
+fn symmetrize<const D: usize>(m: SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
+    (m + m.transpose()) * 0.5
 }
 
 /// The measurement update of the covariance at one fix.
@@ -179,7 +281,7 @@ fn update_covariance(
     phi_from_previous: Matrix3,
 ) -> Result<FixCovariance, FilterError> {
     let h = &model.h;
-    let s = symmetrize2(h * p_prior * h.transpose() + model.r);
+    let s = symmetrize(h * p_prior * h.transpose() + model.r);
     let s_chol = s
         .cholesky()
         .ok_or(FilterError::InnovationNotPositiveDefinite { time_s })?;
@@ -213,10 +315,6 @@ fn update_covariance(
         p_prior_inv,
         p_post_inv,
     })
-}
-
-fn symmetrize2(s: Matrix2) -> Matrix2 {
-    (s + s.transpose()) * 0.5
 }
 
 #[cfg(test)]

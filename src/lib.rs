@@ -1,21 +1,31 @@
 //! accelcal: calibrates an accelerometer's bias with GPS through an error-state Kalman filter,
 //! verifies the filter with Monte Carlo statistics, and writes the study up as an HTML report.
 //!
-//! The pipeline, one module per step: [`config`] → [`model`] → [`simulation`] → [`filter`] →
-//! [`ensemble`] → [`checks`] → [`export`] and the report.
+//! The pipeline, one module per step, each depending only on the ones before it:
+//! [`config`] → [`model`] → [`filter`] → [`simulation`] → [`realization`], [`ensemble`] →
+//! [`stats`], [`checks`] → [`study`], [`sensitivity`] → [`export`], [`plot`] → [`report`].
+//! Below the study, [`logs`] reads and writes sensor logs and [`calibrate`] runs the filter and a
+//! smoother over them. [`format`](mod@format), [`output`], [`progress`] and [`error`] are leaves
+//! every step may use. The `accelcal` binary (`src/main.rs`) parses the command line and calls
+//! [`study`], [`sensitivity`], [`calibrate`], [`export`] and [`report`].
+#![warn(missing_docs)]
 
-pub mod app;
+pub mod calibrate;
 pub mod checks;
-pub mod cli;
 pub mod config;
 pub mod ensemble;
 pub mod error;
 pub mod export;
 pub mod filter;
+pub mod format;
+pub mod logs;
 pub mod model;
 pub mod output;
 pub mod plot;
+pub mod progress;
 pub mod realization;
 pub mod report;
+pub mod sensitivity;
 pub mod simulation;
+pub mod stats;
 pub mod study;

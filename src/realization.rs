@@ -2,19 +2,26 @@
 
 use serde::Serialize;
 
-use crate::filter::{FilterSchedule, Matrix3, Vector3};
+use crate::filter::{FilterSchedule, Matrix3, Vector3, rows};
 use crate::model::Model;
 use crate::simulation::{Draws, FixState, Observer, SampleState, run_realization};
 
 /// The state at one accelerometer sample t_j.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SampleRecord {
+    /// Time t_j, s.
     pub t_s: f64,
     /// True acceleration a(t_j), m/s².
     pub accel_m_s2: f64,
+    /// The accelerometer's output a_c(t_j) = a + b + w, m/s².
+    pub accel_output_m_s2: f64,
+    /// True position p(t_j), m.
     pub truth_p_m: f64,
+    /// True velocity v(t_j), m/s.
     pub truth_v_m_s: f64,
+    /// Integrated accelerometer position p_c(t_j), m.
     pub computed_p_m: f64,
+    /// Integrated accelerometer velocity v_c(t_j), m/s.
     pub computed_v_m_s: f64,
     /// True error state δx(t_j) = (p − p_c, v − v_c, b).
     pub delta_x: [f64; 3],
@@ -29,11 +36,17 @@ pub struct SampleRecord {
 /// A realization at one GPS fix.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FixRecord {
+    /// Time of the fix t_i, s.
     pub t_s: f64,
+    /// True error state δx(t_i) = (p − p_c, v − v_c, b).
     pub delta_x: [f64; 3],
+    /// A priori estimate δx̂(t_i⁻).
     pub prior: [f64; 3],
+    /// A posteriori estimate δx̂(t_i⁺).
     pub post: [f64; 3],
+    /// A priori σ = √diag P(t_i⁻).
     pub sigma_prior: [f64; 3],
+    /// A posteriori σ = √diag P(t_i⁺).
     pub sigma_post: [f64; 3],
     /// A priori covariance P(t_i⁻), row-major.
     pub cov_prior: [[f64; 3]; 3],
@@ -48,13 +61,21 @@ pub struct FixRecord {
 /// One realization, recorded at every sample and every fix.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Realization {
+    /// Seed of the random streams.
     pub seed: u64,
+    /// Index of the realization: its stream is (seed, index).
     pub index: u64,
+    /// True initial position p(0), m.
     pub p0_m: f64,
+    /// True initial velocity v(0), m/s.
     pub v0_m_s: f64,
+    /// The realization's bias b, m/s².
     pub bias_m_s2: f64,
+    /// The accelerometer samples, in time order: every one, or those a figure can show (see
+    /// [`record_for_figures`]); not written to JSON.
     #[serde(skip)]
     pub samples: Vec<SampleRecord>,
+    /// Every GPS fix.
     pub fixes: Vec<FixRecord>,
 }
 
@@ -62,8 +83,48 @@ fn sigma(p: &Matrix3) -> [f64; 3] {
     std::array::from_fn(|k| p[(k, k)].sqrt())
 }
 
-fn rows(p: &Matrix3) -> [[f64; 3]; 3] {
-    std::array::from_fn(|r| std::array::from_fn(|c| p[(r, c)]))
+/// The detail window of a run from `t0_s` to `t1_s`: two seconds from two thirds into the run
+/// (20–22 s of 30 s), the whole run when it is shorter. Figures show every sample there.
+pub fn detail_window(t0_s: f64, t1_s: f64) -> (f64, f64) {
+    const DETAIL_S: f64 = 2.0;
+    let span = t1_s - t0_s;
+    if span <= DETAIL_S {
+        return (t0_s, t1_s);
+    }
+    let start = (t0_s + 2.0 * span / 3.0)
+        .floor()
+        .min(t1_s - DETAIL_S)
+        .max(t0_s);
+    (start, start + DETAIL_S)
+}
+
+/// Keeps a long run's samples to what a figure can show: every sample in the detail window, and
+/// elsewhere, per bucket of consecutive samples, the first one and those where an error
+/// component δx − δx̂ is smallest or largest, so that spikes survive.
+struct Thinning {
+    bucket: usize,
+    window: (f64, f64),
+    pending: Vec<SampleRecord>,
+}
+
+impl Thinning {
+    fn flush(&mut self, out: &mut Vec<SampleRecord>) {
+        if self.pending.is_empty() {
+            return;
+        }
+        let error = |s: &SampleRecord, k: usize| s.delta_x[k] - s.estimate[k];
+        let mut keep = vec![0];
+        for k in 0..3 {
+            let by = |a: &&SampleRecord, b: &&SampleRecord| error(a, k).total_cmp(&error(b, k));
+            let indexed = || self.pending.iter().enumerate();
+            keep.extend(indexed().min_by(|a, b| by(&a.1, &b.1)).map(|(i, _)| i));
+            keep.extend(indexed().max_by(|a, b| by(&a.1, &b.1)).map(|(i, _)| i));
+        }
+        keep.sort_unstable();
+        keep.dedup();
+        out.extend(keep.into_iter().map(|i| self.pending[i].clone()));
+        self.pending.clear();
+    }
 }
 
 struct Recorder<'a> {
@@ -73,6 +134,7 @@ struct Recorder<'a> {
     cov: Matrix3,
     samples: Vec<SampleRecord>,
     fixes: Vec<FixRecord>,
+    thinning: Option<Thinning>,
 }
 
 impl Observer for Recorder<'_> {
@@ -81,9 +143,10 @@ impl Observer for Recorder<'_> {
     fn sample(&mut self, s: &SampleState) {
         let t_s = self.model.timeline.time_s(s.step);
         let p = &self.model.config.profile;
-        self.samples.push(SampleRecord {
+        let record = SampleRecord {
             t_s,
             accel_m_s2: p.accel_amplitude_m_s2 * (p.accel_angular_freq_rad_s * t_s).sin(),
+            accel_output_m_s2: s.accel_output_m_s2,
             truth_p_m: s.truth_p_m,
             truth_v_m_s: s.truth_v_m_s,
             computed_p_m: s.computed_p_m,
@@ -96,7 +159,22 @@ impl Observer for Recorder<'_> {
             estimate: self.estimate.into(),
             sigma: sigma(&self.cov),
             cov: rows(&self.cov),
-        });
+        };
+        match &mut self.thinning {
+            None => self.samples.push(record),
+            Some(thin) => {
+                let in_window = t_s >= thin.window.0 && t_s <= thin.window.1;
+                if in_window || s.step == self.model.timeline.steps {
+                    thin.flush(&mut self.samples);
+                    self.samples.push(record);
+                } else {
+                    thin.pending.push(record);
+                    if thin.pending.len() == thin.bucket {
+                        thin.flush(&mut self.samples);
+                    }
+                }
+            }
+        }
         // Propagate to the next sample: δx̂ ← Φ·δx̂, P ← Φ·P·Φᵀ + Q.
         let m = &self.schedule.model;
         self.estimate = m.phi * self.estimate;
@@ -124,13 +202,50 @@ impl Observer for Recorder<'_> {
 
 /// Runs realization `index` under `seed` and records it in full.
 pub fn record(model: &Model, schedule: &FilterSchedule, seed: u64, index: u64) -> Realization {
+    record_with(model, schedule, seed, index, None)
+}
+
+/// Runs realization `index` under `seed` and records every fix, and of the samples what figures
+/// of at most about `max_samples` points can show (see [`detail_window`]): every sample when the
+/// run has no more, else every sample of the detail window and the first, smallest and largest
+/// errors of each bucket of samples elsewhere. Memory then stays bounded for hour-long runs.
+pub fn record_for_figures(
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    index: u64,
+    max_samples: usize,
+) -> Realization {
+    let steps = model.timeline.steps + 1;
+    let thinning = (steps > max_samples).then(|| Thinning {
+        // Up to seven samples kept per bucket.
+        bucket: (7 * steps).div_ceil(max_samples.max(7)),
+        window: detail_window(0.0, model.timeline.time_s(model.timeline.steps)),
+        pending: Vec::new(),
+    });
+    record_with(model, schedule, seed, index, thinning)
+}
+
+fn record_with(
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    index: u64,
+    thinning: Option<Thinning>,
+) -> Realization {
+    let capacity = if thinning.is_some() {
+        0
+    } else {
+        model.timeline.steps + 1
+    };
     let mut rec = Recorder {
         model,
         schedule,
         estimate: Vector3::zeros(),
         cov: schedule.model.p0,
-        samples: Vec::with_capacity(model.timeline.steps + 1),
+        samples: Vec::with_capacity(capacity),
         fixes: Vec::with_capacity(model.timeline.fixes()),
+        thinning,
     };
     let Draws {
         p0_m,

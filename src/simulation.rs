@@ -9,7 +9,7 @@ use rand::RngExt;
 use rand_distr::StandardNormal;
 use rand_pcg::Pcg64Mcg;
 
-use crate::config::TruthModel;
+use crate::config::{Case, TruthModel};
 use crate::filter::{FilterSchedule, Vector2, Vector3};
 use crate::model::Model;
 
@@ -25,12 +25,39 @@ fn splitmix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// The random stream of realization `index` under `seed`. It depends on nothing else, so results
-/// do not depend on the thread count or on how the ensemble is split.
-pub fn stream(seed: u64, index: u64) -> Stream {
-    let hi = splitmix64(splitmix64(seed) ^ index);
+/// The random stream of realization `index` of `case` under `seed`. It depends on nothing else,
+/// so results do not depend on the thread count or on how the ensemble is split, and different
+/// cases draw independent numbers.
+pub fn stream(seed: u64, case: Case, index: u64) -> Stream {
+    let case_seed = splitmix64(seed ^ splitmix64(0xC0DE_CA5E ^ case.stream_key()));
+    let hi = splitmix64(splitmix64(case_seed) ^ index);
     let lo = splitmix64(hi ^ 0x6A09_E667_F3BC_C909);
     Pcg64Mcg::new((u128::from(hi) << 64) | u128::from(lo))
+}
+
+/// Where a realization's standard normal numbers come from.
+pub trait Noise {
+    /// The next standard normal number.
+    fn normal(&mut self) -> f64;
+}
+
+impl Noise for Stream {
+    #[inline]
+    fn normal(&mut self) -> f64 {
+        self.sample(StandardNormal)
+    }
+}
+
+/// No noise at all: every draw is its mean. A realization driven by it is the deterministic part
+/// of every realization (the system is linear), so its errors are the ensemble's expected errors.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoNoise;
+
+impl Noise for NoNoise {
+    #[inline]
+    fn normal(&mut self) -> f64 {
+        0.0
+    }
 }
 
 /// The state of a realization at one accelerometer sample t_j (after the fix update, if any).
@@ -48,6 +75,10 @@ pub struct SampleState {
     pub computed_v_m_s: f64,
     /// The realization's bias b, m/s².
     pub bias_m_s2: f64,
+    /// The accelerometer's output a_c(t_j) = a + b + w, eq. (2): what a log of the sensor holds.
+    /// It is integrated over [t_j, t_{j+1}]; at the last sample, which no step integrates, it is
+    /// drawn after every other number of the realization.
+    pub accel_output_m_s2: f64,
 }
 
 /// What a realization produced at one GPS fix.
@@ -65,6 +96,8 @@ pub struct FixState {
     pub residual: Vector2,
     /// The measurement δz(t_i) = z − (p_c, v_c).
     pub dz: Vector2,
+    /// The GPS fix z(t_i) = (p + η_p, v + η_v): what a log of the receiver holds, (m, m/s).
+    pub z: Vector2,
 }
 
 /// Receives what a realization produces. Both hooks default to doing nothing.
@@ -89,14 +122,10 @@ pub struct Draws {
     pub bias_m_s2: f64,
 }
 
-#[inline]
-fn normal(rng: &mut Stream) -> f64 {
-    rng.sample(StandardNormal)
-}
-
 /// Runs realization `index` of `model` under `seed` through the filter `schedule`, reporting to
 /// `observer`. Draw order: p(0), v(0), b; then, fix by fix, w at every sample up to the fix and
-/// (η_p, η_v) at the fix; then, for an observer that records samples, w after the last fix.
+/// (η_p, η_v) at the fix; then, for an observer that records samples, w after the last fix and
+/// w of the last sample's output.
 pub fn run_realization<O: Observer>(
     model: &Model,
     schedule: &FilterSchedule,
@@ -104,13 +133,37 @@ pub fn run_realization<O: Observer>(
     index: u64,
     observer: &mut O,
 ) -> Draws {
-    let mut rng = stream(seed, index);
+    run_with(
+        model,
+        schedule,
+        &mut stream(seed, model.case(), index),
+        observer,
+    )
+}
+
+/// Runs the noise-free realization of `model`: initial values at their means, zero bias, no
+/// accelerometer or GPS noise. Its errors are the expected errors of every realization.
+pub fn run_noise_free<O: Observer>(
+    model: &Model,
+    schedule: &FilterSchedule,
+    observer: &mut O,
+) -> Draws {
+    run_with(model, schedule, &mut NoNoise, observer)
+}
+
+/// The simulation of one realization with the normal numbers of `rng`.
+fn run_with<N: Noise, O: Observer>(
+    model: &Model,
+    schedule: &FilterSchedule,
+    rng: &mut N,
+    observer: &mut O,
+) -> Draws {
     let cfg = &model.config;
     let ts = &model.truth_stats;
     let draws = Draws {
-        p0_m: cfg.initial.position_mean_m + ts.initial_position_sigma_m * normal(&mut rng),
-        v0_m_s: cfg.initial.velocity_mean_m_s + ts.initial_velocity_sigma_m_s * normal(&mut rng),
-        bias_m_s2: ts.bias_var_m2_s4.sqrt() * normal(&mut rng),
+        p0_m: cfg.initial.position_mean_m + ts.initial_position_sigma_m * rng.normal(),
+        v0_m_s: cfg.initial.velocity_mean_m_s + ts.initial_velocity_sigma_m_s * rng.normal(),
+        bias_m_s2: ts.bias_var_m2_s4.sqrt() * rng.normal(),
     };
     let b = draws.bias_m_s2;
     let w_sigma = ts.accel_noise_var_m2_s4.sqrt();
@@ -127,11 +180,11 @@ pub fn run_realization<O: Observer>(
         draws.p0_m,
         draws.v0_m_s,
     ];
-    let truth_at = |j: usize, pe: f64, ve: f64| match model.truth {
+    let truth_at = |j: usize, pe: f64, ve: f64| match model.truth() {
         TruthModel::Analytic => model.analytic_truth(tl.time_s(j), draws.p0_m, draws.v0_m_s),
         TruthModel::Euler => (pe, ve),
     };
-    let sample = |j: usize, pc: f64, vc: f64, pe: f64, ve: f64| {
+    let sample = |j: usize, [pc, vc, pe, ve]: [f64; 4], ac: f64| {
         let (tp, tv) = truth_at(j, pe, ve);
         SampleState {
             step: j,
@@ -140,6 +193,7 @@ pub fn run_realization<O: Observer>(
             computed_p_m: pc,
             computed_v_m_s: vc,
             bias_m_s2: b,
+            accel_output_m_s2: ac,
         }
     };
 
@@ -147,14 +201,14 @@ pub fn run_realization<O: Observer>(
     let mut j = 0;
     // The integration state (p_c, v_c, p_E, v_E), advanced sample by sample from `j` to `end`.
     // It is passed by value so that it lives in registers through the hot loop.
-    let integrate_to = |j: usize, end: usize, state: [f64; 4], rng: &mut Stream, obs: &mut O| {
+    let integrate_to = |j: usize, end: usize, state: [f64; 4], rng: &mut N, obs: &mut O| {
         let [mut pc, mut vc, mut pe, mut ve] = state;
         for (k, &a) in accel[j..end].iter().enumerate() {
-            if O::SAMPLES {
-                obs.sample(&sample(j + k, pc, vc, pe, ve));
-            }
             // eq. (2): the accelerometer's output.
-            let ac = a + b + w_sigma * normal(rng);
+            let ac = a + b + w_sigma * rng.normal();
+            if O::SAMPLES {
+                obs.sample(&sample(j + k, [pc, vc, pe, ve], ac));
+            }
             // eq. (3): position uses the velocity before the step.
             pc += vc * dt + ac * half_dt2;
             vc += ac * dt;
@@ -165,20 +219,22 @@ pub fn run_realization<O: Observer>(
         [pc, vc, pe, ve]
     };
     for (i, (&jf, fix)) in tl.fix_steps.iter().zip(&schedule.fixes).enumerate() {
-        s = integrate_to(j, jf, s, &mut rng, observer);
+        s = integrate_to(j, jf, s, rng, observer);
         j = jf;
         let [pc, vc, pe, ve] = s;
-        let (tp, tv) = match model.truth {
+        let (tp, tv) = match model.truth() {
             TruthModel::Analytic => {
                 model.analytic_truth_at_fix(i, tl.time_s(jf), draws.p0_m, draws.v0_m_s)
             }
             TruthModel::Euler => (pe, ve),
         };
         let delta_x = Vector3::new(tp - pc, tv - vc, b);
-        let dz = Vector2::new(
-            tp + eta_p_sigma * normal(&mut rng) - pc,
-            tv + eta_v_sigma * normal(&mut rng) - vc,
+        // eq. (6): δz = z − (p_c, v_c), with z the receiver's fix.
+        let z = Vector2::new(
+            tp + eta_p_sigma * rng.normal(),
+            tv + eta_v_sigma * rng.normal(),
         );
+        let dz = Vector2::new(z[0] - pc, z[1] - vc);
         let prior = fix.phi_from_previous * estimate;
         let (post, residual) = schedule.update(i, &prior, &dz);
         estimate = post;
@@ -189,11 +245,13 @@ pub fn run_realization<O: Observer>(
             post,
             residual,
             dz,
+            z,
         });
     }
     if O::SAMPLES {
-        let [pc, vc, pe, ve] = integrate_to(j, tl.steps, s, &mut rng, observer);
-        observer.sample(&sample(tl.steps, pc, vc, pe, ve));
+        let end = integrate_to(j, tl.steps, s, rng, observer);
+        let ac = accel[tl.steps] + b + w_sigma * rng.normal();
+        observer.sample(&sample(tl.steps, end, ac));
     }
     draws
 }
@@ -205,9 +263,15 @@ mod tests {
 
     #[test]
     fn streams_are_fixed_by_seed_and_index() {
-        let a: Vec<u64> = (0..4).map(|_| stream(7, 3).next_u64()).collect();
+        let case = Case::REPORT[0];
+        let a: Vec<u64> = (0..4).map(|_| stream(7, case, 3).next_u64()).collect();
         assert!(a.windows(2).all(|w| w[0] == w[1]));
-        assert_ne!(stream(7, 3).next_u64(), stream(7, 4).next_u64());
-        assert_ne!(stream(7, 3).next_u64(), stream(8, 3).next_u64());
+        assert_ne!(stream(7, case, 3).next_u64(), stream(7, case, 4).next_u64());
+        assert_ne!(stream(7, case, 3).next_u64(), stream(8, case, 3).next_u64());
+        let first: Vec<u64> = Case::REPORT
+            .iter()
+            .map(|&c| stream(7, c, 3).next_u64())
+            .collect();
+        assert!(first[0] != first[1] && first[1] != first[2] && first[0] != first[2]);
     }
 }

@@ -110,6 +110,51 @@ fn wrong_type_is_refused() {
 }
 
 #[test]
+fn configuration_errors_name_file_line_column_field_and_quote_the_line() {
+    refuses(
+        "[ensemble]\nrealizations = \"many\"\n",
+        &[
+            "c.toml:2:16",
+            "field `ensemble.realizations`",
+            "expected u64",
+            " 2 | realizations = \"many\"",
+            "   |                ^^^^^^",
+        ],
+    );
+    refuses(
+        "[ensemble]\nrealizations = -1\n",
+        &[
+            "c.toml:2:16",
+            "`ensemble.realizations`",
+            "integer `-1`",
+            "2 | realizations = -1",
+        ],
+    );
+    refuses(
+        "[gps]\nposition_sigma_m = 1.0\nposition_sigma_m = 2.0\n",
+        &[
+            "c.toml:3:1",
+            "`gps.position_sigma_m`",
+            "duplicate key",
+            "3 | position_sigma_m = 2.0",
+        ],
+    );
+    refuses(
+        "\n[gps\nposition_sigma_m = 1.0\n",
+        &["c.toml:2:5", "field `gps`", "2 | [gps"],
+    );
+    // A value out of range is found in the file too.
+    refuses(
+        "[profile]\nduration_s = 6.0\n[accelerometer]\nnoise_var_m2_s4 = -0.0004\n",
+        &[
+            "c.toml:4:19",
+            "`accelerometer.noise_var_m2_s4` = -0.0004",
+            "4 | noise_var_m2_s4 = -0.0004",
+        ],
+    );
+}
+
+#[test]
 fn residual_pair_off_the_fix_grid_is_refused() {
     refuses(
         "[checks]\nresidual_pair_s = [10.1, 20.0]\n",
@@ -256,4 +301,117 @@ fn simulate_writes_every_accelerometer_sample() {
     assert!(lines[0].starts_with("t_s,"));
     let fixes = lines[1..].iter().filter(|l| l.ends_with(",1")).count();
     assert_eq!(fixes, 150);
+}
+
+#[test]
+fn checks_that_cannot_fail_at_ten_realizations_are_untestable_not_passed() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(
+        &[
+            "ensemble",
+            "--truth",
+            "euler",
+            "--realizations",
+            "10",
+            "--json",
+            "out.json",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("untestable at N = 10, needs N ≥"),
+        "{stdout}"
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("out.json")).unwrap())
+            .unwrap();
+    assert_eq!(doc["summary"]["all_passed"], false);
+    for c in doc["summary"]["checks"].as_array().unwrap() {
+        let untestable = c["verdict"] == "untestable";
+        let bounded = c["id"] == "orthogonality" || c["id"] == "residual_whiteness";
+        assert_eq!(untestable, bounded, "{c}");
+        assert_eq!(c["passed"], c["verdict"] == "pass", "{c}");
+        if bounded {
+            assert!(c["min_realizations"].as_u64().unwrap() > 10, "{c}");
+        }
+    }
+}
+
+/// Runs `sensitivity` with `extra` arguments and expects exit code 2 naming `field`.
+fn sensitivity_refuses(extra: &[&str], field: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("out.json"), "earlier results").unwrap();
+    let mut args = vec!["sensitivity", "--json", "out.json", "--quiet"];
+    args.extend_from_slice(extra);
+    let o = run(&args, dir.path());
+    let msg = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{extra:?}: {msg}");
+    assert!(msg.contains(field), "{extra:?}: {msg}");
+    assert!(!msg.contains("panicked"), "{msg}");
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("out.json")).unwrap(),
+        "earlier results"
+    );
+}
+
+#[test]
+fn sensitivity_refuses_bad_parameters_and_factors() {
+    sensitivity_refuses(&["--parameters", "gps_sigma"], "--parameters");
+    sensitivity_refuses(&["--factors", "0.5,0"], "--factors");
+    sensitivity_refuses(&["--factors", "-2"], "--factors");
+    sensitivity_refuses(&["--factors", "inf"], "--factors");
+    sensitivity_refuses(&["--factors", "nan"], "--factors");
+    sensitivity_refuses(&["--factors", ""], "--factors");
+}
+
+#[test]
+fn sensitivity_writes_the_cases_of_the_data_contract() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("c.toml"),
+        "[profile]\nduration_s = 2.0\n[ensemble]\nrealizations = 200\n",
+    )
+    .unwrap();
+    let o = run(
+        &[
+            "sensitivity",
+            "--config",
+            "c.toml",
+            "--parameters",
+            "accel_noise_var_m2_s4,bias_var_m2_s4",
+            "--factors",
+            "0.5,2",
+            "--ensembles",
+            "2",
+            "--json",
+            "s.json",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.json")).unwrap()).unwrap();
+    let cases = doc["cases"].as_array().unwrap();
+    assert_eq!(cases.len(), 4);
+    for c in cases {
+        for key in [
+            "parameter",
+            "factor",
+            "claimed_sigma_final",
+            "actual_sigma_final",
+            "expected_nees_final",
+            "detection",
+            "monte_carlo",
+        ] {
+            assert!(!c[key].is_null(), "{key} missing: {c}");
+        }
+        assert_eq!(c["detection"].as_object().unwrap().len(), 7);
+        assert_eq!(c["monte_carlo"]["ensembles"], 2);
+        assert_eq!(c["monte_carlo"]["realizations"], 200);
+        assert_eq!(c["monte_carlo"]["detected"].as_object().unwrap().len(), 7);
+    }
 }

@@ -3,7 +3,7 @@
 
 use accelcal::config::Config;
 use accelcal::model::Model;
-use accelcal::study::Study;
+use accelcal::study::{Silent, Study};
 use serde_json::Value;
 
 const VOLATILE: [&str; 3] = ["accelcal_version", "realizations_per_s", "elapsed_s"];
@@ -35,6 +35,75 @@ fn diff(a: &Value, b: &Value, path: &str) -> Option<String> {
     }
 }
 
+/// The default study with its sensitivity, as `cargo run --release` writes it; run once.
+fn default_study() -> &'static Study {
+    static STUDY: std::sync::OnceLock<Study> = std::sync::OnceLock::new();
+    STUDY.get_or_init(|| {
+        Study::run(&Model::new(&Config::default()).unwrap(), &mut Silent)
+            .unwrap()
+            .with_sensitivity(&mut Silent)
+            .unwrap()
+    })
+}
+
+/// `html` with the content of every element of class `timing` removed: run times, rates and
+/// the thread count vary between runs.
+fn without_timing(html: &str) -> String {
+    let mut out = String::with_capacity(html.len());
+    let mut rest = html;
+    while let Some(i) = rest.find("timing\">") {
+        let start = i + "timing\">".len();
+        out.push_str(&rest[..start]);
+        let end = rest[start..].find('<').map_or(rest.len(), |j| start + j);
+        rest = &rest[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
+#[test]
+fn committed_page_matches_the_code() {
+    let committed =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/report/index.html"))
+            .expect("report/index.html is committed");
+    let study = default_study();
+    let now = accelcal::report::render(study, "accelcal report")
+        .unwrap()
+        .html;
+    let (a, b) = (without_timing(&committed), without_timing(&now));
+    if a != b {
+        let line = a
+            .lines()
+            .zip(b.lines())
+            .position(|(x, y)| x != y)
+            .unwrap_or(a.lines().count().min(b.lines().count()));
+        panic!(
+            "report/index.html is stale (run `cargo run --release`): first difference at line {}:\n{}\nvs\n{}",
+            line + 1,
+            a.lines()
+                .nth(line)
+                .unwrap_or("")
+                .chars()
+                .take(300)
+                .collect::<String>(),
+            b.lines()
+                .nth(line)
+                .unwrap_or("")
+                .chars()
+                .take(300)
+                .collect::<String>()
+        );
+    }
+}
+
+#[test]
+fn timing_cells_are_masked_and_nothing_else() {
+    let a = "<td class=\"num timing\">1.23</td><td>4</td>";
+    let b = "<td class=\"num timing\">9.87</td><td>4</td>";
+    assert_eq!(without_timing(a), without_timing(b));
+    assert_ne!(without_timing(a), without_timing(&b.replace('4', "5")));
+}
+
 #[test]
 fn committed_data_matches_the_code() {
     let committed: Value = serde_json::from_str(
@@ -42,9 +111,8 @@ fn committed_data_matches_the_code() {
             .expect("report/data.json is committed"),
     )
     .unwrap();
-    let model = Model::new(&Config::default()).unwrap();
-    let study = Study::run(&model, true).unwrap();
-    let now: Value = serde_json::from_str(&accelcal::export::report_data_json(&study)).unwrap();
+    let study = default_study();
+    let now: Value = serde_json::from_str(&accelcal::export::report_data_json(study)).unwrap();
     if let Some(d) = diff(&committed, &now, "data") {
         panic!("report/data.json is stale (run `cargo run --release`): first difference at {d}");
     }

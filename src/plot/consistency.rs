@@ -1,116 +1,217 @@
 //! The average normalized estimation error squared (NEES) and innovation squared (NIS).
 
-use plotters::style::Color;
+use plotters::style::{Color, RGBColor};
 
-use super::panel::{
-    Axis, Entry, Layout, Panel, Swatch, draw_legend, extent, legend_height, padded, render, rows,
-    time_span, y_label_area,
-};
-use super::{BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotResult};
+use super::axis::{Axis, y_label_area};
+use super::geometry::{Point, extent, padded, time_span};
+use super::legend::{Entry, Swatch, draw_legend, legend_height};
+use super::panel::{Area, Layout, Panel, columns, render, rows};
+use super::{BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotError, PlotResult, REFERENCE};
 use crate::checks::Check;
 use crate::ensemble::EnsembleStats;
 
 /// Height of one panel, px.
 const ROW_PX: u32 = 300;
+/// Width of the full-run column of a split row, px; the enlarged band takes the rest.
+const FULL_COLUMN_PX: u32 = 590;
 /// Dimension of the error state: the expected NEES.
 const STATE_DIM: f64 = 3.0;
 /// Dimension of the measurement: the expected NIS.
 const MEASUREMENT_DIM: f64 = 2.0;
+/// A statistic reaching this multiple of its band's upper end (or this fraction of its lower
+/// end) would flatten the band to a line on a linear axis: its row is split.
+const FAR_RATIO: f64 = 3.0;
+/// The enlarged band fills the middle of its axis, which reaches this many band widths beyond
+/// either end.
+const ZOOM_MARGIN: f64 = 1.5;
+
+/// One statistic: its series, its band and its expected value.
+struct Statistic<'a> {
+    name: &'static str,
+    series: Vec<(Vec<Point>, RGBColor)>,
+    check: &'a Check,
+    expected: f64,
+}
+
+/// How a row shows its statistic.
+enum Scale {
+    /// One linear axis over the values, the band and the expected value.
+    Linear(Axis),
+    /// The values on a log axis over the whole run, and beside it a linear axis enlarged around
+    /// the band, which the values far from it run off.
+    Split { log: Axis, zoom: Axis },
+}
+
+impl Statistic<'_> {
+    fn values(&self) -> impl Iterator<Item = f64> + '_ {
+        self.series
+            .iter()
+            .flat_map(|(points, _)| points.iter().map(|p| p.1))
+            .filter(|v| v.is_finite())
+    }
+
+    /// A linear axis when the values stay within [`FAR_RATIO`] of the band, a split otherwise.
+    fn scale(&self) -> Scale {
+        let name = format!("average {}", self.name);
+        let (lower, upper) = (self.check.lower, self.check.upper);
+        let reference = [lower, upper, self.expected];
+        let all = || self.values().chain(reference);
+        let far = self
+            .values()
+            .any(|v| v > FAR_RATIO * upper || v < lower / FAR_RATIO);
+        let positive = extent(all().filter(|v| *v > 0.0));
+        match positive {
+            Some((lo, hi)) if far && upper > lower => {
+                let w = upper - lower;
+                Scale::Split {
+                    log: Axis::log10(&name, "", (lo, hi)),
+                    zoom: Axis::linear(
+                        &name,
+                        "",
+                        (lower - ZOOM_MARGIN * w, upper + ZOOM_MARGIN * w),
+                        5,
+                    ),
+                }
+            }
+            _ => {
+                let range = extent(all()).map_or((0.0, 2.0 * self.expected), |e| padded(e, 0.08));
+                Scale::Linear(Axis::linear(&name, "", range, 7))
+            }
+        }
+    }
+
+    /// The band (shaded, black edges), the expected value and the series on `p`, over `[t0, t1]`.
+    fn draw(&self, p: &Panel<'_>, (t0, t1): (f64, f64)) -> Result<(), PlotError> {
+        let (lower, upper) = (self.check.lower, self.check.upper);
+        p.band(&[t0, t1], &[lower; 2], &[upper; 2], BLACK.mix(0.1))?;
+        p.hline(self.expected, REFERENCE.stroke_width(1))?;
+        p.hline(lower, BLACK.stroke_width(1))?;
+        p.hline(upper, BLACK.stroke_width(1))?;
+        for (points, color) in &self.series {
+            p.line(points.iter().copied(), color.stroke_width(2))?;
+        }
+        Ok(())
+    }
+}
 
 /// Top: the ensemble-average NEES (1/N) Σ eᵀP⁻¹e at every fix, a priori and a posteriori, against
 /// its expected value 3 and the χ² band of `nees`. Bottom: the average NIS (1/N) Σ rᵀS⁻¹r against
 /// 2 and the band of `nis`.
+///
+/// A statistic that reaches [`FAR_RATIO`] times its band's upper end (33 against a band
+/// [2.9, 3.1], say) would flatten the band to a line on a linear axis: its row then shows the
+/// whole run on a log axis, and beside it the run again on an axis enlarged around the band.
 pub fn consistency(stats: &EnsembleStats, nees: &Check, nis: &Check) -> PlotResult {
     let fixes = &stats.fixes;
     let (t0, t1) = time_span(fixes.iter().map(|f| f.time_s));
-    let time = Axis::linear("time", "s", (t0.min(0.0), t1), 8);
-    let fitted = |name: &str, values: Vec<f64>, check: &Check, expected: f64| {
-        let values = values
-            .into_iter()
-            .chain([check.lower, check.upper, expected]);
-        let range = extent(values).map_or((0.0, 2.0 * expected), |e| padded(e, 0.08));
-        Axis::linear(name, "", range, 7)
-    };
-    let nees_axis = fitted(
-        "average NEES",
-        fixes
-            .iter()
-            .flat_map(|f| [f.prior.nees_avg, f.post.nees_avg])
-            .collect(),
-        nees,
-        STATE_DIM,
-    );
-    let nis_axis = fitted(
-        "average NIS",
-        fixes.iter().map(|f| f.nis_avg).collect(),
-        nis,
-        MEASUREMENT_DIM,
-    );
-    let y_area_px = y_label_area(&[&nees_axis, &nis_axis]);
+    let span = (t0.min(0.0), t1);
+    let statistics = [
+        Statistic {
+            name: "NEES",
+            series: vec![
+                (
+                    fixes.iter().map(|f| (f.time_s, f.prior.nees_avg)).collect(),
+                    ORANGE,
+                ),
+                (
+                    fixes.iter().map(|f| (f.time_s, f.post.nees_avg)).collect(),
+                    BLUE,
+                ),
+            ],
+            check: nees,
+            expected: STATE_DIM,
+        },
+        Statistic {
+            name: "NIS",
+            series: vec![(
+                fixes.iter().map(|f| (f.time_s, f.nis_avg)).collect(),
+                BLUISH_GREEN,
+            )],
+            check: nis,
+            expected: MEASUREMENT_DIM,
+        },
+    ];
+    let scales: Vec<Scale> = statistics.iter().map(Statistic::scale).collect();
+    let main_axes: Vec<&Axis> = scales
+        .iter()
+        .map(|s| match s {
+            Scale::Linear(a) | Scale::Split { log: a, .. } => a,
+        })
+        .collect();
+    let zoom_axes: Vec<&Axis> = scales
+        .iter()
+        .filter_map(|s| match s {
+            Scale::Split { zoom, .. } => Some(zoom),
+            Scale::Linear(_) => None,
+        })
+        .collect();
+    let main_area = y_label_area(&main_axes);
+    let zoom_area = y_label_area(&zoom_axes);
 
     let legend = [
         Entry::new(Swatch::Line(ORANGE.stroke_width(2)), "NEES, a priori"),
         Entry::new(Swatch::Line(BLUE.stroke_width(2)), "NEES, a posteriori"),
         Entry::new(Swatch::Line(BLUISH_GREEN.stroke_width(2)), "NIS"),
-        Entry::new(
-            Swatch::Line(BLACK.mix(0.4).stroke_width(1)),
-            "expected value",
-        ),
+        Entry::new(Swatch::Line(REFERENCE.stroke_width(1)), "expected value"),
         Entry::new(Swatch::Line(BLACK.stroke_width(1)), "χ² acceptance band"),
     ];
     let legend_px = legend_height(&legend);
     let last_row_px = ROW_PX + 24;
 
     render(legend_px + ROW_PX + last_row_px + 6, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX, last_row_px]);
+        let parts = rows(root, &[legend_px, ROW_PX]);
         draw_legend(&parts[0], &legend)?;
-        let p = Panel::new(
-            &parts[1],
-            &format!(
-                "Average NEES over N = {} realizations: expected {STATE_DIM}, band [{:.3}, {:.3}]",
-                stats.realizations, nees.lower, nees.upper
-            ),
-            time.clone(),
-            nees_axis,
-            Layout {
+        for (row, (stat, scale)) in statistics.iter().zip(&scales).enumerate() {
+            let layout = |y_area_px| Layout {
                 y_area_px,
-                x_title: false,
+                x_title: row == 1,
                 title: true,
-            },
-        )?;
-        p.hline(STATE_DIM, BLACK.mix(0.4).stroke_width(1))?;
-        p.hline(nees.lower, BLACK.stroke_width(1))?;
-        p.hline(nees.upper, BLACK.stroke_width(1))?;
-        p.line(
-            fixes.iter().map(|f| (f.time_s, f.prior.nees_avg)),
-            ORANGE.stroke_width(2),
-        )?;
-        p.line(
-            fixes.iter().map(|f| (f.time_s, f.post.nees_avg)),
-            BLUE.stroke_width(2),
-        )?;
-
-        let q = Panel::new(
-            &parts[2],
-            &format!(
-                "Average NIS: expected {MEASUREMENT_DIM}, band [{:.3}, {:.3}]",
-                nis.lower, nis.upper
-            ),
-            time,
-            nis_axis,
-            Layout {
-                y_area_px,
-                x_title: true,
-                title: true,
-            },
-        )?;
-        q.hline(MEASUREMENT_DIM, BLACK.mix(0.4).stroke_width(1))?;
-        q.hline(nis.lower, BLACK.stroke_width(1))?;
-        q.hline(nis.upper, BLACK.stroke_width(1))?;
-        q.line(
-            fixes.iter().map(|f| (f.time_s, f.nis_avg)),
-            BLUISH_GREEN.stroke_width(2),
-        )?;
+            };
+            let over = if row == 0 {
+                format!(
+                    " over N = {} realizations",
+                    crate::format::count(stats.realizations)
+                )
+            } else {
+                String::new()
+            };
+            let (lower, upper) = (stat.check.lower, stat.check.upper);
+            let area: &Area<'_> = &parts[row + 1];
+            match scale {
+                Scale::Linear(axis) => {
+                    let p = Panel::new(
+                        area,
+                        &format!(
+                            "Average {}{over}: expected {}, band [{lower:.3}, {upper:.3}]",
+                            stat.name, stat.expected
+                        ),
+                        Axis::linear("time", "s", span, 8),
+                        axis.clone(),
+                        layout(main_area),
+                    )?;
+                    stat.draw(&p, span)?;
+                }
+                Scale::Split { log, zoom } => {
+                    let cols = columns(area, &[FULL_COLUMN_PX]);
+                    let p = Panel::new(
+                        &cols[0],
+                        &format!("Average {}{over}, log axis", stat.name),
+                        Axis::linear("time", "s", span, 7),
+                        log.clone(),
+                        layout(main_area),
+                    )?;
+                    stat.draw(&p, span)?;
+                    let q = Panel::new(
+                        &cols[1],
+                        &format!("Enlarged: band [{lower:.3}, {upper:.3}]"),
+                        Axis::linear("time", "s", span, 4),
+                        zoom.clone(),
+                        layout(zoom_area),
+                    )?;
+                    stat.draw(&q, span)?;
+                }
+            }
+        }
         Ok(())
     })
 }

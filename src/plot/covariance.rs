@@ -2,14 +2,15 @@
 
 use plotters::style::Color;
 
-use super::panel::{
-    Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, extent, legend_height, padded,
-    render, rows, time_span, y_label_area,
-};
+use super::axis::{Axis, y_label_area};
+use super::geometry::{extent, padded, time_span};
+use super::legend::{Entry, Swatch, draw_legend, legend_height};
+use super::panel::{Layout, Panel, columns, render, rows};
 use super::{
-    BLACK, BLUE, ORANGE, PlotResult, SKY_BLUE, STATE_UNITS, VERMILLION, WIDTH_PX, capitalized,
+    BLACK, BLUE, ORANGE, PlotResult, REFERENCE, SKY_BLUE, VERMILLION, WIDTH_PX, capitalized,
+    state_name, state_unit,
 };
-use crate::checks::{Check, STATE_NAMES};
+use crate::checks::Check;
 use crate::ensemble::{EnsembleStats, FixStats, StageStats};
 
 /// Height of one state's row, px.
@@ -38,7 +39,7 @@ pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
             let unit = if k == 0 {
                 "m²".to_string()
             } else {
-                format!("({})²", STATE_UNITS[k])
+                format!("({})²", state_unit(k))
             };
             Axis::log10("variance", &unit, (lo, hi))
         })
@@ -50,7 +51,7 @@ pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
                 .flat_map(|f| [ratio(&f.prior, k), ratio(&f.post, k)])
                 .chain([check.lower, check.upper, 1.0]);
             let range = extent(values).map_or((0.5, 1.5), |e| padded(e, 0.1));
-            Axis::linear("P_ave / P", "", range, 6)
+            Axis::linear("P^{ave} / P", "", range, 6)
         })
         .collect();
     let var_area = y_label_area(&var_axes.iter().collect::<Vec<_>>());
@@ -63,7 +64,7 @@ pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
         ),
         Entry::new(
             Swatch::Line(VERMILLION.stroke_width(2)),
-            "ensemble P_ave, a priori",
+            "ensemble P^{ave}, a priori",
         ),
         Entry::new(
             Swatch::Line(SKY_BLUE.mix(0.6).stroke_width(5)),
@@ -71,11 +72,15 @@ pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
         ),
         Entry::new(
             Swatch::Line(BLUE.stroke_width(2)),
-            "ensemble P_ave, a posteriori",
+            "ensemble P^{ave}, a posteriori",
         ),
         Entry::new(
             Swatch::Line(BLACK.stroke_width(1)),
-            format!("χ² band [{:.3}, {:.3}]", check.lower, check.upper),
+            format!(
+                "χ² band [{}, {}]",
+                crate::format::sig(check.lower, 4),
+                crate::format::sig(check.upper, 4)
+            ),
         ),
     ];
     let legend_px = legend_height(&legend);
@@ -91,7 +96,7 @@ pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
                 x_title: k == 2,
                 title: true,
             };
-            let name = STATE_NAMES[k];
+            let name = state_name(k);
             let p = Panel::new(
                 &cols[0],
                 &format!("{}: ensemble and filter variance", capitalized(name)),
@@ -122,12 +127,12 @@ pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
 
             let q = Panel::new(
                 &cols[1],
-                &format!("{}: variance ratio P_ave / P", capitalized(name)),
+                &format!("{}: variance ratio P^{{ave}} / P", capitalized(name)),
                 time.clone(),
                 ratio_axes[k].clone(),
                 layout(ratio_area),
             )?;
-            q.hline(1.0, BLACK.mix(0.4).stroke_width(1))?;
+            q.hline(1.0, REFERENCE.stroke_width(1))?;
             q.hline(check.lower, BLACK.stroke_width(1))?;
             q.hline(check.upper, BLACK.stroke_width(1))?;
             q.line(

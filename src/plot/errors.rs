@@ -2,20 +2,17 @@
 
 use plotters::style::Color;
 
-use super::panel::{
-    Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, extent, legend_height, max_abs,
-    padded, render, rows, settled_from, time_span, y_label_area,
-};
-use super::{BLACK, BLUE, ORANGE, PlotResult, STATE_UNITS, capitalized};
-use crate::checks::STATE_NAMES;
+use super::axis::{Axis, y_label_area};
+use super::geometry::{before, clipped_until, extent, max_abs, padded, settled_from, time_span};
+use super::legend::{Entry, Swatch, draw_legend, legend_height};
+use super::panel::{Layout, Panel, columns, render, rows};
+use super::{BLACK, BLUE, ORANGE, PlotResult, REFERENCE, capitalized, state_name, state_unit};
 use crate::realization::Realization;
 
 /// Height of one state's row, px.
 const ROW_PX: u32 = 270;
 /// Width of the full-run column, px; the zoom takes the rest.
 const FULL_COLUMN_PX: u32 = 590;
-/// Length of the zoom window, s.
-const ZOOM_S: f64 = 2.0;
 /// The full-run axes show σ up to this multiple of its final value; earlier, larger σ (the
 /// bias's first seconds) runs off the axis rather than flattening the rest of the run.
 const SETTLED_SIGMA_RATIO: f64 = 5.0;
@@ -28,7 +25,8 @@ const SETTLED_SIGMA_RATIO: f64 = 5.0;
 /// and after σ has fallen to five times its final value: σ starts at the prior's 10 m, 1 m/s,
 /// 0.1 m/s² and collapses within the first fixes (the bias's over about ten seconds), which would
 /// otherwise flatten the rest of the run. The zoom plots σ alone because its sawtooth is about 1 %
-/// of σ: on an axis that also holds e, the teeth would be a pixel high.
+/// of σ: on an axis that also holds e, the teeth would be a pixel high. A full-run panel whose
+/// error or ±1σ leaves its axis says so in its title ("clipped before 7.7 s").
 pub fn realization_errors(r: &Realization) -> PlotResult {
     let t: Vec<f64> = r.samples.iter().map(|s| s.t_s).collect();
     let (t0, t1) = time_span(t.iter().copied());
@@ -67,11 +65,11 @@ pub fn realization_errors(r: &Realization) -> PlotResult {
         for k in 0..3 {
             let last = k == 2;
             let cols = columns(&parts[k + 1], &[FULL_COLUMN_PX]);
-            let name = STATE_NAMES[k];
+            let name = state_name(k);
 
             let full = Panel::new(
                 &cols[0],
-                &format!("{}: error and ±1σ over the run", capitalized(name)),
+                &full_run_title(r, k, &error_axes[k]),
                 time.clone(),
                 error_axes[k].clone(),
                 full_layout(last),
@@ -79,7 +77,7 @@ pub fn realization_errors(r: &Realization) -> PlotResult {
             let sigma: Vec<f64> = r.samples.iter().map(|s| s.sigma[k]).collect();
             let lower: Vec<f64> = sigma.iter().map(|s| -s).collect();
             full.band(&t, &lower, &sigma, ORANGE.mix(0.35))?;
-            full.hline(0.0, BLACK.mix(0.5).stroke_width(1))?;
+            full.hline(0.0, REFERENCE.stroke_width(1))?;
             full.line(
                 r.samples
                     .iter()
@@ -121,14 +119,33 @@ pub fn realization_errors(r: &Realization) -> PlotResult {
     })
 }
 
+/// The title of state `k`'s full-run panel, saying what `axis` clips: the error, ±1σ or both,
+/// which leave it early in the run.
+fn full_run_title(r: &Realization, k: usize, axis: &Axis) -> String {
+    let name = capitalized(state_name(k));
+    let error = clipped_until(
+        r.samples
+            .iter()
+            .map(|s| (s.t_s, s.delta_x[k] - s.estimate[k])),
+        |v| axis.shows(v),
+    );
+    let sigma = clipped_until(r.samples.iter().map(|s| (s.t_s, s.sigma[k])), |v| {
+        axis.shows(v)
+    });
+    match (error, sigma) {
+        (None, None) => format!("{name}: error and ±1σ over the run"),
+        (Some(t), None) => format!("{name}: error and ±1σ (error off the axis {})", before(t)),
+        (None, Some(t)) => format!("{name}: error and ±1σ (±1σ off the axis {})", before(t)),
+        (Some(a), Some(b)) => format!(
+            "{name}: error and ±1σ (both off the axis {})",
+            before(a.max(b))
+        ),
+    }
+}
+
 /// The two-second window the zoom shows: from two thirds into the run (20–22 s of 30 s).
 fn zoom_window(t0: f64, t1: f64) -> (f64, f64) {
-    let span = t1 - t0;
-    if span <= ZOOM_S {
-        return (t0, t1);
-    }
-    let start = (t0 + 2.0 * span / 3.0).floor().min(t1 - ZOOM_S).max(t0);
-    (start, start + ZOOM_S)
+    crate::realization::detail_window(t0, t1)
 }
 
 /// The symmetric error axis of state `k`, scaled to e and σ after `settle` or, if later, after σ
@@ -147,8 +164,8 @@ fn error_axis(r: &Realization, k: usize, settle: f64) -> Axis {
     let m = max_abs(late.flat_map(|s| [s.sigma[k], s.delta_x[k] - s.estimate[k]]));
     let m = if m > 0.0 { 1.3 * m } else { 1.0 };
     Axis::linear(
-        &format!("{} error", STATE_NAMES[k]),
-        STATE_UNITS[k],
+        &format!("{} error", state_name(k)),
+        state_unit(k),
         (-m, m),
         7,
     )
@@ -169,5 +186,5 @@ fn sigma_axis(r: &Realization, k: usize, (a, b): (f64, f64)) -> Axis {
                 .flat_map(|f| [f.sigma_prior[k], f.sigma_post[k]]),
         );
     let range = extent(values).map_or((0.0, 1.0), |e| padded(e, 0.12));
-    Axis::linear(&format!("{} σ", STATE_NAMES[k]), STATE_UNITS[k], range, 5)
+    Axis::linear(&format!("{} σ", state_name(k)), state_unit(k), range, 5)
 }

@@ -2,8 +2,9 @@
 //!
 //! One file per figure family; every public function takes plain data (a [`Realization`] or an
 //! [`EnsembleStats`] with its [`Check`]) and returns the SVG document as a string. The shared look
-//! lives here as constants: the width, the font, the font sizes and an Okabe–Ito palette, which
-//! stays distinguishable under the common colour-vision deficiencies.
+//! lives here as constants: the width, the font, the font sizes and a palette derived from
+//! Okabe–Ito's, which stays distinguishable under the common colour-vision deficiencies; every
+//! colour a line, marker or text is drawn in reaches 3:1 against white.
 //!
 //! The output is deterministic: plotters runs without font crates and lays text out with its
 //! naive estimate, and every number written is a pixel coordinate computed from the data alone.
@@ -18,26 +19,39 @@
 //! [`Check`]: crate::checks::Check
 
 use plotters::drawing::DrawingAreaErrorKind;
-use plotters::style::RGBColor;
+use plotters::style::{FontDesc, RGBColor, TextStyle};
 
+use crate::checks::catalogue::state_words;
+use crate::filter::Component;
+
+mod axis;
+mod calibration;
+mod cases;
 mod consistency;
 mod covariance;
 mod errors;
+mod geometry;
+mod legend;
+mod markup;
 mod mean_error;
 mod orthogonality;
 mod panel;
 mod residuals;
+mod sensitivity;
 mod trajectory;
-mod truth_models;
 
+pub use calibration::{
+    calibration_bias, calibration_nis, calibration_residuals, calibration_trajectory,
+};
+pub use cases::{CaseSeries, accuracy_ratio, mean_error_in_sigma};
 pub use consistency::consistency;
 pub use covariance::covariance;
 pub use errors::realization_errors;
 pub use mean_error::mean_error;
 pub use orthogonality::orthogonality;
 pub use residuals::residual_whiteness;
+pub use sensitivity::{SensitivitySeries, sigma_ratio};
 pub use trajectory::trajectory;
-pub use truth_models::truth_models;
 
 /// Width of every figure, px. The report shows them in a column about 900 px wide, so a figure is
 /// scaled by about 0.94 and the font sizes below shrink by as much.
@@ -53,26 +67,48 @@ pub const TICK_LABEL_PX: f64 = 14.0;
 /// Legend entries, px.
 pub const LEGEND_PX: f64 = 14.0;
 
-/// Okabe–Ito black: text, axes, reference lines.
+/// Black: text, axes, band edges.
 pub const BLACK: RGBColor = RGBColor(0x00, 0x00, 0x00);
-/// Okabe–Ito orange.
-pub const ORANGE: RGBColor = RGBColor(0xE6, 0x9F, 0x00);
-/// Okabe–Ito sky blue.
-pub const SKY_BLUE: RGBColor = RGBColor(0x56, 0xB4, 0xE9);
-/// Okabe–Ito bluish green.
+/// Dark amber (Okabe–Ito orange #E69F00 darkened to 3.6:1 on white; the original reaches 2.25:1),
+/// kept yellower than vermillion so the two stay apart.
+pub const ORANGE: RGBColor = RGBColor(0xB0, 0x7D, 0x00);
+/// Dark sky blue (Okabe–Ito sky blue #56B4E9 darkened to 3.7:1; the original reaches 2.3:1).
+pub const SKY_BLUE: RGBColor = RGBColor(0x3A, 0x8A, 0xCB);
+/// Okabe–Ito bluish green (3.4:1).
 pub const BLUISH_GREEN: RGBColor = RGBColor(0x00, 0x9E, 0x73);
-/// Okabe–Ito yellow.
-pub const YELLOW: RGBColor = RGBColor(0xF0, 0xE4, 0x42);
-/// Okabe–Ito blue.
+/// Olive (Okabe–Ito yellow #F0E442 darkened to 3.9:1; the original reaches 1.3:1).
+pub const YELLOW: RGBColor = RGBColor(0x8F, 0x82, 0x00);
+/// Okabe–Ito blue (5.2:1).
 pub const BLUE: RGBColor = RGBColor(0x00, 0x72, 0xB2);
-/// Okabe–Ito vermillion: bounds and warnings.
+/// Okabe–Ito vermillion (3.9:1): bounds and warnings.
 pub const VERMILLION: RGBColor = RGBColor(0xD5, 0x5E, 0x00);
-/// Okabe–Ito reddish purple.
-pub const REDDISH_PURPLE: RGBColor = RGBColor(0xCC, 0x79, 0xA7);
-/// Dark grey: axis frames and secondary text.
+/// Dark reddish purple (Okabe–Ito reddish purple #CC79A7 darkened to 4.5:1; the original
+/// reaches 3.06:1, too close to the limit once a thin line is anti-aliased).
+pub const REDDISH_PURPLE: RGBColor = RGBColor(0xB4, 0x56, 0x8E);
+/// Dark grey: axis frames and secondary text (7.5:1).
 pub const GREY: RGBColor = RGBColor(0x55, 0x55, 0x55);
-/// Light grey: grid lines.
+/// Mid grey: reference lines such as zero and an expected value (4.5:1), lighter than the black
+/// of band edges.
+pub const REFERENCE: RGBColor = RGBColor(0x76, 0x76, 0x76);
+/// Light grey: grid lines. The one stroke colour below 3:1, on purpose: the grid is decoration
+/// behind the data (the ticks on the frame carry the scale) and must not compete with it.
 pub const GRID: RGBColor = RGBColor(0xE3, 0xE3, 0xE3);
+
+/// Every colour figures stroke lines, markers or text with, by name. Each reaches 3:1 against
+/// white (WCAG 2 relative luminance); [`GRID`] is left out on purpose (see there).
+#[cfg(test)]
+pub(crate) const STROKE_COLORS: [(&str, RGBColor); 10] = [
+    ("BLACK", BLACK),
+    ("ORANGE", ORANGE),
+    ("SKY_BLUE", SKY_BLUE),
+    ("BLUISH_GREEN", BLUISH_GREEN),
+    ("YELLOW", YELLOW),
+    ("BLUE", BLUE),
+    ("VERMILLION", VERMILLION),
+    ("REDDISH_PURPLE", REDDISH_PURPLE),
+    ("GREY", GREY),
+    ("REFERENCE", REFERENCE),
+];
 
 /// Why a figure could not be drawn.
 #[derive(Debug, thiserror::Error)]
@@ -88,8 +124,15 @@ impl<E: std::error::Error + Send + Sync> From<DrawingAreaErrorKind<E>> for PlotE
     }
 }
 
-/// Units of the error-state components δp, δv, b, in state order.
-pub(crate) const STATE_UNITS: [&str; 3] = ["m", "m/s", "m/s²"];
+/// Unit of state component `k` (δp, δv, b).
+pub(crate) fn state_unit(k: usize) -> &'static str {
+    Component::STATE[k].unit()
+}
+
+/// Name of state component `k` (δp, δv, b).
+pub(crate) fn state_name(k: usize) -> &'static str {
+    state_words(Component::STATE[k])
+}
 
 /// `s` with its first letter in upper case, for panel titles.
 pub(crate) fn capitalized(s: &str) -> String {
@@ -98,6 +141,21 @@ pub(crate) fn capitalized(s: &str) -> String {
         Some(f) => f.to_uppercase().chain(c).collect(),
         None => String::new(),
     }
+}
+
+/// Average advance of a character as a fraction of the font size; generous for the common
+/// sans-serif faces (DejaVu Sans digits are 0.64 em, Arial's 0.56 em).
+const CHAR_EM: f64 = 0.6;
+/// A text style whose glyphs are `px` pixels high in the SVG. plotters' SVG backend writes
+/// `font-size = size / 1.24`, so it is handed `px · 1.24`.
+pub(crate) fn font(px: f64) -> TextStyle<'static> {
+    FontDesc::from((FONT_FAMILY, px * 1.24)).color(&BLACK)
+}
+
+/// Estimated width of `text` at `px` pixels, its sub- and superscript markup (`p_{c}`, see
+/// [`markup`]) drawn as scripts.
+pub(crate) fn text_width(text: &str, px: f64) -> f64 {
+    markup::drawn_chars(text) * CHAR_EM * px
 }
 
 /// A figure's SVG document, or why it could not be drawn.

@@ -2,12 +2,14 @@
 
 use plotters::style::Color;
 
-use super::panel::{
-    Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, legend_height, max_abs, render, rows,
-    time_span, y_label_area,
+use super::axis::{Axis, y_label_area};
+use super::geometry::{max_abs, time_span};
+use super::legend::{Entry, Swatch, draw_legend, legend_height};
+use super::panel::{Layout, Panel, columns, render, rows};
+use super::{
+    BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotResult, REFERENCE, WIDTH_PX, capitalized, state_name,
 };
-use super::{BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotResult, WIDTH_PX, capitalized};
-use crate::checks::{Check, STATE_NAMES};
+use crate::checks::Check;
 use crate::ensemble::{EnsembleStats, StageStats};
 
 /// Height of one error component's row, px.
@@ -30,7 +32,7 @@ pub fn orthogonality(stats: &EnsembleStats, check: &Check) -> PlotResult {
             .iter()
             .flat_map(|f| [&f.prior, &f.post])
             .flat_map(|s| (0..9).map(move |i| z(s, i / 3, i % 3)))
-            .chain([check.bound]),
+            .chain([check.upper]),
     );
     let y = Axis::linear("√N · correlation", "", (-1.15 * m, 1.15 * m), 7);
     let y_area_px = y_label_area(&[&y]);
@@ -39,13 +41,13 @@ pub fn orthogonality(stats: &EnsembleStats, check: &Check) -> PlotResult {
         .map(|k| {
             Entry::new(
                 Swatch::Line(COLORS[k].stroke_width(2)),
-                format!("{} estimate", STATE_NAMES[k]),
+                format!("{} estimate", state_name(k)),
             )
         })
         .collect();
     legend.push(Entry::new(
         Swatch::Line(BLACK.stroke_width(1)),
-        format!("±{:.2} bound", check.bound),
+        format!("±{:.2} bound", check.upper),
     ));
     let legend_px = legend_height(&legend);
     let last_row_px = ROW_PX + 24;
@@ -60,7 +62,7 @@ pub fn orthogonality(stats: &EnsembleStats, check: &Check) -> PlotResult {
                     &cols[c],
                     &format!(
                         "{} error vs the estimates, {}",
-                        capitalized(STATE_NAMES[j]),
+                        capitalized(state_name(j)),
                         if prior { "a priori" } else { "a posteriori" }
                     ),
                     time.clone(),
@@ -71,9 +73,9 @@ pub fn orthogonality(stats: &EnsembleStats, check: &Check) -> PlotResult {
                         title: true,
                     },
                 )?;
-                p.hline(0.0, BLACK.mix(0.5).stroke_width(1))?;
-                p.hline(check.bound, BLACK.stroke_width(1))?;
-                p.hline(-check.bound, BLACK.stroke_width(1))?;
+                p.hline(0.0, REFERENCE.stroke_width(1))?;
+                p.hline(check.upper, BLACK.stroke_width(1))?;
+                p.hline(-check.upper, BLACK.stroke_width(1))?;
                 for (k, color) in COLORS.iter().enumerate() {
                     p.line(
                         fixes.iter().map(|f| {

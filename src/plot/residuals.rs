@@ -1,15 +1,15 @@
 //! Whiteness of the residuals: the normalized correlation of r(t_i) and r(t_m), t_m < t_i.
 
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{Color, RGBColor};
 
-use super::panel::{
-    Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, font, format_number, legend_height,
-    render, rows, y_label_area,
-};
-use super::{BLACK, BLUE, GRID, PlotResult, TICK_LABEL_PX, VERMILLION};
+use super::axis::{Axis, y_label_area};
+use super::legend::{Entry, Swatch, draw_legend, legend_height};
+use super::panel::{Layout, Panel, columns, render, rows};
+use super::{BLACK, BLUE, GRID, PlotResult, REFERENCE, TICK_LABEL_PX, VERMILLION};
+use super::{font, text_width};
 use crate::checks::{Check, ResidualPair, residual_z};
 use crate::ensemble::EnsembleStats;
+use crate::format::fixed;
 
 /// Cells per side of the map at most: fixes are grouped so the map holds ≤ 50 × 50 cells.
 const MAX_CELLS: usize = 50;
@@ -27,7 +27,7 @@ const HIGH: RGBColor = RGBColor(0x00, 0x45, 0x7A);
 
 /// Left: every pair of fixes t_m < t_i, coloured by the largest |z| of its four component pairs,
 /// z = √N·corr(r_a(t_i), r_b(t_m)); the fixes are grouped into at most 50 × 50 cells, each showing
-/// its largest |z|, with |z| beyond `check.bound` in vermillion. Right: the four z of the
+/// its largest |z|, with |z| beyond `check.upper` in vermillion. Right: the four z of the
 /// statement's pair against `pair.bound`.
 pub fn residual_whiteness(stats: &EnsembleStats, check: &Check, pair: &ResidualPair) -> PlotResult {
     let times: Vec<f64> = stats.fixes.iter().map(|f| f.time_s).collect();
@@ -70,24 +70,29 @@ pub fn residual_whiteness(stats: &EnsembleStats, check: &Check, pair: &ResidualP
     let level = |z: f64| -> Option<usize> {
         if !z.is_finite() {
             None
-        } else if z >= check.bound {
+        } else if z >= check.upper {
             Some(LEVELS)
         } else {
-            Some(((z / check.bound * LEVELS as f64).floor() as usize).min(LEVELS - 1))
+            Some(((z / check.upper * LEVELS as f64).floor() as usize).min(LEVELS - 1))
         }
     };
 
-    let map_x = Axis::linear("t_m", "s", (first, last), 7);
-    let map_y = Axis::linear("t_i", "s", (first, last), 7);
-    let scale_top = 1.25 * check.bound;
-    let scale_x = Axis::linear("largest |z| in the cell", "", (0.0, scale_top), 8);
+    let map_x = Axis::linear("t_{m}", "s", (first, last), 7);
+    let map_y = Axis::linear("t_{i}", "s", (first, last), 7);
+    let scale_top = 1.25 * check.upper;
+    let scale_x = Axis::linear(
+        &format!("largest |z| in the cell (bound {})", fixed(check.upper, 2)),
+        "",
+        (0.0, scale_top),
+        8,
+    );
     let scale_y = Axis::bare((-0.5, 0.5));
     let map_area = y_label_area(&[&map_y]);
 
-    let names = ["r_p", "r_v"];
+    let names = ["r_{p}", "r_{v}"];
     // In pair.z's order: (position, position), (position, velocity), (velocity, position), ….
     let categories: Vec<String> = (0..4)
-        .map(|c| format!("{}(t_i)·{}(t_m)", names[c / 2], names[c % 2]))
+        .map(|c| format!("{}(t_{{i}})·{}(t_{{m}})", names[c / 2], names[c % 2]))
         .collect();
     let zs = pair.z.iter().flatten().copied().collect::<Vec<_>>();
     let reach = zs
@@ -95,14 +100,33 @@ pub fn residual_whiteness(stats: &EnsembleStats, check: &Check, pair: &ResidualP
         .filter(|z| z.is_finite())
         .fold(pair.bound, |m, z| m.max(z.abs()));
     let pair_x = Axis::linear("z = √N · correlation", "", (-1.2 * reach, 1.2 * reach), 5);
-    let pair_y = Axis::bare((-0.5, 3.6));
-    let pair_area = y_label_area(&[&pair_y]);
+    let pair_y = Axis::bare((-0.5, 3.5));
+    // Each component pair is named, with its z, left of the plot, clear of its lines and dots.
+    let pair_labels: Vec<[String; 2]> = zs
+        .iter()
+        .zip(&categories)
+        .map(|(&z, name)| {
+            let value = if z.is_finite() {
+                format!("z = {}", fixed(z, 2))
+            } else {
+                "undefined".to_string()
+            };
+            [name.clone(), value]
+        })
+        .collect();
+    let pair_area = pair_labels
+        .iter()
+        .flatten()
+        .map(|l| text_width(l, TICK_LABEL_PX))
+        .fold(0.0, f64::max)
+        .ceil() as u32
+        + 14;
 
     let pairs = n * n.saturating_sub(1) / 2;
     let map_title = if per_cell == 1 {
-        format!("All {pairs} pairs t_m < t_i")
+        format!("All {pairs} pairs t_{{m}} < t_{{i}}")
     } else {
-        format!("All {pairs} pairs t_m < t_i, in cells of {per_cell} × {per_cell} fixes")
+        format!("All {pairs} pairs t_{{m}} < t_{{i}}, in cells of {per_cell} × {per_cell} fixes")
     };
 
     let legend = [
@@ -133,34 +157,33 @@ pub fn residual_whiteness(stats: &EnsembleStats, check: &Check, pair: &ResidualP
                 title: true,
             },
         )?;
-        for ci in 0..cells {
+        // Levels of every cell, by row (block of t_i) and column (block of t_m ≤ t_i).
+        let grid: Vec<Vec<Option<usize>>> = (0..cells)
+            .map(|ci| (0..=ci).map(|cm| level(cell_max(ci, cm))).collect())
+            .collect();
+        for (ci, row) in grid.iter().enumerate() {
             let (y0, y1) = edges(ci);
-            // Runs of equal colour along the row are drawn as one rectangle.
-            let mut run: Option<(usize, usize, usize)> = None;
-            for cm in 0..=ci {
-                let l = level(cell_max(ci, cm));
-                match (run, l) {
-                    (Some((start, end, lv)), Some(l)) if lv == l && end + 1 == cm => {
-                        run = Some((start, cm, lv));
-                    }
-                    _ => {
-                        if let Some((start, end, lv)) = run.take() {
-                            map.rect(
-                                (edges(start).0, y0),
-                                (edges(end).1, y1),
-                                level_color(lv).filled(),
-                            )?;
-                        }
-                        run = l.map(|l| (cm, cm, l));
-                    }
+            // Runs of equal colour along the row are drawn as one rectangle, grown by a pixel
+            // under the cells drawn after it (right, and the row above) so no seam shows.
+            let mut start = 0;
+            while start < row.len() {
+                let mut end = start;
+                while end + 1 < row.len() && row[end + 1] == row[start] {
+                    end += 1;
                 }
-            }
-            if let Some((start, end, lv)) = run {
-                map.rect(
-                    (edges(start).0, y0),
-                    (edges(end).1, y1),
-                    level_color(lv).filled(),
-                )?;
+                if let Some(lv) = row[start] {
+                    let right = row.get(end + 1).is_some_and(Option::is_some);
+                    let up = grid
+                        .get(ci + 1)
+                        .is_some_and(|above| above[start..=end].iter().all(Option::is_some));
+                    map.cell(
+                        (edges(start).0, y0),
+                        (edges(end).1, y1),
+                        (i32::from(right), i32::from(up)),
+                        level_color(lv).filled(),
+                    )?;
+                }
+                start = end + 1;
             }
         }
         map.dots([(pair.t_m_s, pair.t_i_s)], 7, BLACK.stroke_width(2))?;
@@ -177,27 +200,23 @@ pub fn residual_whiteness(stats: &EnsembleStats, check: &Check, pair: &ResidualP
             },
         )?;
         for l in 0..=LEVELS {
-            let lo = check.bound * l as f64 / LEVELS as f64;
+            let lo = check.upper * l as f64 / LEVELS as f64;
             let hi = if l == LEVELS {
                 scale_top
             } else {
-                check.bound * (l + 1) as f64 / LEVELS as f64
+                check.upper * (l + 1) as f64 / LEVELS as f64
             };
-            scale.rect((lo, -0.5), (hi, 0.5), level_color(l).filled())?;
+            let grow = i32::from(l < LEVELS);
+            scale.cell((lo, -0.5), (hi, 0.5), (grow, 0), level_color(l).filled())?;
         }
-        scale.text(
-            (check.bound, 0.0),
-            &format!(" ≥ {}", format_number(check.bound, 2)),
-            &font(TICK_LABEL_PX).color(&plotters::style::WHITE),
-            Pos::new(HPos::Left, VPos::Center),
-        )?;
+        scale.vline(check.upper, BLACK.stroke_width(2))?;
 
         let p = Panel::new(
             &cols[1],
             &format!(
-                "Pair t_m = {} s, t_i = {} s",
-                format_number(pair.t_m_s, 1),
-                format_number(pair.t_i_s, 1)
+                "Pair t_{{m}} = {} s, t_{{i}} = {} s",
+                fixed(pair.t_m_s, 1),
+                fixed(pair.t_i_s, 1)
             ),
             pair_x,
             pair_y,
@@ -207,25 +226,14 @@ pub fn residual_whiteness(stats: &EnsembleStats, check: &Check, pair: &ResidualP
                 title: true,
             },
         )?;
-        p.vline(0.0, BLACK.mix(0.5).stroke_width(1))?;
+        p.vline(0.0, REFERENCE.stroke_width(1))?;
         p.vline(pair.bound, BLACK.stroke_width(1))?;
         p.vline(-pair.bound, BLACK.stroke_width(1))?;
-        // One row per component pair, top to bottom, named above its line.
-        let left = -1.2 * reach * 0.97;
-        for (idx, (&z, name)) in zs.iter().zip(&categories).enumerate() {
+        // One row per component pair, top to bottom.
+        for (idx, (&z, lines)) in zs.iter().zip(&pair_labels).enumerate() {
             let y = (3 - idx) as f64;
             p.hline(y, GRID.stroke_width(1))?;
-            let value = if z.is_finite() {
-                format!("{name}: z = {}", format_number(z, 2))
-            } else {
-                format!("{name}: undefined")
-            };
-            p.text(
-                (left, y + 0.14),
-                &value,
-                &font(TICK_LABEL_PX),
-                Pos::new(HPos::Left, VPos::Bottom),
-            )?;
+            p.label_left(y, lines, &font(TICK_LABEL_PX))?;
             let color = if z.abs() > pair.bound {
                 VERMILLION
             } else {

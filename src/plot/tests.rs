@@ -4,10 +4,13 @@
 use std::sync::OnceLock;
 
 use super::*;
-use crate::checks::Check;
-use crate::config::{Config, TruthModel};
+use crate::checks::{Check, CheckId};
+use crate::config::{Case, Config};
+use crate::ensemble::EnsembleStats;
 use crate::model::Model;
 use crate::study::Study;
+
+mod presentation;
 
 fn small_study() -> &'static Study {
     static STUDY: OnceLock<Study> = OnceLock::new();
@@ -16,75 +19,95 @@ fn small_study() -> &'static Study {
         c.profile.duration_s = 4.0;
         c.ensemble.realizations = 200;
         c.checks.residual_pair_s = Some([1.0, 3.0]);
-        Study::run(&Model::new(&c).unwrap(), true).unwrap()
+        Study::run(&Model::new(&c).unwrap(), &mut crate::study::Silent).unwrap()
     })
 }
 
-fn check<'a>(study: &'a Study, id: &str) -> &'a Check {
-    study.primary().verdicts.get(id).unwrap()
+/// The point-sample case of the closed-form truth: the one with a mean error to draw.
+const CASE: Case = Case::REPORT[1];
+
+fn check(study: &Study, id: CheckId) -> &Check {
+    study.case(CASE).verdicts.get(id)
+}
+
+/// The cases of `study` as the cross-case figures take them.
+fn series(study: &Study) -> Vec<CaseSeries<'_>> {
+    study
+        .cases
+        .iter()
+        .map(|o| CaseSeries {
+            label: o.case.to_string().replace('_', " "),
+            stats: &o.run.stats,
+            achieved_rms: &o.achieved_rms,
+        })
+        .collect()
 }
 
 /// Every figure of `study`, by name.
 fn figures(study: &Study) -> Vec<(&'static str, String)> {
-    figures_of(study, study.model.truth)
+    figures_of(study, CASE)
 }
 
-/// Every figure of `study`, the ensemble figures drawn for truth model `truth`.
-fn figures_of(study: &Study, truth: TruthModel) -> Vec<(&'static str, String)> {
-    let p = study.ensemble(truth);
+/// Every figure of `study`, the ensemble figures drawn for `case`.
+fn figures_of(study: &Study, case: Case) -> Vec<(&'static str, String)> {
+    let p = study.case(case);
     let s = &p.run.stats;
     let v = &p.verdicts;
-    let check = |_: &Study, id: &str| v.get(id).unwrap();
-    vec![
+    let mut out = vec![
         (
             "realization_errors",
             realization_errors(&study.realization).unwrap(),
         ),
         ("trajectory", trajectory(&study.realization).unwrap()),
-        (
-            "mean_error",
-            mean_error(s, check(study, "mean_error")).unwrap(),
-        ),
-        (
-            "covariance",
-            covariance(s, check(study, "covariance_match")).unwrap(),
-        ),
-        (
-            "orthogonality",
-            orthogonality(s, check(study, "orthogonality")).unwrap(),
-        ),
-        (
-            "residual_whiteness",
-            residual_whiteness(s, check(study, "residual_whiteness"), &v.residual_pair).unwrap(),
-        ),
-        (
-            "consistency",
-            consistency(s, check(study, "nees"), check(study, "nis")).unwrap(),
-        ),
-        (
-            "truth_models",
-            truth_models(
-                &study.ensemble(TruthModel::Analytic).run.stats,
-                &study.ensemble(TruthModel::Euler).run.stats,
-            )
-            .unwrap(),
-        ),
-    ]
+    ];
+    // Every check is drawn by one figure; a new check does not compile until it has one.
+    for id in CheckId::ALL {
+        let figure = match id {
+            CheckId::MeanError => ("mean_error", mean_error(s, v.get(id), &p.prediction.fixes)),
+            CheckId::CovarianceMatch => ("covariance", covariance(s, v.get(id))),
+            CheckId::CovarianceCorrelation => continue, // drawn by the covariance figure
+            CheckId::Orthogonality => ("orthogonality", orthogonality(s, v.get(id))),
+            CheckId::ResidualWhiteness => (
+                "residual_whiteness",
+                residual_whiteness(s, v.get(id), &v.residual_pair),
+            ),
+            CheckId::Nees => (
+                "consistency",
+                consistency(s, v.get(id), v.get(CheckId::Nis)),
+            ),
+            CheckId::Nis => continue, // drawn with NEES
+        };
+        out.push((figure.0, figure.1.unwrap()));
+    }
+    let cases = series(study);
+    out.push(("accuracy_ratio", accuracy_ratio(&cases).unwrap()));
+    out.push((
+        "mean_error_in_sigma",
+        mean_error_in_sigma(&cases, 4.5).unwrap(),
+    ));
+    out
 }
 
-/// The text of every `<text>` element of `svg`, which must parse as XML.
+/// The text of every `<text>` element of `svg` (its `<tspan>`s included), which must parse as
+/// XML.
 fn texts(svg: &str) -> Vec<String> {
     let doc = roxmltree::Document::parse(svg).expect("the SVG is well-formed XML");
     assert_eq!(doc.root_element().tag_name().name(), "svg");
     doc.descendants()
         .filter(|n| n.has_tag_name("text"))
-        .map(|n| n.text().unwrap_or("").trim().to_string())
+        .map(|n| {
+            n.descendants()
+                .filter_map(|d| d.text().filter(|_| d.is_text()))
+                .collect::<String>()
+                .trim()
+                .to_string()
+        })
         .collect()
 }
 
 #[test]
 fn every_figure_is_well_formed_and_labelled() {
-    let expected: [(&str, &[&str]); 8] = [
+    let expected: [(&str, &[&str]); 9] = [
         (
             "realization_errors",
             &[
@@ -98,12 +121,13 @@ fn every_figure_is_well_formed_and_labelled() {
             "trajectory",
             &["time (s)", "acceleration (m/s²)", "position (m)"],
         ),
-        ("mean_error", &["time (s)", "e_ave ("]),
-        ("covariance", &["time (s)", "variance (m²)", "P_ave / P"]),
+        ("mean_error", &["time (s)", "eave ("]),
+        ("covariance", &["time (s)", "variance (m²)", "Pave / P"]),
         ("orthogonality", &["time (s)", "√N · correlation"]),
-        ("residual_whiteness", &["t_m (s)", "t_i (s)"]),
+        ("residual_whiteness", &["tm (s)", "ti (s)"]),
         ("consistency", &["time (s)", "average NEES", "average NIS"]),
-        ("truth_models", &["time (s)", "e_ave / σ"]),
+        ("accuracy_ratio", &["time (s)", "RMS error / σ"]),
+        ("mean_error_in_sigma", &["time (s)", "|mean error| / σ"]),
     ];
     let figs = figures(small_study());
     for ((name, svg), (expected_name, labels)) in figs.iter().zip(expected) {
@@ -131,18 +155,21 @@ fn figures_are_deterministic() {
 #[test]
 fn non_finite_statistics_are_skipped() {
     let study = small_study();
-    let mut stats = study.primary().run.stats.clone();
+    let mut stats = study.case(CASE).run.stats.clone();
     stats.fixes[1].post.mean_error[0] = f64::NAN;
     stats.fixes[2].post.ensemble_cov[1][1] = f64::INFINITY;
     stats.fixes[3].prior.orthogonality_corr[2][0] = f64::NAN;
     stats.fixes[4].nis_avg = f64::NAN;
-    let c = check(study, "mean_error");
+    let c = check(study, CheckId::MeanError);
+    let prediction = vec![[[f64::NAN; 3]; 2]; stats.fixes.len()];
+    let rms = vec![[f64::NAN; 3]; stats.fixes.len()];
     for svg in [
-        mean_error(&stats, c).unwrap(),
+        mean_error(&stats, c, &prediction).unwrap(),
         covariance(&stats, c).unwrap(),
         orthogonality(&stats, c).unwrap(),
         consistency(&stats, c, c).unwrap(),
-        truth_models(&stats, &stats).unwrap(),
+        accuracy_ratio(&undefined(&stats, &rms)).unwrap(),
+        mean_error_in_sigma(&undefined(&stats, &rms), 4.5).unwrap(),
     ] {
         texts(&svg);
         assert!(!svg.contains("NaN") && !svg.contains("inf"));
@@ -152,7 +179,7 @@ fn non_finite_statistics_are_skipped() {
 #[test]
 fn figures_survive_statistics_that_are_all_undefined() {
     let study = small_study();
-    let mut stats = study.primary().run.stats.clone();
+    let mut stats = study.case(CASE).run.stats.clone();
     for f in &mut stats.fixes {
         for s in [&mut f.prior, &mut f.post] {
             s.mean_error = [f64::NAN; 3];
@@ -163,28 +190,43 @@ fn figures_survive_statistics_that_are_all_undefined() {
         }
         f.nis_avg = f64::NAN;
     }
-    stats.residual_corr.iter_mut().for_each(|x| *x = f64::NAN);
+    stats
+        .residual_moments
+        .iter_mut()
+        .for_each(|x| *x = f64::NAN);
     let mut r = study.realization.clone();
     for s in &mut r.samples {
         s.sigma = [f64::NAN; 3];
         s.estimate = [f64::INFINITY; 3];
     }
-    let c = check(study, "mean_error");
-    let mut pair = study.primary().verdicts.residual_pair.clone();
+    let c = check(study, CheckId::MeanError);
+    let mut pair = study.case(CASE).verdicts.residual_pair.clone();
     pair.z = [[f64::NAN; 2]; 2];
+    let prediction = vec![[[f64::INFINITY; 3]; 2]; stats.fixes.len()];
+    let rms = vec![[f64::NAN; 3]; stats.fixes.len()];
     for svg in [
         realization_errors(&r).unwrap(),
         trajectory(&r).unwrap(),
-        mean_error(&stats, c).unwrap(),
+        mean_error(&stats, c, &prediction).unwrap(),
         covariance(&stats, c).unwrap(),
         orthogonality(&stats, c).unwrap(),
         residual_whiteness(&stats, c, &pair).unwrap(),
         consistency(&stats, c, c).unwrap(),
-        truth_models(&stats, &stats).unwrap(),
+        accuracy_ratio(&undefined(&stats, &rms)).unwrap(),
+        mean_error_in_sigma(&undefined(&stats, &rms), 4.5).unwrap(),
     ] {
         texts(&svg);
         assert!(!svg.contains("NaN") && !svg.contains("inf"));
     }
+}
+
+/// One case series of `stats` with achieved RMS errors `rms`.
+fn undefined<'a>(stats: &'a EnsembleStats, rms: &'a [[f64; 3]]) -> Vec<CaseSeries<'a>> {
+    vec![CaseSeries {
+        label: "undefined".to_string(),
+        stats,
+        achieved_rms: rms,
+    }]
 }
 
 /// Writes every figure of the default configuration to /tmp/figs for a look:
@@ -192,16 +234,21 @@ fn figures_survive_statistics_that_are_all_undefined() {
 #[test]
 #[ignore = "runs the full default study (seconds in release, minutes in debug)"]
 fn render_default_figures() {
-    let study = Study::run(&Model::new(&Config::default()).unwrap(), true).unwrap();
-    let dir = std::path::Path::new("/tmp/figs");
+    let study = Study::run(
+        &Model::new(&Config::default()).unwrap(),
+        &mut crate::study::Silent,
+    )
+    .unwrap();
+    let dir = std::path::Path::new("/tmp/figs-wt");
     std::fs::create_dir_all(dir).unwrap();
     let small = small_study();
-    for (suffix, study, truth) in [
-        ("", &study, TruthModel::Analytic),
-        ("_euler", &study, TruthModel::Euler),
-        ("_small", small, TruthModel::Analytic),
+    for (suffix, study, case) in [
+        ("", &study, Case::REPORT[1]),
+        ("_euler", &study, Case::REPORT[0]),
+        ("_interval", &study, Case::REPORT[2]),
+        ("_small", small, Case::REPORT[1]),
     ] {
-        for (name, svg) in figures_of(study, truth) {
+        for (name, svg) in figures_of(study, case) {
             texts(&svg);
             std::fs::write(dir.join(format!("{name}{suffix}.svg")), &svg).unwrap();
             println!("{name}{suffix}: {:.0} KB", svg.len() as f64 / 1024.0);

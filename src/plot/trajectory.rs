@@ -3,11 +3,11 @@
 
 use plotters::style::Color;
 
-use super::panel::{
-    Axis, Entry, Layout, Panel, Swatch, columns, draw_legend, extent, legend_height, padded,
-    render, rows, settled_from, time_span, y_label_area,
-};
-use super::{BLUE, ORANGE, PlotResult, VERMILLION, WIDTH_PX};
+use super::axis::{Axis, y_label_area};
+use super::geometry::{before, clipped_until, extent, padded, settled_from, time_span};
+use super::legend::{Entry, Swatch, draw_legend, legend_height};
+use super::panel::{Layout, Panel, columns, render, rows};
+use super::{BLUE, BLUISH_GREEN, PlotResult, VERMILLION, WIDTH_PX};
 use crate::realization::{Realization, SampleRecord};
 
 /// Height of one row, px.
@@ -18,7 +18,8 @@ const ROW_PX: u32 = 250;
 /// drifts δv = v − v_c, δp = p − p_c — each with the filter's estimate.
 ///
 /// The estimates start at zero, far from a truth drawn from the prior, so the right-hand axes are
-/// fitted to the truth over the run and to the estimates after the first second.
+/// fitted to the truth over the run and to the estimates after the first second; a panel whose
+/// estimate runs off its axis says until when in its title ("clipped before 1.6 s").
 pub fn trajectory(r: &Realization) -> PlotResult {
     let s = &r.samples;
     let (t0, t1) = time_span(s.iter().map(|x| x.t_s));
@@ -64,13 +65,39 @@ pub fn trajectory(r: &Realization) -> PlotResult {
         drift_axis(1, "velocity drift", "m/s"),
         drift_axis(0, "position drift", "m"),
     ];
+    // Right-hand titles, with what the axis clips of the estimate (the truth is always in).
+    let drift_index = [2, 1, 0];
+    let titles_right: Vec<String> = [
+        (
+            "Accelerometer bias b and its estimate",
+            "Bias b and its estimate",
+        ),
+        (
+            "Velocity drift δv = v − v_{c} and estimate",
+            "Velocity drift δv = v − v_{c}",
+        ),
+        (
+            "Position drift δp = p − p_{c} and estimate",
+            "Position drift δp = p − p_{c}",
+        ),
+    ]
+    .iter()
+    .zip(&right)
+    .zip(drift_index)
+    .map(|(((full, short), axis), k)| {
+        match clipped_until(s.iter().map(|x| (x.t_s, x.estimate[k])), |v| axis.shows(v)) {
+            Some(t) => format!("{short} (off the axis {})", before(t)),
+            None => full.to_string(),
+        }
+    })
+    .collect();
     let left_area = y_label_area(&left.iter().collect::<Vec<_>>());
     let right_area = y_label_area(&right.iter().collect::<Vec<_>>());
 
     let legend = [
         Entry::new(Swatch::Line(BLUE.stroke_width(2)), "truth"),
         Entry::new(
-            Swatch::Line(ORANGE.stroke_width(2)),
+            Swatch::Line(BLUISH_GREEN.stroke_width(2)),
             "integrated accelerometer",
         ),
         Entry::new(Swatch::Line(VERMILLION.stroke_width(2)), "filter estimate"),
@@ -83,19 +110,13 @@ pub fn trajectory(r: &Realization) -> PlotResult {
         draw_legend(&parts[0], &legend)?;
         let titles_left = [
             "True acceleration a(t)",
-            "Velocity: truth v and integrated v_c",
-            "Position: truth p and integrated p_c",
-        ];
-        let titles_right = [
-            "Accelerometer bias b and its estimate",
-            "Velocity drift δv = v − v_c and estimate",
-            "Position drift δp = p − p_c and estimate",
+            "Velocity: truth v and integrated v_{c}",
+            "Position: truth p and integrated p_{c}",
         ];
         type Series = fn(&SampleRecord) -> f64;
         let truth: [Series; 3] = [|x| x.accel_m_s2, |x| x.truth_v_m_s, |x| x.truth_p_m];
         let computed: [Option<Series>; 3] =
             [None, Some(|x| x.computed_v_m_s), Some(|x| x.computed_p_m)];
-        let drift_index = [2, 1, 0];
         for row in 0..3 {
             let cols = columns(&parts[row + 1], &[WIDTH_PX / 2]);
             let layout = |y_area_px| Layout {
@@ -111,7 +132,10 @@ pub fn trajectory(r: &Realization) -> PlotResult {
                 layout(left_area),
             )?;
             if let Some(c) = computed[row] {
-                p.line(s.iter().map(|x| (x.t_s, c(x))), ORANGE.stroke_width(2))?;
+                p.line(
+                    s.iter().map(|x| (x.t_s, c(x))),
+                    BLUISH_GREEN.stroke_width(2),
+                )?;
             }
             p.line(
                 s.iter().map(|x| (x.t_s, truth[row](x))),
@@ -121,7 +145,7 @@ pub fn trajectory(r: &Realization) -> PlotResult {
             let k = drift_index[row];
             let q = Panel::new(
                 &cols[1],
-                titles_right[row],
+                &titles_right[row],
                 time.clone(),
                 right[row].clone(),
                 layout(right_area),

@@ -14,12 +14,13 @@ impl Default for Math {
 }
 
 impl Math {
+    /// A converter with the report's macros: `\dx`, `\dxhat`, `\dxbar` (the a priori estimate δx̂⁻) and `\T` (transpose).
     pub fn new() -> Self {
         let config = MathCoreConfig {
             macros: vec![
                 ("dx".into(), r"\delta\mathbf{x}".into()),
                 ("dxhat".into(), r"\widehat{\delta\mathbf{x}}".into()),
-                ("dxbar".into(), r"\overline{\delta\mathbf{x}}".into()),
+                ("dxbar".into(), r"\widehat{\delta\mathbf{x}}^{-}".into()),
                 ("T".into(), r"^{\mathsf{T}}".into()),
             ],
             ..Default::default()

@@ -1,35 +1,69 @@
-//! The HTML report: runs the study, draws the figures, fills the templates, and writes
-//! `index.html` and `data.json` into the output directory, atomically.
+//! The HTML report of a [`Study`]: draws the figures, builds the view, fills the templates. Pure:
+//! it returns the page and its view as text, and the caller writes them.
 //!
-//! Layers: [`view`] turns results into text; [`equations`] holds every formula as MathML;
-//! the templates under `templates/` only place that text.
+//! Layers: [`view`] holds the view types, [`prose`] and [`params`] the words and the parameter
+//! table, [`figures`] the figures and the numbering, [`equations`] every formula as MathML; the
+//! templates under `templates/` only place that text.
 
+pub mod calibration;
+pub mod cases;
 pub mod equations;
-pub mod format;
+pub mod figures;
 pub mod math;
+pub mod params;
+pub mod prose;
+pub mod rich;
+pub mod sensitivity;
 pub mod view;
 
-use anyhow::{Context, Result};
 use askama::Template;
 use base64::Engine;
 
-use crate::app::{load_model, verdict_lines};
-use crate::cli::ReportArgs;
-use crate::export;
-use crate::output::write_all_atomic;
-use crate::plot;
-use crate::study::{EnsembleOutcome, Study};
+use crate::checks::CheckId;
+use crate::format::{count, fixed, percent, short, sig};
+use crate::study::Study;
 use equations::Equations;
+use figures::Numbering;
 use math::Math;
-use view::{FigureView, Figures, ReportView};
+use view::{CatalogueEntry, EquationNumbers, Figures, ReportView, TableNumbers};
+
+/// The report could not be rendered.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// A figure could not be drawn.
+    #[error("cannot draw figure {figure}: {source}")]
+    Figure {
+        /// The figure's id.
+        figure: String,
+        /// What plotters said.
+        source: crate::plot::PlotError,
+    },
+    /// The templates could not be filled.
+    #[error("cannot fill the report templates: {0}")]
+    Template(#[from] askama::Error),
+}
 
 /// The report page.
 #[derive(Template)]
 #[template(path = "report.html")]
 pub struct ReportPage<'a> {
+    /// The view.
     pub v: &'a ReportView,
+    /// The equations.
     pub eq: &'a Equations,
+    /// The stylesheet.
     pub style: &'a str,
+}
+
+/// A rendered report: the page, and its view as JSON.
+#[derive(Clone, Debug)]
+pub struct Page {
+    /// index.html.
+    pub html: String,
+    /// view.json: what the page shows, as text.
+    pub view_json: String,
+    /// The view itself.
+    pub view: ReportView,
 }
 
 /// The stylesheet, with the math font embedded as a data URL.
@@ -37,195 +71,203 @@ pub fn stylesheet() -> String {
     let font = base64::engine::general_purpose::STANDARD
         .encode(include_bytes!("../../assets/math-font.woff2"));
     format!(
-        "@font-face {{ font-family: \"AccelcalMath\"; src: url(data:font/woff2;base64,{font}) format(\"woff2\"); }}\n{}",
+        "@font-face {{ font-family: \"AccelcalMath\"; src: url(data:font/woff2;base64,{font}) format(\"woff2\"); ascent-override: 75%; descent-override: 25%; line-gap-override: 0%; }}\n{}",
         include_str!("../../assets/report.css")
     )
 }
 
-/// Removes the SVG namespace declaration: inline SVG in HTML needs none, and the report then
-/// holds no address at all.
-fn inline_svg(svg: String) -> String {
-    svg.replacen(" xmlns=\"http://www.w3.org/2000/svg\"", "", 1)
+/// σ_b after 1 s and 5 s where the run is that long, and at the end.
+fn bias_sigma_progress(study: &Study) -> String {
+    let fixes = &study.schedule.fixes;
+    let last = fixes.last().expect("at least two fixes");
+    let end_s = last.time_s;
+    let mut milestones: Vec<String> = [1.0, 5.0]
+        .into_iter()
+        .filter(|&t| t < end_s - 1e-9)
+        .filter_map(|t| fixes.iter().find(|f| f.time_s >= t - 1e-9))
+        .map(|f| {
+            format!(
+                "{} m/s² after {} s",
+                sig(f.p_post[(2, 2)].sqrt(), 2),
+                short(f.time_s)
+            )
+        })
+        .collect();
+    milestones.push(format!(
+        "{} m/s² at the end ({} s)",
+        sig(last.p_post[(2, 2)].sqrt(), 2),
+        short(end_s)
+    ));
+    match milestones.split_last() {
+        Some((end, [])) => end.clone(),
+        Some((end, rest)) => format!("{} and {end}", rest.join(", ")),
+        None => String::new(),
+    }
 }
 
-fn figure(
-    id: &str,
-    number: usize,
-    title: &str,
-    caption: String,
-    svg: plot::PlotResult,
-) -> Result<FigureView> {
-    Ok(FigureView {
-        id: id.to_string(),
-        number,
-        title: title.to_string(),
-        caption,
-        svg: inline_svg(svg.with_context(|| format!("cannot draw figure {id}"))?),
+/// The check catalogue as the theory section shows it.
+fn catalogue(math: &Math) -> Vec<CatalogueEntry> {
+    CheckId::ALL
+        .iter()
+        .map(|&id| {
+            let h = id.hypothesis();
+            CatalogueEntry {
+                id: id.name().to_string(),
+                title: format!("{}{}", id.title()[..1].to_uppercase(), &id.title()[1..]),
+                hypothesis: format!("{}{}.", h[..1].to_uppercase(), &h[1..]),
+                rationale: id.rationale().to_string(),
+                members: id.members().to_string(),
+                formula: math.block(id.formula()),
+            }
+        })
+        .collect()
+}
+
+/// Numbers the display equations in reading order.
+fn equation_numbers() -> EquationNumbers {
+    let mut n = 0;
+    let mut next = || {
+        n += 1;
+        n
+    };
+    EquationNumbers {
+        profile: next(),
+        analytic_truth: next(),
+        accelerometer: next(),
+        interval_mean: next(),
+        integration: next(),
+        gps: next(),
+        euler_truth: next(),
+        dynamics: next(),
+        measurement: next(),
+        lag: next(),
+        prediction: next(),
+    }
+}
+
+/// Builds the view of `study`; `command` reproduces it.
+///
+/// # Errors
+/// [`RenderError`] when a figure cannot be drawn.
+pub fn build(study: &Study, command: &str, math: &Math) -> Result<ReportView, RenderError> {
+    let model = &study.model;
+    let c = &model.config;
+    let tl = &model.timeline;
+    let r = &study.realization;
+    let last = r.fixes.last().expect("at least two fixes");
+    let first = &study.schedule.fixes[0];
+    let eqn = equation_numbers();
+    // Tables and figures are numbered in the order the page shows them.
+    let mut numbers = Numbering::default();
+    let params_table = numbers.table();
+    let (trajectory, realization) = figures::realization_figures(study, &mut numbers)?;
+    let summary_table = numbers.table();
+    let accuracy_table = numbers.table();
+    let (accuracy, mean_error) = figures::comparison_figures(study, &mut numbers)?;
+    let prediction_table = numbers.table();
+    let claimed = prose::claimed_sigma(study);
+    let mut cases = Vec::with_capacity(study.cases.len());
+    for (i, o) in study.cases.iter().enumerate() {
+        let tables = (numbers.table(), numbers.table());
+        let figures = figures::check_figures(o, &mut numbers)?;
+        cases.push(cases::case_view(o, i, tables, figures, claimed));
+    }
+    let tables = TableNumbers {
+        params: params_table,
+        summary: summary_table,
+        accuracy: accuracy_table,
+        prediction: prediction_table,
+        performance: numbers.table(),
+    };
+    let sensitivity = study
+        .sensitivity
+        .as_ref()
+        .map(|s| sensitivity::view(s, &mut numbers))
+        .transpose()?;
+    let differences = params::filter_differences(study);
+    Ok(ReportView {
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        realizations: count(c.ensemble.realizations),
+        fixes: count(tl.fixes() as u64),
+        steps: count(tl.steps as u64),
+        accel_rate: short(c.accelerometer.sample_rate_hz),
+        gps_rate: short(c.gps.sample_rate_hz),
+        steps_per_fix: tl.steps_per_fix.to_string(),
+        first_fix: fixed(tl.fix_time_s(0), 2),
+        false_alarm: percent(c.checks.false_alarm_rate),
+        false_alarm_share: prose::share_words(c.checks.false_alarm_rate),
+        seed: c.ensemble.seed.to_string(),
+        filter_matches_truth: differences.is_empty(),
+        params: params::params(study),
+        choices_html: params::choices(study, &differences)
+            .iter()
+            .map(|c| rich::rich(c))
+            .collect(),
+        catalogue: catalogue(math),
+        summary: cases::summary(&study.cases),
+        realization_case: {
+            let i = study
+                .cases
+                .iter()
+                .position(|o| o.case == study.realization_case)
+                .unwrap_or(0);
+            format!(
+                "case {} ({})",
+                prose::letter(i),
+                prose::case_title(study.realization_case)
+            )
+        },
+        bias_true: sig(r.bias_m_s2, 3),
+        bias_estimate: sig(last.post[2], 3),
+        bias_error_sigmas: fixed((r.bias_m_s2 - last.post[2]) / last.sigma_post[2], 2),
+        bias_prior_sigma: sig(c.filter_bias_var_m2_s4().sqrt(), 2),
+        end_time: short(last.t_s),
+        first_fix_sigma_p: sig(first.p_post[(0, 0)].sqrt(), 2),
+        first_fix_sigma_v: sig(first.p_post[(1, 1)].sqrt(), 2),
+        bias_sigma_progress: bias_sigma_progress(study),
+        euler_velocity_drift: prose::euler_velocity_drift(study),
+        interval_position_error: sig(tl.dt_s * tl.dt_s * c.profile.accel_amplitude_m_s2 / 12.0, 2),
+        threads: rayon::current_num_threads().to_string(),
+        fig: Figures {
+            trajectory,
+            realization,
+            accuracy,
+            mean_error,
+        },
+        abstract_html: rich::rich(&prose::abstract_findings(study, &differences)),
+        conclusions_html: prose::conclusions(study, &differences, eqn.dynamics, tables.accuracy)
+            .iter()
+            .map(|c| rich::rich(c))
+            .collect(),
+        cases,
+        sensitivity,
+        tables,
+        eqn,
+        filter_differences: differences,
+        config_toml: c.to_toml_string(),
+        command: command.to_string(),
     })
 }
 
-/// The five figures of the Monte Carlo checks for one ensemble, numbered from `first`.
-fn check_figures(e: &EnsembleOutcome, first: usize, suffix: &str) -> Result<Vec<FigureView>> {
-    let s = &e.run.stats;
-    let v = &e.verdicts;
-    let get = |id: &str| v.get(id).expect("every check is evaluated");
-    let truth = e.truth.name();
-    let alpha = format::percent(get("mean_error").false_alarm_rate);
-    Ok(vec![
-        figure(
-            &format!("fig-mean-error{suffix}"),
-            first,
-            "Ensemble mean error",
-            format!(
-                "The a priori and a posteriori ensemble mean error eᵃᵛᵉ of each state at every GPS fix ({truth} truth, N = {}), against the band ±{}·σ/√N, where σ is the filter's standard deviation and {} the Bonferroni bound at α = {alpha}.",
-                format::count(s.realizations),
-                format::fixed(get("mean_error").bound, 2),
-                format::fixed(get("mean_error").bound, 2),
-            ),
-            plot::mean_error(s, get("mean_error")),
-        )?,
-        figure(
-            &format!("fig-covariance{suffix}"),
-            first + 1,
-            "Ensemble variance against the filter's covariance",
-            format!(
-                "Top: the ensemble variance Pᵃᵛᵉ (N − 1 normalization) and the filter's P, a priori and a posteriori, on a logarithmic axis ({truth} truth). Bottom: their ratio, with the χ² band [{}, {}] that holds the family-wise false-alarm rate α = {alpha}.",
-                format::sig(get("covariance_match").lower, 4),
-                format::sig(get("covariance_match").upper, 4)
-            ),
-            plot::covariance(s, get("covariance_match")),
-        )?,
-        figure(
-            &format!("fig-orthogonality{suffix}"),
-            first + 2,
-            "Orthogonality of error and estimate",
-            format!(
-                "The normalized correlation √N·corr(e − e_ave, δx̂) of every error component with every estimate component, a priori and a posteriori, at every fix ({truth} truth), against ±{}.",
-                format::fixed(get("orthogonality").bound, 2)
-            ),
-            plot::orthogonality(s, get("orthogonality")),
-        )?,
-        figure(
-            &format!("fig-whiteness{suffix}"),
-            first + 3,
-            "Residual whiteness",
-            format!(
-                "Left: the largest |z| of the four component pairs of the residual correlation over every pair of fixes tₘ < tᵢ ({truth} truth), bound {}. Right: the single pair tₘ = {} s, tᵢ = {} s, against ±{}.",
-                format::fixed(get("residual_whiteness").bound, 2),
-                format::fixed(v.residual_pair.t_m_s, 1),
-                format::fixed(v.residual_pair.t_i_s, 1),
-                format::fixed(v.residual_pair.bound, 2)
-            ),
-            plot::residual_whiteness(s, get("residual_whiteness"), &v.residual_pair),
-        )?,
-        figure(
-            &format!("fig-consistency{suffix}"),
-            first + 4,
-            "Average NEES and NIS",
-            format!(
-                "The ensemble average of the normalized estimation error squared (expected 3) and of the normalized innovation squared (expected 2) at every fix ({truth} truth), with their χ² bounds."
-            ),
-            plot::consistency(s, get("nees"), get("nis")),
-        )?,
-    ])
-}
-
-/// Renders the report of `study` as HTML. Pure: no IO.
-pub fn render(study: &Study, command: &str) -> Result<(String, ReportView)> {
-    let primary = study.primary();
-    let other = study
-        .ensembles
-        .iter()
-        .find(|e| e.truth != study.model.truth)
-        .expect("two truth models");
-    let r = &study.realization;
-    let mut checks = check_figures(primary, 3, "")?.into_iter();
-    let mut next = || checks.next().expect("five figures");
-    let fig = Figures {
-        trajectory: figure(
-            "fig-trajectory",
-            1,
-            "Acceleration profile and true trajectory",
-            format!(
-                "Left: the true acceleration a(t), velocity and position of realization {} (seed {}, {} truth), with the accelerometer's integration from the prior means. Right: the realization's bias, velocity drift δv = v − v_c and position drift δp = p − p_c, with the filter's estimates of each.",
-                r.index,
-                r.seed,
-                study.model.truth
-            ),
-            plot::trajectory(r),
-        )?,
-        realization: figure(
-            "fig-realization",
-            2,
-            "Estimation error of one realization",
-            "The error δx − δx̂ of position, velocity and bias at every accelerometer sample, with the filter's ±1σ. Left: the whole run; right: the filter's σ over a short window, growing between fixes and dropping at each fix (open circles before the update, dots after).".to_string(),
-            plot::realization_errors(r),
-        )?,
-        mean_error: next(),
-        covariance: next(),
-        orthogonality: next(),
-        whiteness: next(),
-        consistency: next(),
-        truths: figure(
-            "fig-truths",
-            8,
-            "Effect of the truth model on the mean error",
-            "The a posteriori ensemble mean error of each state in units of the filter's σ, for the closed-form (analytic) and the Euler-integrated truth. A consistent filter keeps it near zero, within a few σ/√N.".to_string(),
-            plot::truth_models(&study.ensemble(crate::config::TruthModel::Analytic).run.stats, &study.ensemble(crate::config::TruthModel::Euler).run.stats),
-        )?,
-    };
-    let other_figures = check_figures(other, 9, &format!("-{}", other.truth.name()))?;
-    let view = view::build(study, fig, other_figures, command.to_string());
-    let eq = Equations::render(&Math::new());
+/// Renders the report of `study` as HTML, with its view as JSON. `command` reproduces it.
+///
+/// # Errors
+/// [`RenderError`] when a figure cannot be drawn or the templates cannot be filled.
+pub fn render(study: &Study, command: &str) -> Result<Page, RenderError> {
+    let math = Math::new();
+    let view = build(study, command, &math)?;
+    let eq = Equations::render(&math);
     let style = stylesheet();
     let html = ReportPage {
         v: &view,
         eq: &eq,
         style: &style,
     }
-    .render()
-    .context("cannot fill the report templates")?;
-    Ok((html, view))
-}
-
-/// The command line that reproduces a report.
-fn reproduce_command(args: &ReportArgs) -> String {
-    let mut s = String::from("accelcal report");
-    if let Some(c) = &args.model.config {
-        s.push_str(&format!(" --config {}", c.display()));
-    }
-    if let Some(t) = args.model.truth {
-        s.push_str(&format!(" --truth {t}"));
-    }
-    if let Some(seed) = args.model.seed {
-        s.push_str(&format!(" --seed {seed}"));
-    }
-    if let Some(n) = args.realizations {
-        s.push_str(&format!(" --realizations {n}"));
-    }
-    s
-}
-
-/// Runs the report command.
-pub fn run(args: &ReportArgs) -> Result<()> {
-    let model = load_model(&args.model, args.realizations)?;
-    let study = Study::run(&model, args.model.quiet)?;
-    let command = reproduce_command(args);
-    let (html, _) = render(&study, &command)?;
-    let data = export::report_data_json(&study);
-    write_all_atomic(
-        &args.out,
-        &[
-            ("index.html", html.as_bytes()),
-            ("data.json", data.as_bytes()),
-        ],
-    )?;
-    for e in &study.ensembles {
-        print!("{}", verdict_lines(e.truth, &e.run, &e.verdicts));
-    }
-    println!(
-        "report written to {}",
-        args.out.join("index.html").display()
-    );
-    Ok(())
+    .render()?;
+    let view_json = serde_json::to_string_pretty(&view).expect("the view is plain text");
+    Ok(Page {
+        html,
+        view_json,
+        view,
+    })
 }

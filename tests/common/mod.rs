@@ -17,7 +17,12 @@ pub fn model_of(config: &Config) -> (Model, FilterSchedule) {
 /// Runs the ensemble of `config` with `truth` and evaluates its checks.
 pub fn verdicts_of(config: &Config, truth: TruthModel) -> Verdicts {
     let (model, schedule) = model_of(config);
-    accelcal::app::ensemble_with_verdicts(&model.with_truth(truth), &schedule, true).1
+    accelcal::study::run_case(
+        &model.with_truth(truth),
+        &schedule,
+        &mut accelcal::study::Silent,
+    )
+    .verdicts
 }
 
 /// Path of the built binary.

@@ -1,8 +1,11 @@
-//! Number formatting for the report: the view layer's only way to turn numbers into text.
+//! Numbers as people read them: significant digits, the true minus sign, thin-space thousands,
+//! superscript powers of ten. The only way the figures, the report and the command line turn
+//! numbers into text.
 
 const SUPERSCRIPTS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
 
-fn superscript(n: i32) -> String {
+/// `n` in superscript digits: −3 → "⁻³".
+pub fn superscript(n: i32) -> String {
     let mut s = String::new();
     if n < 0 {
         s.push('⁻');
@@ -13,12 +16,28 @@ fn superscript(n: i32) -> String {
     s
 }
 
+/// 10^k with a superscript exponent: "1", "10", "10⁻³".
+///
+/// # Examples
+/// ```
+/// use accelcal::format::power_of_ten;
+/// assert_eq!(power_of_ten(-12), "10⁻¹²");
+/// assert_eq!(power_of_ten(0), "1");
+/// ```
+pub fn power_of_ten(k: i32) -> String {
+    match k {
+        0 => "1".to_string(),
+        1 => "10".to_string(),
+        _ => format!("10{}", superscript(k)),
+    }
+}
+
 /// `x` with `sig` significant digits: plain between 10⁻³ and 10⁶, otherwise `m × 10ⁿ`.
 /// Uses the true minus sign.
 ///
 /// # Examples
 /// ```
-/// use accelcal::report::format::sig;
+/// use accelcal::format::sig;
 /// assert_eq!(sig(0.012345, 3), "0.0123");
 /// assert_eq!(sig(-1234.6, 3), "−1235");
 /// assert_eq!(sig(2.5e-5, 2), "2.5 × 10⁻⁵");
@@ -48,7 +67,14 @@ pub fn sig(x: f64, sig: usize) -> String {
     if x < 0.0 { format!("−{s}") } else { s }
 }
 
-/// `x` with a fixed number of decimals and the true minus sign.
+/// `x` with a fixed number of decimals and the true minus sign; never "−0".
+///
+/// # Examples
+/// ```
+/// use accelcal::format::fixed;
+/// assert_eq!(fixed(-0.0001, 2), "0.00");
+/// assert_eq!(fixed(-1.5, 1), "−1.5");
+/// ```
 pub fn fixed(x: f64, decimals: usize) -> String {
     if !x.is_finite() {
         return "—".to_string();

@@ -4,55 +4,38 @@
 //! Validation happens once, when a [`crate::model::Model`] is built from the parsed configuration,
 //! and names the offending field with its accepted range.
 
+mod case;
+mod source;
+
 use std::f64::consts::PI;
-use std::fmt;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::ConfigError;
-
-/// Which model produces the true position and velocity.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum TruthModel {
-    /// Closed-form integral of the acceleration profile, eq. (1) of the problem statement.
-    Analytic,
-    /// The true acceleration integrated with the accelerometer's Euler formula, eq. (4): the error
-    /// dynamics of eq. (5) are then exact.
-    Euler,
-}
-
-impl TruthModel {
-    /// Both models, in the order the report presents them.
-    pub const ALL: [TruthModel; 2] = [TruthModel::Analytic, TruthModel::Euler];
-
-    /// The lowercase name used in files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            TruthModel::Analytic => "analytic",
-            TruthModel::Euler => "euler",
-        }
-    }
-}
-
-impl fmt::Display for TruthModel {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+use crate::error::{ConfigError, Position};
+pub use case::{AccelerometerOutput, Case, TruthModel};
+pub use source::ConfigText;
 
 /// Every parameter of the study.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Config {
+    /// The true acceleration and the length of the run.
     pub profile: ProfileConfig,
+    /// The accelerometer as it really is.
     pub accelerometer: AccelerometerConfig,
+    /// The GPS receiver as it really is.
     pub gps: GpsConfig,
+    /// The prior of the initial position and velocity.
     pub initial: InitialConfig,
+    /// The statistics the filter assumes.
     pub filter: FilterConfig,
+    /// The Monte Carlo ensemble.
     pub ensemble: EnsembleConfig,
+    /// The statistical verdicts.
     pub checks: ChecksConfig,
+    /// The sensitivity study.
+    pub sensitivity: SensitivityConfig,
 }
 
 /// The true acceleration a(t) = A·sin(ω·t) and the length of the run.
@@ -88,6 +71,9 @@ pub struct AccelerometerConfig {
     pub noise_var_m2_s4: f64,
     /// Variance of the zero-mean Gaussian prior of the constant bias b, (m/s²)².
     pub bias_var_m2_s4: f64,
+    /// What each sample reports: the acceleration at the sample time, or its mean over the
+    /// sample interval.
+    pub output: AccelerometerOutput,
 }
 
 impl Default for AccelerometerConfig {
@@ -96,6 +82,7 @@ impl Default for AccelerometerConfig {
             sample_rate_hz: 200.0,
             noise_var_m2_s4: 0.0004,
             bias_var_m2_s4: 0.01,
+            output: AccelerometerOutput::Sample,
         }
     }
 }
@@ -181,7 +168,7 @@ pub struct FilterConfig {
 pub struct EnsembleConfig {
     /// Number of realizations N.
     pub realizations: u64,
-    /// Seed of the random streams; realization l draws from the stream (seed, l).
+    /// Seed of the random streams; realization l of a case draws from the stream (seed, case, l).
     pub seed: u64,
     /// Truth model of the ensemble.
     pub truth: TruthModel,
@@ -201,13 +188,18 @@ impl Default for EnsembleConfig {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ChecksConfig {
-    /// Family-wise false-alarm rate of each check (Bonferroni over the family's members).
+    /// Study-wide false-alarm rate: the probability that a consistent filter fails any check. Each
+    /// of the seven checks gets a seventh, split over its distinct members (Bonferroni).
     pub false_alarm_rate: f64,
     /// The single pair (t_m, t_i), t_m < t_i, of GPS fix times whose residual correlation the
     /// problem statement asks for, s. Default: the fixes nearest one third and two thirds of
     /// the run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residual_pair_s: Option<[f64; 2]>,
+    /// Largest lag, in fixes, of the residual whiteness check. Left out, every pair of fixes is
+    /// tested while there are at most 1000 fixes, and pairs up to 50 fixes apart beyond.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residual_max_lag: Option<u32>,
 }
 
 impl Default for ChecksConfig {
@@ -215,6 +207,26 @@ impl Default for ChecksConfig {
         Self {
             false_alarm_rate: 0.01,
             residual_pair_s: None,
+            residual_max_lag: None,
+        }
+    }
+}
+
+/// The sensitivity study: each statistic the filter assumes, scaled.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SensitivityConfig {
+    /// Factors on the assumed standard deviations (a variance is scaled by the square).
+    pub factors: Vec<f64>,
+    /// Independent Monte Carlo ensembles of `ensemble.realizations` per statistic and factor.
+    pub ensembles: u64,
+}
+
+impl Default for SensitivityConfig {
+    fn default() -> Self {
+        Self {
+            factors: vec![0.25, 0.5, 2.0, 4.0],
+            ensembles: 1,
         }
     }
 }
@@ -226,29 +238,27 @@ impl Config {
     /// Parses a TOML document. Missing fields take their defaults; unknown fields are an error.
     ///
     /// # Errors
-    /// [`ConfigError::Parse`] with the TOML parser's message, which names the field and line.
+    /// [`ConfigError::Parse`] with the parser's message, the line and column, the field's
+    /// dotted path and the offending line where the parser gives a span.
     pub fn from_toml_str(text: &str) -> Result<Self, ConfigError> {
-        toml::from_str(text).map_err(|e| ConfigError::Parse {
-            message: e.to_string(),
+        toml::from_str(text).map_err(|e| {
+            let span = e.span();
+            ConfigError::Parse {
+                file: None,
+                position: span.clone().map(|s| Box::new(Position::of(text, s))),
+                field: span.and_then(|s| source::field_at(text, s.start)),
+                message: e.message().trim_end().to_string(),
+            }
         })
     }
 
     /// Reads and parses a TOML file.
     ///
     /// # Errors
-    /// [`ConfigError::Read`] when the file cannot be read, [`ConfigError::Parse`] when it is not a
-    /// valid configuration.
+    /// [`ConfigError::Read`] when the file cannot be read, [`ConfigError::Parse`] naming the file
+    /// when it is not a valid configuration.
     pub fn from_file(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ConfigError::Read {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
-        Self::from_toml_str(&text).map_err(|e| match e {
-            ConfigError::Parse { message } => ConfigError::Parse {
-                message: format!("{}: {message}", path.display()),
-            },
-            other => other,
-        })
+        ConfigText::read(path)?.parse()
     }
 
     /// The configuration as TOML, every field written out (the filter section only where set).
@@ -298,6 +308,14 @@ impl Config {
             .unwrap_or(self.initial.velocity_sigma_m_s)
     }
 
+    /// The simulated case: `ensemble.truth` and `accelerometer.output`.
+    pub fn case(&self) -> Case {
+        Case {
+            truth: self.ensemble.truth,
+            output: self.accelerometer.output,
+        }
+    }
+
     /// True when the filter assumes exactly the truth's statistics.
     pub fn filter_matches_truth(&self) -> bool {
         self.filter_accel_noise_var_m2_s4() == self.accelerometer.noise_var_m2_s4
@@ -333,6 +351,54 @@ mod tests {
     fn unknown_field_is_an_error_naming_it() {
         let err = Config::from_toml_str("[gps]\nposition_sigma = 2.0\n").unwrap_err();
         assert!(err.to_string().contains("position_sigma"), "{err}");
+    }
+
+    #[test]
+    fn parse_errors_name_line_column_field_and_quote_the_line() {
+        let cases = [
+            (
+                "[ensemble]\nrealizations = \"many\"\n",
+                (2, 16),
+                "ensemble.realizations",
+            ),
+            (
+                "[ensemble]\nrealizations = -1\n",
+                (2, 16),
+                "ensemble.realizations",
+            ),
+            (
+                "[gps]\nposition_sigma_m = 1.0\nposition_sigma_m = 2.0\n",
+                (3, 1),
+                "gps.position_sigma_m",
+            ),
+            (
+                "\n[checks]\nresidual_pair_s = [1.0, \"a\"]\n",
+                (3, 25),
+                "checks.residual_pair_s",
+            ),
+        ];
+        for (text, (line, column), field) in cases {
+            let err = Config::from_toml_str(text).unwrap_err();
+            let ConfigError::Parse {
+                position: Some(p),
+                field: Some(f),
+                ..
+            } = &err
+            else {
+                panic!("no position for {text:?}: {err:?}");
+            };
+            assert_eq!((p.line, p.column), (line, column), "{err}");
+            assert_eq!(f, field, "{err}");
+            let shown = err.to_string();
+            assert!(
+                shown.contains(&format!("at line {line}, column {column}")),
+                "{shown}"
+            );
+            assert!(
+                shown.contains(text.lines().nth(line - 1).unwrap()),
+                "{shown}"
+            );
+        }
     }
 
     #[test]

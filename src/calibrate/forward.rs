@@ -1,0 +1,163 @@
+//! The forward pass over a log: the accelerometer integrated by eq. (3) and the error-state
+//! filter, one sample at a time, with the step of each pair of time stamps.
+
+use crate::error::FilterError;
+use crate::filter::{ErrorStateModel, Matrix2, Matrix3, Vector2, Vector3, transition};
+use crate::logs::GpsFix;
+
+use super::StepMode;
+
+/// What the filter did at one GPS fix: everything the smoother and the report need.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilteredFix {
+    /// Line of the fix in the GPS log.
+    pub line: u64,
+    /// Accelerometer sample the fix is applied at (0 = the log's first).
+    pub sample: u64,
+    /// Time stamp of that sample, s.
+    pub t_s: f64,
+    /// The fix z = (z_p, z_v), (m, m/s).
+    pub z: Vector2,
+    /// Integrated accelerometer (p_c, v_c) at the fix, (m, m/s).
+    pub integrated: Vector2,
+    /// A priori estimate δx̂⁻.
+    pub prior: Vector3,
+    /// A posteriori estimate δx̂⁺.
+    pub post: Vector3,
+    /// Residual r = δz − H·δx̂⁻, (m, m/s).
+    pub residual: Vector2,
+    /// Innovation covariance S = H·P⁻·Hᵀ + R.
+    pub s: Matrix2,
+    /// Normalized innovation squared rᵀ·S⁻¹·r.
+    pub nis: f64,
+    /// A priori covariance P⁻.
+    pub p_prior: Matrix3,
+    /// (P⁻)⁻¹.
+    pub p_prior_inv: Matrix3,
+    /// A posteriori covariance P⁺.
+    pub p_post: Matrix3,
+    /// Transition of the estimate from the previous fix (or the log's first sample).
+    pub phi_from_previous: Matrix3,
+}
+
+/// The integration and the filter at the current sample.
+pub(super) struct Forward<'m> {
+    model: &'m ErrorStateModel,
+    mode: StepMode,
+    /// Δt²/2 of the nominal step, s², written as in the simulation so that the bits agree.
+    half_dt2_s2: f64,
+    /// Index of the current sample.
+    pub k: u64,
+    /// Its time stamp, s.
+    pub t_s: f64,
+    /// Integrated position p_c, m.
+    pub pc_m: f64,
+    /// Integrated velocity v_c, m/s.
+    pub vc_m_s: f64,
+    /// Estimate δx̂ (a posteriori at a fix).
+    pub x: Vector3,
+    /// Its covariance P.
+    pub p: Matrix3,
+    /// Sample, time and a posteriori estimate of the last fix (the start before any).
+    last_fix: (u64, f64, Vector3),
+}
+
+impl<'m> Forward<'m> {
+    /// The start of the log at `t0_s`: eq. (3) from the prior means, δx̂ = 0, P = P(0).
+    pub fn new(
+        model: &'m ErrorStateModel,
+        mode: StepMode,
+        position_mean_m: f64,
+        velocity_mean_m_s: f64,
+        t0_s: f64,
+    ) -> Self {
+        let dt = model.dt_s;
+        Self {
+            model,
+            mode,
+            half_dt2_s2: 0.5 * dt * dt,
+            k: 0,
+            t_s: t0_s,
+            pc_m: position_mean_m,
+            vc_m_s: velocity_mean_m_s,
+            x: Vector3::zeros(),
+            p: model.p0,
+            last_fix: (0, t0_s, Vector3::zeros()),
+        }
+    }
+
+    /// Integrates the output `accel_m_s2` of the current sample up to the next one at
+    /// `t_next_s`, and propagates the estimate and its covariance over the step.
+    pub fn advance(&mut self, accel_m_s2: f64, t_next_s: f64) {
+        let a = accel_m_s2;
+        match self.mode {
+            StepMode::Nominal => {
+                // The simulation's recursion, operation for operation.
+                let dt = self.model.dt_s;
+                self.pc_m += self.vc_m_s * dt + a * self.half_dt2_s2;
+                self.vc_m_s += a * dt;
+                self.x = self.model.phi * self.x;
+                self.p = self.model.propagate(&self.p);
+            }
+            StepMode::PerStep => {
+                let dt = t_next_s - self.t_s;
+                let half_dt2 = 0.5 * dt * dt;
+                // eq. (3) with this step's Δt_j; Φ(Δt_j) and Q(Δt_j) for eq. (5).
+                self.pc_m += self.vc_m_s * dt + a * half_dt2;
+                self.vc_m_s += a * dt;
+                self.x = transition(dt) * self.x;
+                self.p = self.model.propagate_over(&self.p, dt);
+            }
+        }
+        self.k += 1;
+        self.t_s = t_next_s;
+    }
+
+    /// Transition Φ from the current sample to sample `k_to` at `t_to_s`.
+    pub fn transition_to(&self, k_to: u64, t_to_s: f64) -> Matrix3 {
+        match self.mode {
+            StepMode::Nominal => transition((k_to - self.k) as f64 * self.model.dt_s),
+            StepMode::PerStep => transition(t_to_s - self.t_s),
+        }
+    }
+
+    /// The measurement update with `fix` at the current sample.
+    ///
+    /// # Errors
+    /// [`FilterError`] when a covariance is not positive definite.
+    pub fn update(&mut self, fix: &GpsFix) -> Result<FilteredFix, FilterError> {
+        let (k0, t0, post0) = self.last_fix;
+        let (phi, prior) = match self.mode {
+            // As the in-memory filter: one transition over the whole interval since the last fix.
+            StepMode::Nominal => {
+                let phi = transition((self.k - k0) as f64 * self.model.dt_s);
+                (phi, phi * post0)
+            }
+            StepMode::PerStep => (transition(self.t_s - t0), self.x),
+        };
+        let cov = self.model.update_covariance(&self.p, self.t_s, phi)?;
+        let z = Vector2::new(fix.position_m, fix.velocity_m_s);
+        // eq. (6): δz = z − (p_c, v_c).
+        let dz = Vector2::new(z[0] - self.pc_m, z[1] - self.vc_m_s);
+        let (post, residual) = self.model.update_estimate(&cov, &prior, &dz);
+        self.x = post;
+        self.p = cov.p_post;
+        self.last_fix = (self.k, self.t_s, post);
+        Ok(FilteredFix {
+            line: fix.line,
+            sample: self.k,
+            t_s: self.t_s,
+            z,
+            integrated: Vector2::new(self.pc_m, self.vc_m_s),
+            prior,
+            post,
+            residual,
+            s: cov.s,
+            nis: (residual.transpose() * cov.s_inv * residual)[0],
+            p_prior: cov.p_prior,
+            p_prior_inv: cov.p_prior_inv,
+            p_post: cov.p_post,
+            phi_from_previous: phi,
+        })
+    }
+}

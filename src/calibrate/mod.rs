@@ -1,0 +1,318 @@
+//! Calibration from recorded logs: an accelerometer log and a GPS log in, the bias with its σ,
+//! filtered and smoothed estimates at every sample, and the NIS test out.
+//!
+//! The logs are streamed, never held: memory grows with the number of GPS fixes, not samples.
+//!
+//! 1. `scan` reads the GPS log and streams the accelerometer log once: format, increasing time
+//!    stamps, the median step, whether every step equals the configured Δt (the nominal mode),
+//!    and every fix inside the log's span.
+//! 2. The forward pass streams it again: eq. (3) from the prior means and the error-state filter
+//!    (`forward`), every step checked against the median, every fix applied at its sample;
+//!    what the smoother needs is kept at the fixes. Then `smoother::backward` runs the
+//!    Rauch–Tung–Striebel pass over the fixes.
+//! 3. [`Prepared::write_estimates`] streams it a third time, repeating the forward pass
+//!    operation for operation, and writes each sample's filtered and smoothed estimates.
+//!
+//! Nothing is written before the logs have passed every check of the first two passes.
+
+mod forward;
+mod nis;
+mod scan;
+mod smoother;
+pub mod summary;
+
+use std::io::Write;
+
+use serde::Serialize;
+use thiserror::Error;
+
+use crate::error::FilterError;
+use crate::filter::{ErrorStateModel, Matrix3, Vector3};
+use crate::logs::read::{AccelReader, LogSource};
+use crate::logs::{LogError, LogProblem};
+use crate::model::{Model, NoiseStats};
+use forward::FilteredFix;
+pub use nis::{NisTest, nis_test};
+pub use scan::NOMINAL_TOLERANCE;
+use scan::{FixMatcher, Scan};
+use smoother::SmoothedFix;
+use summary::{Calibration, EstimateRow, FilterRecord, FixReport, StateRecord, Summary, sigma};
+
+/// How each step's Δt is taken.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StepMode {
+    /// Every step equals the configured Δt to a relative 10⁻⁹: the constant Δt and the
+    /// in-memory filter's recursion, operation for operation (a simulated log calibrates to the
+    /// simulation's bits).
+    Nominal,
+    /// Φ(Δt_j) and Q(Δt_j) from each pair of consecutive time stamps.
+    PerStep,
+}
+
+impl StepMode {
+    /// The name in `summary.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            StepMode::Nominal => "nominal",
+            StepMode::PerStep => "per_step",
+        }
+    }
+}
+
+/// What a calibration takes from the configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// p_c(0): the mean of p(0), m.
+    pub position_mean_m: f64,
+    /// v_c(0): the mean of v(0), m/s.
+    pub velocity_mean_m_s: f64,
+    /// The statistics the filter assumes (`[filter]`, defaulting to the truth sections).
+    pub filter_stats: NoiseStats,
+    /// The configured step Δt = 1 / accelerometer.sample_rate_hz, s.
+    pub nominal_dt_s: f64,
+    /// The NIS test's false-alarm rate α (`checks.false_alarm_rate`).
+    pub false_alarm_rate: f64,
+}
+
+impl Settings {
+    /// The settings of a validated model.
+    pub fn from_model(model: &Model) -> Self {
+        let c = &model.config;
+        Self {
+            position_mean_m: c.initial.position_mean_m,
+            velocity_mean_m_s: c.initial.velocity_mean_m_s,
+            filter_stats: model.filter_stats,
+            nominal_dt_s: model.timeline.dt_s,
+            false_alarm_rate: c.checks.false_alarm_rate,
+        }
+    }
+}
+
+/// A calibration that could not be completed.
+#[derive(Debug, Error)]
+pub enum CalibrateError {
+    /// A log is bad input.
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// The filter's covariance stopped being positive definite.
+    #[error(transparent)]
+    Filter(#[from] FilterError),
+    /// The estimates could not be written.
+    #[error("cannot write the estimates: {0}")]
+    Write(#[from] std::io::Error),
+}
+
+impl CalibrateError {
+    /// Whether the input is to blame (a bad log or filter statistics), not the machine.
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(self, CalibrateError::Write(_))
+    }
+}
+
+/// The logs checked and filtered, and the smoother's backward pass done: ready to write.
+pub struct Prepared<'a> {
+    settings: Settings,
+    model: ErrorStateModel,
+    accel: &'a dyn LogSource,
+    scan: Scan,
+    fixes: Vec<FilteredFix>,
+    smoothed: Vec<SmoothedFix>,
+    /// Filtered estimate and covariance at the last sample.
+    end: (Vector3, Matrix3),
+}
+
+/// One sample of the forward pass as a visitor sees it.
+type Visit<'v> =
+    dyn FnMut(&forward::Forward<'_>, Option<&FilteredFix>) -> Result<(), CalibrateError> + 'v;
+
+/// Checks the logs, runs the filter over them and the smoother's backward pass (passes 1 and 2).
+///
+/// # Errors
+/// [`CalibrateError::Log`] naming the file and line of the first problem of either log;
+/// [`CalibrateError::Filter`] when a covariance is not positive definite.
+pub fn prepare<'a>(
+    accel: &'a dyn LogSource,
+    gps: &dyn LogSource,
+    settings: &Settings,
+) -> Result<Prepared<'a>, CalibrateError> {
+    let scan = scan::scan(accel, gps, settings.nominal_dt_s)?;
+    let mut prepared = Prepared {
+        settings: settings.clone(),
+        model: ErrorStateModel::new(settings.nominal_dt_s, &settings.filter_stats),
+        accel,
+        fixes: Vec::new(),
+        scan,
+        smoothed: Vec::new(),
+        end: (Vector3::zeros(), Matrix3::zeros()),
+    };
+    let mut fixes = Vec::with_capacity(prepared.scan.gps.len());
+    let mut end = prepared.end;
+    prepared.forward_pass(&mut |fw, fix| {
+        if let Some(f) = fix {
+            fixes.push(f.clone());
+        }
+        end = (fw.x, fw.p);
+        Ok(())
+    })?;
+    prepared.smoothed = smoother::backward(&fixes);
+    prepared.fixes = fixes;
+    prepared.end = end;
+    Ok(prepared)
+}
+
+impl Prepared<'_> {
+    /// One pass of the integration and the filter over the accelerometer log, handing every
+    /// sample (after its fix, if any) to `visit`. Returns the number of samples.
+    fn forward_pass(&self, visit: &mut Visit<'_>) -> Result<u64, CalibrateError> {
+        let mut reader = AccelReader::open(self.accel)?;
+        let changed = || LogError::of_file(self.accel.name(), LogProblem::Changed);
+        let mut matcher = FixMatcher::new(&self.scan);
+        let Some(mut current) = reader.next_sample()? else {
+            return Err(changed().into());
+        };
+        let s = &self.settings;
+        let mut fw = forward::Forward::new(
+            &self.model,
+            self.scan.mode,
+            s.position_mean_m,
+            s.velocity_mean_m_s,
+            current.t_s,
+        );
+        loop {
+            let next = reader.next_sample()?;
+            if let Some(n) = &next {
+                self.scan.check_step(reader.file(), &current, n)?;
+            }
+            let fix = match matcher.at_sample(current.t_s, next.map(|n| n.t_s))? {
+                Some(i) => Some(fw.update(&self.scan.gps[i])?),
+                None => None,
+            };
+            visit(&fw, fix.as_ref())?;
+            match next {
+                Some(n) => {
+                    fw.advance(current.accel_m_s2, n.t_s);
+                    current = n;
+                }
+                None => break,
+            }
+        }
+        matcher.finish()?;
+        if fw.k + 1 != self.scan.samples {
+            return Err(changed().into());
+        }
+        Ok(fw.k + 1)
+    }
+
+    /// Pass 3: writes `estimates.csv` to `out`, one row per sample in time order.
+    ///
+    /// # Errors
+    /// [`CalibrateError::Write`] when `out` fails; [`LogProblem::Changed`] when the log no longer
+    /// reads as it did.
+    pub fn write_estimates(&self, out: &mut dyn Write) -> Result<(), CalibrateError> {
+        let header = format!("{}\n", summary::ESTIMATES_COLUMNS.join(","));
+        out.write_all(header.as_bytes())?;
+        let mut row = String::with_capacity(512);
+        let mut next = 0usize;
+        let changed = || LogError::of_file(self.accel.name(), LogProblem::Changed);
+        self.forward_pass(&mut |fw, fix| {
+            if let Some(f) = fix
+                && self.fixes.get(next) != Some(f)
+            {
+                return Err(changed().into());
+            }
+            // The first fix after this sample: its smoothed estimate carries back to here.
+            while self.fixes.get(next).is_some_and(|f| f.sample <= fw.k) {
+                next += 1;
+            }
+            let (xs, ps) = match (self.fixes.get(next), self.smoothed.get(next)) {
+                (Some(f), Some(sm)) => sm.smooth(&fw.x, &fw.p, &fw.transition_to(f.sample, f.t_s)),
+                _ => (fw.x, fw.p),
+            };
+            row.clear();
+            EstimateRow {
+                t_s: fw.t_s,
+                fix: fix.is_some(),
+                integrated: [fw.pc_m, fw.vc_m_s],
+                filtered: (&fw.x, &fw.p),
+                smoothed: (&xs, &ps),
+            }
+            .push(&mut row);
+            out.write_all(row.as_bytes())?;
+            Ok(())
+        })?;
+        out.flush()?;
+        Ok(())
+    }
+
+    /// The calibration's summary and per-fix series.
+    pub fn calibration(&self) -> Calibration {
+        let (x_end, p_end) = &self.end;
+        let s = &self.settings;
+        let f = &s.filter_stats;
+        let sc = &self.scan;
+        let start_smoothed = match (self.fixes.first(), self.smoothed.first()) {
+            (Some(fix), Some(sm)) => {
+                sm.smooth(&Vector3::zeros(), &self.model.p0, &fix.phi_from_previous)
+            }
+            _ => (Vector3::zeros(), self.model.p0),
+        };
+        let nis: Vec<f64> = self.fixes.iter().map(|f| f.nis).collect();
+        let (lo, hi) = sc.accepted_step_s();
+        let summary = Summary {
+            accelcal_version: env!("CARGO_PKG_VERSION"),
+            accelerometer_log: self.accel.name().to_string(),
+            gps_log: sc.gps_name.clone(),
+            bias_m_s2: x_end[2],
+            bias_sigma_m_s2: p_end[(2, 2)].sqrt(),
+            samples: sc.samples,
+            fixes: self.fixes.len(),
+            start_s: sc.span_s.0,
+            end_s: sc.span_s.1,
+            duration_s: sc.span_s.1 - sc.span_s.0,
+            dt_mode: sc.mode,
+            nominal_dt_s: s.nominal_dt_s,
+            median_step_s: sc.median_step_s,
+            min_step_s: sc.step_range_s.0,
+            max_step_s: sc.step_range_s.1,
+            accepted_step_s: [lo, hi],
+            fix_tolerance_s: sc.tolerance_s(),
+            start_smoothed: StateRecord::new(&start_smoothed.0, &start_smoothed.1),
+            end_estimate: StateRecord::new(x_end, p_end),
+            nis: nis_test(&nis, s.false_alarm_rate),
+            filter: FilterRecord {
+                initial_position_mean_m: s.position_mean_m,
+                initial_velocity_mean_m_s: s.velocity_mean_m_s,
+                initial_position_sigma_m: f.initial_position_sigma_m,
+                initial_velocity_sigma_m_s: f.initial_velocity_sigma_m_s,
+                bias_var_m2_s4: f.bias_var_m2_s4,
+                accel_noise_var_m2_s4: f.accel_noise_var_m2_s4,
+                gps_position_sigma_m: f.gps_position_sigma_m,
+                gps_velocity_sigma_m_s: f.gps_velocity_sigma_m_s,
+            },
+        };
+        let fixes = self
+            .fixes
+            .iter()
+            .zip(&self.smoothed)
+            .map(|(f, sm)| FixReport {
+                t_s: f.t_s,
+                z: f.z.into(),
+                integrated: f.integrated.into(),
+                filtered: f.post.into(),
+                filtered_sigma: sigma(&f.p_post),
+                smoothed: sm.x.into(),
+                smoothed_sigma: sigma(&sm.p),
+                residual: f.residual.into(),
+                residual_sigma: [f.s[(0, 0)].sqrt(), f.s[(1, 1)].sqrt()],
+                nis: f.nis,
+            })
+            .collect();
+        Calibration { summary, fixes }
+    }
+
+    /// Which Δt mode runs.
+    pub fn mode(&self) -> StepMode {
+        self.scan.mode
+    }
+}

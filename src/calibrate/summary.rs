@@ -1,0 +1,228 @@
+//! What a calibration hands on: `estimates.csv` rows, the `summary.json` record, and the per-fix
+//! series the report draws.
+
+use serde::Serialize;
+
+use crate::filter::{Matrix3, Vector3};
+use crate::logs::write::push_row;
+
+use super::StepMode;
+use super::nis::NisTest;
+
+/// Columns of `estimates.csv`: one row per accelerometer sample. Filtered values are a
+/// posteriori at a fix; corrected position and velocity are the integration plus the estimated
+/// error, p_c + δp̂ and v_c + δv̂.
+pub const ESTIMATES_COLUMNS: [&str; 20] = [
+    "t_s",
+    "gps_fix",
+    "p_integrated_m",
+    "v_integrated_m_s",
+    "dp_filtered_m",
+    "dv_filtered_m_s",
+    "bias_filtered_m_s2",
+    "sigma_dp_filtered_m",
+    "sigma_dv_filtered_m_s",
+    "sigma_bias_filtered_m_s2",
+    "dp_smoothed_m",
+    "dv_smoothed_m_s",
+    "bias_smoothed_m_s2",
+    "sigma_dp_smoothed_m",
+    "sigma_dv_smoothed_m_s",
+    "sigma_bias_smoothed_m_s2",
+    "p_filtered_m",
+    "v_filtered_m_s",
+    "p_smoothed_m",
+    "v_smoothed_m_s",
+];
+
+/// σ = √diag P.
+pub fn sigma(p: &Matrix3) -> [f64; 3] {
+    std::array::from_fn(|k| p[(k, k)].sqrt())
+}
+
+/// One sample: time, whether a fix was applied, the integration, the filtered and smoothed
+/// estimates with their covariances.
+pub(super) struct EstimateRow<'a> {
+    pub t_s: f64,
+    pub fix: bool,
+    pub integrated: [f64; 2],
+    pub filtered: (&'a Vector3, &'a Matrix3),
+    pub smoothed: (&'a Vector3, &'a Matrix3),
+}
+
+impl EstimateRow<'_> {
+    /// Appends the row in the order of [`ESTIMATES_COLUMNS`].
+    pub fn push(&self, out: &mut String) {
+        let [pc, vc] = self.integrated;
+        let (x, p) = self.filtered;
+        let (xs, ps) = self.smoothed;
+        let (sf, ss) = (sigma(p), sigma(ps));
+        push_row(
+            out,
+            &[
+                self.t_s,
+                if self.fix { 1.0 } else { 0.0 },
+                pc,
+                vc,
+                x[0],
+                x[1],
+                x[2],
+                sf[0],
+                sf[1],
+                sf[2],
+                xs[0],
+                xs[1],
+                xs[2],
+                ss[0],
+                ss[1],
+                ss[2],
+                pc + x[0],
+                vc + x[1],
+                pc + xs[0],
+                vc + xs[1],
+            ],
+        );
+    }
+}
+
+/// An estimate of the error state with its σ.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StateRecord {
+    /// Position error δp̂, m.
+    pub dp_m: f64,
+    /// Velocity error δv̂, m/s.
+    pub dv_m_s: f64,
+    /// Bias b̂, m/s².
+    pub bias_m_s2: f64,
+    /// σ of δp̂, m.
+    pub sigma_dp_m: f64,
+    /// σ of δv̂, m/s.
+    pub sigma_dv_m_s: f64,
+    /// σ of b̂, m/s².
+    pub sigma_bias_m_s2: f64,
+}
+
+impl StateRecord {
+    /// The record of estimate `x` with covariance `p`.
+    pub fn new(x: &Vector3, p: &Matrix3) -> Self {
+        let s = sigma(p);
+        Self {
+            dp_m: x[0],
+            dv_m_s: x[1],
+            bias_m_s2: x[2],
+            sigma_dp_m: s[0],
+            sigma_dv_m_s: s[1],
+            sigma_bias_m_s2: s[2],
+        }
+    }
+}
+
+/// The filter's assumptions, from the configuration.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FilterRecord {
+    /// p_c(0) = mean of p(0), m.
+    pub initial_position_mean_m: f64,
+    /// v_c(0) = mean of v(0), m/s.
+    pub initial_velocity_mean_m_s: f64,
+    /// σ of p(0), m.
+    pub initial_position_sigma_m: f64,
+    /// σ of v(0), m/s.
+    pub initial_velocity_sigma_m_s: f64,
+    /// Prior variance of the bias, (m/s²)².
+    pub bias_var_m2_s4: f64,
+    /// Accelerometer white-noise variance W, (m/s²)².
+    pub accel_noise_var_m2_s4: f64,
+    /// GPS position noise σ, m.
+    pub gps_position_sigma_m: f64,
+    /// GPS velocity noise σ, m/s.
+    pub gps_velocity_sigma_m_s: f64,
+}
+
+/// `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    /// The program's version.
+    pub accelcal_version: &'static str,
+    /// The accelerometer log as named on the command line.
+    pub accelerometer_log: String,
+    /// The GPS log as named on the command line.
+    pub gps_log: String,
+    /// The bias estimate at the end of the log, m/s² (filtered and smoothed agree there).
+    pub bias_m_s2: f64,
+    /// Its σ, m/s².
+    pub bias_sigma_m_s2: f64,
+    /// Accelerometer samples.
+    pub samples: u64,
+    /// GPS fixes applied.
+    pub fixes: usize,
+    /// First accelerometer time stamp, s.
+    pub start_s: f64,
+    /// Last accelerometer time stamp, s.
+    pub end_s: f64,
+    /// end_s − start_s.
+    pub duration_s: f64,
+    /// "nominal": every step equals the configured Δt within a relative 10⁻⁹ and the in-memory
+    /// recursion runs with it; "per_step": Φ(Δt_j), Q(Δt_j) from each pair of time stamps.
+    pub dt_mode: StepMode,
+    /// The configured Δt = 1 / accelerometer.sample_rate_hz, s.
+    pub nominal_dt_s: f64,
+    /// Median step of the log, s.
+    pub median_step_s: f64,
+    /// Shortest step, s.
+    pub min_step_s: f64,
+    /// Longest step, s.
+    pub max_step_s: f64,
+    /// The accepted steps, [0.5, 1.5] × the median, s.
+    pub accepted_step_s: [f64; 2],
+    /// How far from its sample a fix may lie: half the median step, s.
+    pub fix_tolerance_s: f64,
+    /// The smoothed estimate at the first sample: the initial position and velocity errors.
+    pub start_smoothed: StateRecord,
+    /// The estimate at the last sample.
+    pub end_estimate: StateRecord,
+    /// The NIS test of the whole log.
+    pub nis: NisTest,
+    /// The filter's assumptions.
+    pub filter: FilterRecord,
+}
+
+/// One fix as the report draws it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FixReport {
+    /// Time of the fix's sample, s.
+    pub t_s: f64,
+    /// The fix (z_p, z_v), (m, m/s).
+    pub z: [f64; 2],
+    /// Integrated accelerometer (p_c, v_c), (m, m/s).
+    pub integrated: [f64; 2],
+    /// A posteriori estimate.
+    pub filtered: [f64; 3],
+    /// Its σ.
+    pub filtered_sigma: [f64; 3],
+    /// Smoothed estimate.
+    pub smoothed: [f64; 3],
+    /// Its σ.
+    pub smoothed_sigma: [f64; 3],
+    /// Residual r = δz − H·δx̂⁻, (m, m/s).
+    pub residual: [f64; 2],
+    /// √diag S: the residual's predicted σ, (m, m/s).
+    pub residual_sigma: [f64; 2],
+    /// rᵀ S⁻¹ r.
+    pub nis: f64,
+}
+
+/// A calibration's results: the summary and the per-fix series.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Calibration {
+    /// `summary.json`.
+    pub summary: Summary,
+    /// Every fix.
+    pub fixes: Vec<FixReport>,
+}
+
+impl Summary {
+    /// `summary.json` as text.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("finite numbers serialize")
+    }
+}

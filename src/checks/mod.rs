@@ -1,0 +1,348 @@
+//! Statistical verdicts on an ensemble: does the filter's covariance describe its actual errors?
+//!
+//! Each check of the [`catalogue`] is a family of hypothesis tests, one per distinct member (a
+//! fix, a stage, a component, a pair of fixes). The study-wide false-alarm rate α — the
+//! probability that a consistent filter gets any "fail" — is split evenly over the seven checks,
+//! and each check's share α_c over its M members, each tested two-sided at α_c/M (Bonferroni, at
+//! both levels). A check whose statistic cannot pass its bound at this N, or whose approximation
+//! does not hold, is "untestable", never "pass".
+//!
+//! This module returns numbers and typed member ids; words are the catalogue's and the report's.
+
+pub mod catalogue;
+mod members;
+
+use serde::Serialize;
+
+use crate::ensemble::EnsembleStats;
+use crate::stats::{chi_squared_band, chi_squared_median, normal_bound};
+pub use catalogue::{CheckId, MemberId, Null};
+pub use members::{is_bias_copy, residual_z};
+
+/// How the study-wide false-alarm rate is spent over the checks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Budget {
+    per_check: f64,
+}
+
+impl Budget {
+    /// The study-wide rate `alpha` split evenly over the seven checks (Bonferroni).
+    pub fn study(alpha: f64) -> Self {
+        Self {
+            per_check: alpha / CheckId::ALL.len() as f64,
+        }
+    }
+
+    /// Every check at `share`: its expected number of members outside their bands under a
+    /// consistent filter (a probability when ≤ 1). Used to calibrate the bounds themselves.
+    pub fn per_check(share: f64) -> Self {
+        Self { per_check: share }
+    }
+
+    /// The share of check `id` (the same for every check).
+    pub fn share(&self, _id: CheckId) -> f64 {
+        self.per_check
+    }
+
+    /// The study-wide rate: the sum of the shares.
+    pub fn total(&self) -> f64 {
+        CheckId::ALL.iter().map(|&id| self.share(id)).sum()
+    }
+}
+
+/// Why a check could not be tested.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "reason")]
+pub enum Untestable {
+    /// At this N the statistic cannot leave its band, or its approximation does not hold.
+    TooFewRealizations {
+        /// The smallest N that can test it.
+        needs: u64,
+    },
+    /// No member could be computed (no estimate varies over the ensemble).
+    NoMembers,
+}
+
+/// The outcome of one check.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// Every member lies in its band, and the check could have failed.
+    Pass,
+    /// Some member lies outside its band.
+    Fail,
+    /// The check cannot fail at this N: it says nothing.
+    Untestable(Untestable),
+}
+
+impl Verdict {
+    /// "pass", "fail" or "untestable".
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Pass => "pass",
+            Verdict::Fail => "fail",
+            Verdict::Untestable(_) => "untestable",
+        }
+    }
+}
+
+/// The worst member of a check.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Worst {
+    /// Its statistic.
+    pub value: f64,
+    /// Which member it is.
+    pub member: MemberId,
+}
+
+/// The verdict of one check, with the numbers behind it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Check {
+    /// Which check.
+    pub id: CheckId,
+    /// Distinct members tested, M.
+    pub members: usize,
+    /// This check's share α_c of the study-wide false-alarm rate.
+    pub false_alarm_rate: f64,
+    /// Lower end of every member's acceptance band.
+    pub lower: f64,
+    /// Upper end of every member's acceptance band.
+    pub upper: f64,
+    /// Centre of the band: 0 for normal scores, the median for χ² statistics.
+    pub center: f64,
+    /// Members outside the band (a non-finite member is outside every band).
+    pub failures: usize,
+    /// The member farthest outside, relative to its band; `None` when there are no members.
+    pub worst: Option<Worst>,
+    /// The smallest N at which this check can fail.
+    pub min_realizations: u64,
+    /// Pass, fail or untestable.
+    pub verdict: Verdict,
+}
+
+impl Check {
+    /// Whether the verdict is "pass".
+    pub fn passed(&self) -> bool {
+        self.verdict == Verdict::Pass
+    }
+
+    /// Whether the members are normal scores (else χ² statistics).
+    pub fn is_normal(&self) -> bool {
+        match self.id.null(2) {
+            Null::Normal | Null::CorrelationScore | Null::Fisher => true,
+            Null::ChiSquared { .. } => false,
+        }
+    }
+
+    /// The worst member's statistic: |z| for normal scores, the value for χ² statistics.
+    pub fn worst_value(&self) -> f64 {
+        match (self.worst, self.is_normal()) {
+            (Some(w), true) => w.value.abs(),
+            (Some(w), false) => w.value,
+            (None, _) => f64::NAN,
+        }
+    }
+
+    /// The end of the band on the worst member's side.
+    pub fn bound(&self) -> f64 {
+        match self.worst {
+            Some(w) if !self.is_normal() && w.value < self.center => self.lower,
+            _ => self.upper,
+        }
+    }
+
+    /// How far `x` lies from the centre, in units of the half band on its side: above 1 is
+    /// outside. NaN when `x` is not finite.
+    pub fn excursion(&self, x: f64) -> f64 {
+        if x >= self.center {
+            (x - self.center) / (self.upper - self.center)
+        } else {
+            (self.center - x) / (self.center - self.lower)
+        }
+    }
+}
+
+/// The statement's single residual pair (t_m, t_i): its four component products tested on their
+/// own at the residual-whiteness share, as the problem asks. Its verdict is shown for the
+/// statement only: it is not part of the study-wide rate nor of [`Verdicts::all_passed`] (the
+/// same products are members of `residual_whiteness`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ResidualPair {
+    /// Fix index m of the earlier fix.
+    pub earlier: usize,
+    /// Fix index i of the later fix.
+    pub later: usize,
+    /// t_m, s.
+    pub t_m_s: f64,
+    /// t_i, s.
+    pub t_i_s: f64,
+    /// Second moments (1/N) Σ r(t_i)·r(t_m)ᵀ, rows components of r(t_i), columns of r(t_m),
+    /// (m, m/s)².
+    pub mean_product: [[f64; 2]; 2],
+    /// The same as normalized scores z = √N·corr.
+    pub z: [[f64; 2]; 2],
+    /// Two-sided bound on |z| for these four members at the residual-whiteness share.
+    pub bound: f64,
+    /// Pass, fail or untestable.
+    #[serde(serialize_with = "verdict_name")]
+    pub verdict: Verdict,
+}
+
+fn verdict_name<S: serde::Serializer>(v: &Verdict, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(v.name())
+}
+
+/// Every verdict on one ensemble.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Verdicts {
+    /// One per check, in [`CheckId::ALL`] order.
+    pub checks: Vec<Check>,
+    /// The statement's single residual pair.
+    pub residual_pair: ResidualPair,
+    /// The study-wide false-alarm rate the shares add up to.
+    pub false_alarm_rate: f64,
+}
+
+impl Verdicts {
+    /// True when every check passed (an untestable check is not a pass).
+    pub fn all_passed(&self) -> bool {
+        self.checks.iter().all(Check::passed)
+    }
+
+    /// The verdict of check `id`.
+    pub fn get(&self, id: CheckId) -> &Check {
+        &self.checks[id.index()]
+    }
+
+    /// The checks that failed.
+    pub fn failed(&self) -> impl Iterator<Item = &Check> {
+        self.checks.iter().filter(|c| c.verdict == Verdict::Fail)
+    }
+}
+
+/// The acceptance band (lower, upper, centre) of every member of check `id` at `n` realizations,
+/// each member tested two-sided at rate `p_member`.
+pub fn band(id: CheckId, n: u64, p_member: f64) -> (f64, f64, f64) {
+    let p = p_member.min(1.0);
+    match id.null(n) {
+        Null::Normal | Null::CorrelationScore | Null::Fisher => {
+            let b = normal_bound(p);
+            (-b, b, 0.0)
+        }
+        Null::ChiSquared { dof, scale } => {
+            let (lo, hi) = chi_squared_band(dof, scale, p);
+            (lo, hi, chi_squared_median(dof) / scale)
+        }
+    }
+}
+
+/// Whether `check`, judged on one ensemble, would fail on `stats`, another ensemble of the same
+/// design (same members, same N): its band reused, so that many ensembles are judged at the cost
+/// of computing their members.
+pub fn fails_again(check: &Check, stats: &EnsembleStats) -> bool {
+    if matches!(check.verdict, Verdict::Untestable(_)) {
+        return false;
+    }
+    let mut outside = false;
+    members::for_each(check.id, stats, &mut |value, _| {
+        outside |= !(check.lower..=check.upper).contains(&value);
+    });
+    outside
+}
+
+/// Judges check `id` on `stats` at false-alarm share `share`.
+pub fn judge(id: CheckId, stats: &EnsembleStats, share: f64) -> Check {
+    let n = stats.realizations;
+    let m = members::count(id, stats);
+    let p = (share / m.max(1) as f64).min(1.0);
+    let (lower, upper, center) = band(id, n, p);
+    let mut check = Check {
+        id,
+        members: m,
+        false_alarm_rate: share,
+        lower,
+        upper,
+        center,
+        failures: 0,
+        worst: None,
+        min_realizations: id.min_realizations(p),
+        verdict: Verdict::Pass,
+    };
+    let mut worst: Option<(f64, Worst)> = None;
+    members::for_each(id, stats, &mut |value, member| {
+        if !(lower..=upper).contains(&value) {
+            check.failures += 1;
+        }
+        let e = check.excursion(value);
+        // NaN sorts above every number, so a non-finite member is the worst.
+        let worse = match &worst {
+            None => true,
+            Some((w, _)) => (e.is_nan() && !w.is_nan()) || (e.is_nan() == w.is_nan() && e > *w),
+        };
+        if worse {
+            worst = Some((e, Worst { value, member }));
+        }
+    });
+    check.worst = worst.map(|(_, w)| w);
+    check.verdict = if m == 0 {
+        Verdict::Untestable(Untestable::NoMembers)
+    } else if n < check.min_realizations {
+        Verdict::Untestable(Untestable::TooFewRealizations {
+            needs: check.min_realizations,
+        })
+    } else if check.failures > 0 {
+        Verdict::Fail
+    } else {
+        Verdict::Pass
+    };
+    check
+}
+
+/// Runs every check on `stats` within `budget`, and the statement's single residual pair.
+pub fn evaluate(stats: &EnsembleStats, budget: &Budget) -> Verdicts {
+    let checks = CheckId::ALL
+        .iter()
+        .map(|&id| judge(id, stats, budget.share(id)))
+        .collect();
+    let [m, i] = stats.pair;
+    let bound = normal_bound(budget.share(CheckId::ResidualWhiteness).min(1.0) / 4.0);
+    let diagonal = |a| stats.residual_moment(a, a).unwrap_or(f64::NAN);
+    let z: [[f64; 2]; 2] = std::array::from_fn(|j| {
+        std::array::from_fn(|k| {
+            members::z_score(
+                stats.realizations,
+                stats.pair_moments[2 * j + k],
+                diagonal(2 * i + j),
+                diagonal(2 * m + k),
+            )
+        })
+    });
+    let reachable = (stats.realizations as f64).sqrt() > bound;
+    let verdict = if !reachable {
+        Verdict::Untestable(Untestable::TooFewRealizations {
+            needs: (bound * bound).floor() as u64 + 1,
+        })
+    } else if z.iter().flatten().all(|v| v.abs() <= bound) {
+        Verdict::Pass
+    } else {
+        Verdict::Fail
+    };
+    Verdicts {
+        checks,
+        residual_pair: ResidualPair {
+            earlier: m,
+            later: i,
+            t_m_s: stats.fixes[m].time_s,
+            t_i_s: stats.fixes[i].time_s,
+            mean_product: std::array::from_fn(|j| {
+                std::array::from_fn(|k| stats.pair_moments[2 * j + k])
+            }),
+            z,
+            bound,
+            verdict,
+        },
+        false_alarm_rate: budget.total(),
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,153 @@
+//! The commands of sensor logs: simulate a realization (its CSV, its logs) and calibrate from
+//! recorded logs.
+
+use std::io::IsTerminal;
+use std::path::Path;
+
+use std::io::Write as _;
+
+use super::{load_model, write};
+use crate::cli::{CalibrateArgs, CaseArgs, ModelArgs, SimulateArgs};
+use accelcal::calibrate::{self, Settings};
+use accelcal::filter::FilterSchedule;
+use accelcal::format::{count, sig};
+use accelcal::logs::read::LogFile;
+use accelcal::logs::write::LogWriter;
+use accelcal::logs::{ACCEL_FILE, GPS_FILE, TRUTH_FILE};
+use accelcal::model::Model;
+use accelcal::output::StagedFiles;
+use accelcal::{export, realization, report, simulation};
+use anyhow::{Context, Result};
+
+pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
+    let model = load_model(&args.model, &args.case, None)?;
+    let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
+    let seed = model.config.ensemble.seed;
+    if let Some(dir) = &args.logs {
+        write_logs(&model, &schedule, args.realization, dir)?;
+    }
+    let Some(csv_path) = &args.csv else {
+        return Ok(());
+    };
+    let r = realization::record(&model, &schedule, seed, args.realization);
+    let csv = export::realization_csv(&r, &model.timeline.fix_times_s());
+    write(csv_path, csv.as_bytes())?;
+    if let Some(last) = r.fixes.last() {
+        println!(
+            "realization {} ({}): b = {:.6} m/s², estimate at {:.1} s = {:.6} ± {:.6} m/s²; {} samples written to {}",
+            args.realization,
+            model.case(),
+            r.bias_m_s2,
+            last.t_s,
+            last.post[2],
+            last.sigma_post[2],
+            r.samples.len(),
+            csv_path.display()
+        );
+    }
+    Ok(())
+}
+
+/// Runs realization `index` once more, streaming its sensor logs into `dir`.
+fn write_logs(model: &Model, schedule: &FilterSchedule, index: u64, dir: &Path) -> Result<()> {
+    let mut staged = StagedFiles::create(dir, &[ACCEL_FILE, GPS_FILE, TRUTH_FILE])?;
+    let (samples, fixes, draws) = {
+        let [accel, gps, truth]: [_; 3] = staged
+            .writers()
+            .try_into()
+            .map_err(|_| anyhow::anyhow!("three staged log files"))?;
+        let mut writer = LogWriter::new(&model.timeline, accel, gps, truth)
+            .with_context(|| format!("cannot write the logs into {}", dir.display()))?;
+        let draws = simulation::run_realization(
+            model,
+            schedule,
+            model.config.ensemble.seed,
+            index,
+            &mut writer,
+        );
+        let (samples, fixes) = writer
+            .finish()
+            .with_context(|| format!("cannot write the logs into {}", dir.display()))?;
+        (samples, fixes, draws)
+    };
+    staged.commit()?;
+    println!(
+        "realization {index} ({}): b = {:.6} m/s²; logs of {samples} samples and {fixes} fixes \
+         written to {} ({ACCEL_FILE}, {GPS_FILE}, {TRUTH_FILE})",
+        model.case(),
+        draws.bias_m_s2,
+        dir.display()
+    );
+    Ok(())
+}
+
+/// The files `calibrate` writes.
+const ESTIMATES_FILE: &str = "estimates.csv";
+const SUMMARY_FILE: &str = "summary.json";
+const PAGE_FILE: &str = "index.html";
+
+pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
+    let model_args = ModelArgs {
+        config: args.config.clone(),
+        seed: None,
+        quiet: args.quiet,
+    };
+    let model = load_model(&model_args, &CaseArgs::default(), None)?;
+    let settings = Settings::from_model(&model);
+    let note = |text: &str| {
+        if !args.quiet && std::io::stderr().is_terminal() {
+            eprintln!("{text}");
+        }
+    };
+    let (accel, gps) = (LogFile::new(&args.accel), LogFile::new(&args.gps));
+    note("checking the logs and running the filter and the smoother…");
+    let prepared = calibrate::prepare(&accel, &gps, &settings)?;
+    let cal = prepared.calibration();
+    let page = report::calibration::render(&cal, &calibrate_command(args))?;
+    note("writing the estimates…");
+    let mut staged = StagedFiles::create(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE, PAGE_FILE])?;
+    let into = |name: &str| format!("cannot write {}", args.out.join(name).display());
+    prepared
+        .write_estimates(staged.writer(ESTIMATES_FILE))
+        .with_context(|| into(ESTIMATES_FILE))?;
+    staged
+        .writer(SUMMARY_FILE)
+        .write_all(cal.summary.to_json().as_bytes())
+        .with_context(|| into(SUMMARY_FILE))?;
+    staged
+        .writer(PAGE_FILE)
+        .write_all(page.as_bytes())
+        .with_context(|| into(PAGE_FILE))?;
+    staged.commit()?;
+    let s = &cal.summary;
+    println!(
+        "bias {} ± {} m/s² at t = {} s ({} samples, {} fixes, Δt mode {}); NIS test {} \
+         (sum {} in [{}, {}]); written to {}",
+        sig(s.bias_m_s2, 6),
+        sig(s.bias_sigma_m_s2, 3),
+        s.end_s,
+        count(s.samples),
+        count(s.fixes as u64),
+        s.dt_mode.name(),
+        s.nis.verdict,
+        sig(s.nis.sum, 5),
+        sig(s.nis.lower, 5),
+        sig(s.nis.upper, 5),
+        args.out.join(PAGE_FILE).display()
+    );
+    Ok(())
+}
+
+/// The command line that reproduces a calibration.
+fn calibrate_command(args: &CalibrateArgs) -> String {
+    let mut s = format!(
+        "accelcal calibrate --accel {} --gps {}",
+        args.accel.display(),
+        args.gps.display()
+    );
+    if let Some(c) = &args.config {
+        s.push_str(&format!(" --config {}", c.display()));
+    }
+    s.push_str(&format!(" --out {}", args.out.display()));
+    s
+}

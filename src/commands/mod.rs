@@ -1,0 +1,187 @@
+//! What each command does: load and validate the configuration once, run the library, write.
+//! The only place that knows about terminals (the progress bar) and exit codes. `monte_carlo` holds
+//! the commands of the Monte Carlo study (report, ensemble and its shards, merge, sensitivity),
+//! `logs` those of sensor logs (simulate, calibrate).
+
+mod logs;
+mod monte_carlo;
+
+use std::io::IsTerminal;
+use std::path::Path;
+
+use anyhow::Result;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use crate::cli::{CaseArgs, Cli, Command, ModelArgs, ReportArgs};
+use accelcal::calibrate::CalibrateError;
+use accelcal::checks::{Untestable, Verdict, Verdicts};
+use accelcal::config::{Config, ConfigText, DEFAULT_TOML};
+use accelcal::ensemble::{EnsembleRun, partial};
+use accelcal::error::{ConfigError, FilterError};
+use accelcal::format::{count, sig};
+use accelcal::logs::LogError;
+use accelcal::model::Model;
+use accelcal::output::write_atomic;
+use accelcal::study::Progress;
+
+/// Exit code for `err`: 2 for bad input (configuration, filter statistics, logs), 1 otherwise.
+pub fn exit_code(err: &anyhow::Error) -> u8 {
+    let bad_input = err.chain().any(|e| {
+        e.is::<ConfigError>()
+            || e.is::<FilterError>()
+            || e.is::<LogError>()
+            || e.is::<partial::PartialError>()
+            || e.downcast_ref::<CalibrateError>()
+                .is_some_and(CalibrateError::is_bad_input)
+    });
+    if bad_input { 2 } else { 1 }
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        None => monte_carlo::run_report(&ReportArgs::default()),
+        Some(Command::Report(args)) => monte_carlo::run_report(&args),
+        Some(Command::Ensemble(args)) => monte_carlo::run_ensemble(&args),
+        Some(Command::Simulate(args)) => logs::run_simulate(&args),
+        Some(Command::Sensitivity(args)) => monte_carlo::run_sensitivity(&args),
+        Some(Command::Merge(args)) => monte_carlo::run_merge(&args),
+        Some(Command::Calibrate(args)) => logs::run_calibrate(&args),
+        Some(Command::Config) => {
+            print!("{DEFAULT_TOML}");
+            Ok(())
+        }
+    }
+}
+
+/// The configuration named by `args` with its command-line overrides, validated into a model.
+pub(crate) fn load_model(
+    args: &ModelArgs,
+    case: &CaseArgs,
+    realizations: Option<u64>,
+) -> Result<Model, ConfigError> {
+    let text = args.config.as_deref().map(ConfigText::read).transpose()?;
+    let mut config = match &text {
+        Some(t) => t.parse()?,
+        None => Config::default(),
+    };
+    if let Some(t) = case.truth {
+        config.ensemble.truth = t;
+    }
+    if let Some(o) = case.accelerometer_output {
+        config.accelerometer.output = o;
+    }
+    if let Some(s) = args.seed {
+        config.ensemble.seed = s;
+    }
+    if let Some(n) = realizations {
+        config.ensemble.realizations = n;
+    }
+    // A value set on the command line is not the file's: its error points at no line.
+    let from_flags: Vec<&str> = [
+        ("ensemble.truth", case.truth.is_some()),
+        ("accelerometer.output", case.accelerometer_output.is_some()),
+        ("ensemble.seed", args.seed.is_some()),
+        ("ensemble.realizations", realizations.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(field, set)| set.then_some(field))
+    .collect();
+    Model::new(&config).map_err(|e| match (&text, &e) {
+        (Some(t), ConfigError::Invalid { field, .. }) if !from_flags.contains(field) => t.locate(e),
+        _ => e,
+    })
+}
+
+/// A progress bar on standard error when it is a terminal and not silenced, hidden otherwise.
+pub(crate) struct Bar {
+    quiet: bool,
+    bar: Option<ProgressBar>,
+}
+
+impl Bar {
+    pub(crate) fn new(quiet: bool) -> Self {
+        Self {
+            quiet: quiet || !std::io::stderr().is_terminal(),
+            bar: None,
+        }
+    }
+}
+
+impl Progress for Bar {
+    fn start(&mut self, label: &str, total: u64) {
+        if self.quiet {
+            return;
+        }
+        let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{prefix:>9} [{bar:40}] {pos}/{len} realizations, {elapsed} elapsed, eta {eta}",
+            )
+            .expect("valid template")
+            .progress_chars("=> "),
+        );
+        bar.set_prefix(label.to_string());
+        self.bar = Some(bar);
+    }
+
+    fn advance(&mut self, done: u64) {
+        if let Some(bar) = &self.bar {
+            bar.set_position(done);
+        }
+    }
+
+    fn finish(&mut self) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// One line per check: id, verdict, worst against bound.
+pub(crate) fn verdict_lines(label: &str, run: &EnsembleRun, v: &Verdicts) -> String {
+    let mut s = format!(
+        "{label}, N = {}: {} ({:.0} realizations/s; study-wide false-alarm rate {})\n",
+        run.stats.realizations,
+        if v.all_passed() {
+            "every check passed"
+        } else if v.failed().next().is_some() {
+            "some checks failed"
+        } else {
+            "some checks are untestable"
+        },
+        run.realizations_per_s(),
+        sig(v.false_alarm_rate, 2)
+    );
+    for c in &v.checks {
+        let verdict = match c.verdict {
+            Verdict::Pass => "pass".to_string(),
+            Verdict::Fail => "FAIL".to_string(),
+            Verdict::Untestable(Untestable::TooFewRealizations { needs }) => format!(
+                "untestable at N = {}, needs N ≥ {}",
+                run.stats.realizations, needs
+            ),
+            Verdict::Untestable(Untestable::NoMembers) => {
+                "untestable: no member could be computed".to_string()
+            }
+        };
+        let band = if c.is_normal() {
+            format!("|z| ≤ {}", sig(c.upper, 5))
+        } else {
+            format!("[{}, {}]", sig(c.lower, 5), sig(c.upper, 5))
+        };
+        s.push_str(&format!(
+            "  {:<22} {verdict}  worst {:>10}  band {:<22}  ({} of {} members outside)\n",
+            c.id.name(),
+            sig(c.worst_value(), 5),
+            band,
+            count(c.failures as u64),
+            count(c.members as u64)
+        ));
+    }
+    s
+}
+
+pub(crate) fn write(path: &Path, bytes: &[u8]) -> Result<()> {
+    Ok(write_atomic(path, bytes)?)
+}

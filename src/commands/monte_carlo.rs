@@ -1,0 +1,275 @@
+//! The commands of the Monte Carlo study: the report, one ensemble or one shard of it, the merge
+//! of shards, and the sensitivity study.
+
+use std::path::Path;
+
+use super::{Bar, load_model, verdict_lines, write};
+use crate::cli::{CaseArgs, EnsembleArgs, MergeArgs, ReportArgs, SensitivityArgs};
+use accelcal::config::Config;
+use accelcal::ensemble::{self, EnsembleRun, EnsembleStats, Partition, partial};
+use accelcal::error::ConfigError;
+use accelcal::filter::FilterSchedule;
+use accelcal::model::Model;
+use accelcal::output::write_all_atomic;
+use accelcal::sensitivity::{self, AssumedStatistic, Plan};
+use accelcal::study::{self, Progress, Study};
+use accelcal::{export, report};
+use anyhow::Result;
+
+pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
+    let model = load_model(&args.model, &CaseArgs::default(), args.realizations)?;
+    let mut bar = Bar::new(args.model.quiet);
+    let study = Study::run(&model, &mut bar)?.with_sensitivity(&mut bar)?;
+    let command = reproduce_command(args);
+    let page = report::render(&study, &command)?;
+    let data = export::report_data_json(&study);
+    write_all_atomic(
+        &args.out,
+        &[
+            ("index.html", page.html.as_bytes()),
+            ("data.json", data.as_bytes()),
+            ("view.json", page.view_json.as_bytes()),
+        ],
+    )?;
+    for o in &study.cases {
+        print!(
+            "{}",
+            verdict_lines(&o.case.to_string(), &o.run, &o.verdicts)
+        );
+    }
+    println!(
+        "report written to {}",
+        args.out.join("index.html").display()
+    );
+    Ok(())
+}
+
+/// The command line that reproduces a report.
+fn reproduce_command(args: &ReportArgs) -> String {
+    let mut s = String::from("accelcal report");
+    if let Some(c) = &args.model.config {
+        s.push_str(&format!(" --config {}", c.display()));
+    }
+    if let Some(seed) = args.model.seed {
+        s.push_str(&format!(" --seed {seed}"));
+    }
+    if let Some(n) = args.realizations {
+        s.push_str(&format!(" --realizations {n}"));
+    }
+    s
+}
+
+pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
+    let model = load_model(&args.model, &args.case, args.realizations)?;
+    let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
+    if let (Some(shard), Some(path)) = (&args.shard, &args.partial) {
+        return run_shard(&model, &schedule, shard, path, args.model.quiet);
+    }
+    let outcome = study::run_case(&model, &schedule, &mut Bar::new(args.model.quiet));
+    let doc = export::ensemble_doc(&model.config, &schedule, &outcome);
+    let json = export::ensemble_json(&model.config, &doc);
+    match &args.json {
+        Some(path) => {
+            write(path, json.as_bytes())?;
+            let label = model.case().to_string();
+            print!("{}", verdict_lines(&label, &outcome.run, &outcome.verdicts));
+        }
+        None => println!("{json}"),
+    }
+    Ok(())
+}
+
+/// The sensitivity plan of `args` on `config`, or the option that is out of range.
+fn sensitivity_plan(args: &SensitivityArgs, config: &Config) -> Result<Plan, ConfigError> {
+    let factors = args
+        .factors
+        .clone()
+        .unwrap_or_else(|| config.sensitivity.factors.clone());
+    if factors.is_empty() {
+        return Err(ConfigError::invalid(
+            "--factors",
+            "(empty)",
+            "must list at least one factor",
+        ));
+    }
+    if let Some(f) = factors
+        .iter()
+        .find(|f| !(f.is_finite() && **f > 0.0 && **f <= 1e3))
+    {
+        return Err(ConfigError::invalid(
+            "--factors",
+            f,
+            "every factor must be a finite number in (0, 1000]",
+        ));
+    }
+    let parameters = if args.parameters.is_empty() {
+        AssumedStatistic::ALL.to_vec()
+    } else {
+        args.parameters
+            .iter()
+            .map(|p| {
+                AssumedStatistic::from_name(p).ok_or_else(|| {
+                    ConfigError::invalid(
+                        "--parameters",
+                        p,
+                        format!(
+                            "must be keys of [filter]: {}",
+                            AssumedStatistic::ALL.map(|s| s.name()).join(", ")
+                        ),
+                    )
+                })
+            })
+            .collect::<Result<_, _>>()?
+    };
+    Ok(Plan {
+        parameters,
+        factors,
+        realizations: config.ensemble.realizations,
+        ensembles: args.ensembles.unwrap_or(config.sensitivity.ensembles),
+    })
+}
+
+pub(super) fn run_sensitivity(args: &SensitivityArgs) -> Result<()> {
+    let model = load_model(&args.model, &CaseArgs::default(), args.realizations)?;
+    let plan = sensitivity_plan(args, &model.config)?;
+    let result = sensitivity::run(&model.config, &plan, &mut Bar::new(args.model.quiet))?;
+    let json = export::sensitivity::sensitivity_json(&result);
+    match &args.json {
+        Some(path) => {
+            write(path, json.as_bytes())?;
+            println!("{} cases written to {}", result.cases.len(), path.display());
+        }
+        None => println!("{json}"),
+    }
+    Ok(())
+}
+
+/// "K/M" as (K, M), with 1 ≤ K ≤ M ≤ the blocks of `partition`.
+fn parse_shard(text: &str, partition: &Partition) -> Result<(u64, u64), ConfigError> {
+    let expected = format!(
+        "must be K/M with whole numbers 1 ≤ K ≤ M ≤ {} (the blocks of N = {})",
+        partition.blocks, partition.realizations
+    );
+    let parsed = text
+        .split_once('/')
+        .and_then(|(k, m)| Some((k.trim().parse::<u64>().ok()?, m.trim().parse::<u64>().ok()?)));
+    match parsed {
+        Some((k, m)) if 1 <= k && k <= m && m <= partition.blocks => Ok((k, m)),
+        _ => Err(ConfigError::invalid("--shard", text, expected)),
+    }
+}
+
+fn run_shard(
+    model: &Model,
+    schedule: &FilterSchedule,
+    shard: &str,
+    path: &Path,
+    quiet: bool,
+) -> Result<()> {
+    let e = &model.config.ensemble;
+    let partition = Partition::new(e.realizations);
+    let (k, m) = parse_shard(shard, &partition)?;
+    let blocks = partition.shard_blocks(k, m);
+    let layout = ensemble::layout_of(model);
+    let mut file = accelcal::output::AtomicFile::create(path)?;
+    let mut header = partial::PartialHeader {
+        accelcal_version: env!("CARGO_PKG_VERSION").to_string(),
+        config: model.config.clone(),
+        shard: k,
+        shards: m,
+        blocks: [blocks.start, blocks.end],
+        fixes: layout.fixes(),
+        max_lag: layout.max_lag(),
+        pair: model.residual_pair,
+        elapsed_s: 0.0,
+    };
+    let mut bar = Bar::new(quiet);
+    bar.start(
+        &format!("shard {k}/{m}"),
+        partition.realizations_in(&blocks),
+    );
+    let start = std::time::Instant::now();
+    let mut written = Ok(());
+    // The header carries the run time, so blocks wait in a second temporary until the run ends.
+    let spool = tempfile_beside(path)?;
+    let mut spool_w = std::io::BufWriter::new(std::fs::File::create(&spool)?);
+    ensemble::run_blocks(
+        model,
+        schedule,
+        e.seed,
+        e.realizations,
+        blocks.clone(),
+        |done| bar.advance(done),
+        |index, acc| {
+            if written.is_ok() {
+                written = partial::write_block(&mut spool_w, index, &acc);
+            }
+        },
+    );
+    bar.finish();
+    header.elapsed_s = start.elapsed().as_secs_f64();
+    let result = (|| -> Result<()> {
+        written?;
+        use std::io::Write;
+        spool_w.flush()?;
+        drop(spool_w);
+        partial::write_header(file.writer(), &header)?;
+        std::io::copy(&mut std::fs::File::open(&spool)?, file.writer())?;
+        file.commit()?;
+        Ok(())
+    })();
+    let _ = std::fs::remove_file(&spool);
+    result?;
+    if !quiet {
+        println!(
+            "shard {k}/{m}: blocks {}..{} ({} realizations) written to {}",
+            blocks.start,
+            blocks.end,
+            partition.realizations_in(&blocks),
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// A temporary file name beside `path` for spooled output.
+fn tempfile_beside(path: &Path) -> Result<std::path::PathBuf> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    Ok(path.with_file_name(format!(".{name}.{}.blocks", std::process::id())))
+}
+
+pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
+    let mut files = Vec::with_capacity(args.files.len());
+    for path in &args.files {
+        let name = path.display().to_string();
+        let file = std::fs::File::open(path).map_err(|e| partial::PartialError::Format {
+            file: name.clone(),
+            why: format!("cannot open: {e}"),
+        })?;
+        files.push((name, std::io::BufReader::new(file)));
+    }
+    let merged = partial::merge(files)?;
+    let model = Model::new(&merged.config)?;
+    let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
+    let run = EnsembleRun {
+        stats: EnsembleStats::from_sums(&merged.sums, &schedule),
+        elapsed_s: merged.elapsed_s,
+    };
+    let outcome = study::judge_case(&model, &schedule, run);
+    let doc = export::ensemble_doc(&model.config, &schedule, &outcome);
+    let json = export::ensemble_json(&model.config, &doc);
+    match &args.json {
+        Some(path) => {
+            write(path, json.as_bytes())?;
+            if !args.quiet {
+                let label = format!("{} (merged from {} shards)", model.case(), args.files.len());
+                print!("{}", verdict_lines(&label, &outcome.run, &outcome.verdicts));
+            }
+        }
+        None => println!("{json}"),
+    }
+    Ok(())
+}

@@ -1,0 +1,120 @@
+//! The simulated worlds: which truth model produces the trajectory, and what the accelerometer
+//! reports.
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+/// Which model produces the true position and velocity.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum TruthModel {
+    /// Closed-form integral of the acceleration profile, eq. (1) of the problem statement.
+    Analytic,
+    /// The true acceleration integrated with the accelerometer's Euler formula, eq. (4): the error
+    /// dynamics of eq. (5) are then exact.
+    Euler,
+}
+
+impl TruthModel {
+    /// Both models, in the order the report presents them.
+    pub const ALL: [TruthModel; 2] = [TruthModel::Analytic, TruthModel::Euler];
+
+    /// The lowercase name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            TruthModel::Analytic => "analytic",
+            TruthModel::Euler => "euler",
+        }
+    }
+}
+
+impl fmt::Display for TruthModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What the accelerometer reports at each sample t_j.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum AccelerometerOutput {
+    /// The acceleration at the sample time: a_c(t_j) = a(t_j) + b + w(t_j), eq. (2) of the
+    /// problem statement.
+    #[default]
+    #[value(name = "sample")]
+    Sample,
+    /// The mean acceleration over the sample interval, as a strapdown IMU's delta-velocity
+    /// output gives it: a_c(t_j) = (1/Δt)∫ a dt over [t_j, t_j + Δt] + b + w(t_j). The Euler
+    /// velocity integration is then exact.
+    #[value(name = "interval_mean")]
+    IntervalMean,
+}
+
+impl AccelerometerOutput {
+    /// The name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            AccelerometerOutput::Sample => "sample",
+            AccelerometerOutput::IntervalMean => "interval_mean",
+        }
+    }
+}
+
+impl fmt::Display for AccelerometerOutput {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One simulated world: a truth model and an accelerometer output. Each case draws from its own
+/// random streams, so the verdicts of different cases are independent evidence.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Case {
+    /// How the true position and velocity are produced.
+    pub truth: TruthModel,
+    /// What the accelerometer reports.
+    pub output: AccelerometerOutput,
+}
+
+impl Case {
+    /// The cases of the report, in order: the world the filter's model assumes, the closed-form
+    /// physics with point samples, and the closed-form physics with interval means.
+    pub const REPORT: [Case; 3] = [
+        Case {
+            truth: TruthModel::Euler,
+            output: AccelerometerOutput::Sample,
+        },
+        Case {
+            truth: TruthModel::Analytic,
+            output: AccelerometerOutput::Sample,
+        },
+        Case {
+            truth: TruthModel::Analytic,
+            output: AccelerometerOutput::IntervalMean,
+        },
+    ];
+
+    /// A number that tells the case's random streams apart from every other case's.
+    pub fn stream_key(self) -> u64 {
+        match (self.truth, self.output) {
+            (TruthModel::Analytic, AccelerometerOutput::Sample) => 0,
+            (TruthModel::Euler, AccelerometerOutput::Sample) => 1,
+            (TruthModel::Analytic, AccelerometerOutput::IntervalMean) => 2,
+            (TruthModel::Euler, AccelerometerOutput::IntervalMean) => 3,
+        }
+    }
+
+    /// A stable identifier, e.g. `analytic-interval_mean`.
+    pub fn id(self) -> String {
+        format!("{}-{}", self.truth, self.output)
+    }
+}
+
+impl fmt::Display for Case {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} truth, {} output", self.truth, self.output)
+    }
+}

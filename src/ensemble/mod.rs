@@ -1,0 +1,256 @@
+//! The Monte Carlo ensemble: N realizations run in parallel and accumulated as they are produced.
+//!
+//! Memory does not grow with N: realizations are grouped into chunks of [`CHUNK`] consecutive
+//! indices, each chunk is summed into its own [`Accumulator`], and chunk accumulators are merged
+//! into the total in chunk order. The chunk boundaries depend on N alone, so the result is
+//! bit-for-bit the same on one thread or many.
+
+mod layout;
+pub mod partial;
+mod stats;
+mod sums;
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use crate::filter::FilterSchedule;
+use crate::model::Model;
+use crate::simulation::{FixState, Observer, run_realization};
+pub use layout::ResidualLayout;
+pub use stats::{EnsembleStats, FixStats, StageStats};
+use sums::BATCH;
+pub use sums::{Accumulator, FixSums, StageSums};
+
+/// Realizations summed sequentially into one accumulator before it is merged.
+pub const CHUNK: u64 = 64;
+
+/// Memory the chunk accumulators in flight may take together, bytes.
+const WINDOW_BYTES: u64 = 256 << 20;
+
+/// Feeds one realization's fixes into an [`Accumulator`].
+struct Summer<'a> {
+    acc: &'a mut Accumulator,
+    schedule: &'a FilterSchedule,
+    /// This realization's residuals, stacked: (r_p(t_0), r_v(t_0), r_p(t_1), …).
+    stacked: &'a mut [f64],
+}
+
+impl Observer for Summer<'_> {
+    #[inline]
+    fn fix(&mut self, f: &FixState) {
+        let cov = &self.schedule.fixes[f.index];
+        let sums = &mut self.acc.fixes[f.index];
+        sums.prior
+            .add(&(f.delta_x - f.prior), &f.prior, &cov.p_prior_inv);
+        sums.post
+            .add(&(f.delta_x - f.post), &f.post, &cov.p_post_inv);
+        sums.nis += f.residual.dot(&(cov.s_inv * f.residual));
+        self.stacked[2 * f.index] = f.residual[0];
+        self.stacked[2 * f.index + 1] = f.residual[1];
+    }
+}
+
+/// The residual layout of `model`'s ensemble.
+pub fn layout_of(model: &Model) -> ResidualLayout {
+    ResidualLayout::new(model.timeline.fixes(), model.residual_max_lag())
+}
+
+/// Sums realizations `range` of `model` into a fresh accumulator.
+pub fn accumulate(
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    range: std::ops::Range<u64>,
+) -> Accumulator {
+    let m = 2 * model.timeline.fixes();
+    let mut acc = Accumulator::new(&layout_of(model), model.residual_pair);
+    let mut batch = vec![0.0; BATCH * m];
+    let mut filled = 0;
+    for l in range {
+        let mut summer = Summer {
+            acc: &mut acc,
+            schedule,
+            stacked: &mut batch[filled * m..(filled + 1) * m],
+        };
+        run_realization(model, schedule, seed, l, &mut summer);
+        acc.count += 1;
+        filled += 1;
+        if filled == BATCH {
+            acc.add_residual_batch(&mut batch, filled);
+            filled = 0;
+        }
+    }
+    if filled > 0 {
+        acc.add_residual_batch(&mut batch, filled);
+    }
+    acc
+}
+
+/// Largest number of blocks an ensemble is folded in. Blocks are the unit of sharding.
+pub const MAX_BLOCKS: u64 = 256;
+
+/// How the N realizations of an ensemble are grouped, by N alone: chunks of [`CHUNK`]
+/// consecutive indices, each summed into its own accumulator; blocks of consecutive chunks,
+/// each the fold of its chunks in order; the ensemble is the fold of its blocks in order. A
+/// shard runs whole blocks, so shards merged in block order give the sums of one run, number
+/// for number.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Partition {
+    /// Realizations N.
+    pub realizations: u64,
+    /// Chunks, ⌈N / CHUNK⌉.
+    pub chunks: u64,
+    /// Chunks per block, ⌈chunks / MAX_BLOCKS⌉.
+    pub chunks_per_block: u64,
+    /// Blocks, at most [`MAX_BLOCKS`].
+    pub blocks: u64,
+}
+
+impl Partition {
+    /// The partition of `n` realizations.
+    pub fn new(n: u64) -> Self {
+        let chunks = n.div_ceil(CHUNK);
+        let chunks_per_block = chunks.div_ceil(MAX_BLOCKS).max(1);
+        Self {
+            realizations: n,
+            chunks,
+            chunks_per_block,
+            blocks: chunks.div_ceil(chunks_per_block),
+        }
+    }
+
+    /// The chunks of block `b`.
+    pub fn block_chunks(&self, b: u64) -> std::ops::Range<u64> {
+        b * self.chunks_per_block..((b + 1) * self.chunks_per_block).min(self.chunks)
+    }
+
+    /// The realization indices of chunk `c`.
+    pub fn chunk_realizations(&self, c: u64) -> std::ops::Range<u64> {
+        c * CHUNK..((c + 1) * CHUNK).min(self.realizations)
+    }
+
+    /// The realizations of blocks `blocks`.
+    pub fn realizations_in(&self, blocks: &std::ops::Range<u64>) -> u64 {
+        if blocks.is_empty() {
+            return 0;
+        }
+        let first = self.block_chunks(blocks.start).start;
+        let last = self.block_chunks(blocks.end - 1).end;
+        self.chunk_realizations(last - 1).end - self.chunk_realizations(first).start
+    }
+
+    /// The blocks of shard `k` of `m`, k counted from 1: blocks ⌊(k − 1)·B/m⌋ up to ⌊k·B/m⌋.
+    pub fn shard_blocks(&self, k: u64, m: u64) -> std::ops::Range<u64> {
+        (k - 1) * self.blocks / m..k * self.blocks / m
+    }
+}
+
+/// Runs blocks `blocks` of the `n` realizations of `model` under `seed` in parallel, and hands
+/// each block's sums to `on_block` as it is finished, in block order. `progress` is called with
+/// the number of realizations of these blocks finished so far.
+pub fn run_blocks(
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    n: u64,
+    blocks: std::ops::Range<u64>,
+    mut progress: impl FnMut(u64),
+    mut on_block: impl FnMut(u64, Accumulator),
+) {
+    let partition = Partition::new(n);
+    let layout = layout_of(model);
+    // A window of chunks in flight at once; only its size depends on the thread count, never the
+    // chunk boundaries nor the merge order. At most WINDOW_BYTES of accumulators are alive.
+    let acc_bytes = 8 * (layout.len() + 51 * layout.fixes()).max(1) as u64;
+    let threads = rayon::current_num_threads() as u64;
+    let window = (4 * threads)
+        .min((WINDOW_BYTES / acc_bytes).max(threads))
+        .max(1);
+    if blocks.is_empty() {
+        return;
+    }
+    let chunks =
+        partition.block_chunks(blocks.start).start..partition.block_chunks(blocks.end - 1).end;
+    let mut block = blocks.start;
+    let mut sums = Accumulator::new(&layout, model.residual_pair);
+    let mut done = 0;
+    let mut first = chunks.start;
+    while first < chunks.end {
+        let last = (first + window).min(chunks.end);
+        let parts: Vec<Accumulator> = (first..last)
+            .into_par_iter()
+            .map(|c| accumulate(model, schedule, seed, partition.chunk_realizations(c)))
+            .collect();
+        for (c, part) in (first..last).zip(&parts) {
+            sums.merge(part);
+            done += part.count;
+            if c + 1 == partition.block_chunks(block).end {
+                let finished =
+                    std::mem::replace(&mut sums, Accumulator::new(&layout, model.residual_pair));
+                on_block(block, finished);
+                block += 1;
+            }
+        }
+        progress(done);
+        first = last;
+    }
+}
+
+/// Runs `n` realizations of `model` under `seed` in parallel and returns their sums, the fold
+/// of every block in order. `progress` is called with the number of realizations finished so
+/// far.
+pub fn run(
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    n: u64,
+    progress: impl FnMut(u64),
+) -> Accumulator {
+    let mut total = Accumulator::new(&layout_of(model), model.residual_pair);
+    run_blocks(
+        model,
+        schedule,
+        seed,
+        n,
+        0..Partition::new(n).blocks,
+        progress,
+        |_, block| total.merge(&block),
+    );
+    total
+}
+
+/// A finished ensemble: its statistics and how fast it ran.
+#[derive(Clone, Debug)]
+pub struct EnsembleRun {
+    /// The ensemble statistics.
+    pub stats: EnsembleStats,
+    /// Wall-clock time of the realizations, s.
+    pub elapsed_s: f64,
+}
+
+impl EnsembleRun {
+    /// Realizations per second.
+    pub fn realizations_per_s(&self) -> f64 {
+        self.stats.realizations as f64 / self.elapsed_s
+    }
+}
+
+/// Runs the ensemble of `model` with its configured size and seed.
+pub fn run_model(
+    model: &Model,
+    schedule: &FilterSchedule,
+    progress: impl FnMut(u64),
+) -> EnsembleRun {
+    let e = &model.config.ensemble;
+    let start = Instant::now();
+    let acc = run(model, schedule, e.seed, e.realizations, progress);
+    let elapsed_s = start.elapsed().as_secs_f64();
+    EnsembleRun {
+        stats: EnsembleStats::from_sums(&acc, schedule),
+        elapsed_s,
+    }
+}
+
+#[cfg(test)]
+mod tests;

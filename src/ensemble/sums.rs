@@ -1,0 +1,171 @@
+//! Running sums of an ensemble: everything the statistics need, added one realization at a time
+//! and merged chunk by chunk, with no per-realization storage.
+
+use super::layout::ResidualLayout;
+use crate::filter::{Matrix3, Vector3};
+
+/// Running sums over realizations of one estimate stage (a priori or a posteriori) at one fix.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StageSums {
+    /// Σ e, e = δx − δx̂.
+    pub e: Vector3,
+    /// Σ e·eᵀ, upper triangle in the order (00, 01, 02, 11, 12, 22).
+    pub ee: [f64; 6],
+    /// Σ e·δx̂ᵀ.
+    pub ex: Matrix3,
+    /// Σ δx̂.
+    pub x: Vector3,
+    /// Σ δx̂_k², the diagonal of Σ δx̂·δx̂ᵀ.
+    pub xx: Vector3,
+    /// Σ eᵀ·P⁻¹·e (the normalized estimation error squared).
+    pub nees: f64,
+}
+
+/// Upper-triangle index pairs of a symmetric 3×3 matrix, in [`StageSums::ee`] order.
+const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+impl StageSums {
+    #[inline]
+    pub(super) fn add(&mut self, e: &Vector3, x: &Vector3, p_inv: &Matrix3) {
+        self.e += e;
+        let mut nees = 0.0;
+        for (s, &(r, c)) in self.ee.iter_mut().zip(&UPPER) {
+            let prod = e[r] * e[c];
+            *s += prod;
+            // eᵀP⁻¹e over the upper triangle: off-diagonal terms count twice.
+            nees += if r == c { 1.0 } else { 2.0 } * p_inv[(r, c)] * prod;
+        }
+        self.ex += e * x.transpose();
+        self.x += x;
+        self.xx += x.component_mul(x);
+        self.nees += nees;
+    }
+
+    /// Σ e·eᵀ as a full matrix.
+    pub fn ee_matrix(&self) -> Matrix3 {
+        let mut m = Matrix3::zeros();
+        for (v, &(r, c)) in self.ee.iter().zip(&UPPER) {
+            m[(r, c)] = *v;
+            m[(c, r)] = *v;
+        }
+        m
+    }
+
+    fn merge(&mut self, o: &Self) {
+        self.e += o.e;
+        for (a, b) in self.ee.iter_mut().zip(&o.ee) {
+            *a += b;
+        }
+        self.ex += o.ex;
+        self.x += o.x;
+        self.xx += o.xx;
+        self.nees += o.nees;
+    }
+}
+
+/// Running sums at one fix.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FixSums {
+    /// Sums of the a priori stage.
+    pub prior: StageSums,
+    /// Sums of the a posteriori stage.
+    pub post: StageSums,
+    /// Σ rᵀ·S⁻¹·r (the normalized innovation squared).
+    pub nis: f64,
+}
+
+/// Running sums of an ensemble, or of part of one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Accumulator {
+    /// Realizations summed.
+    pub count: u64,
+    /// One entry per fix.
+    pub fixes: Vec<FixSums>,
+    /// Which residual products are kept.
+    pub layout: ResidualLayout,
+    /// Σ ρ·ρᵀ over realizations, where ρ = (r(t_0), r(t_1), …) stacks every residual: the kept
+    /// part of the lower triangle, diagonal included (see [`ResidualLayout`]).
+    pub residual_products: Vec<f64>,
+    /// The fix indices [m, i] of the statement's single residual pair.
+    pub pair: [usize; 2],
+    /// Σ r_j(t_i)·r_k(t_m) of the single pair, row-major (j, k), kept whatever the layout.
+    pub pair_products: [f64; 4],
+}
+
+impl Accumulator {
+    /// Empty sums with the residual products of `layout` and the single pair `pair`.
+    pub fn new(layout: &ResidualLayout, pair: [usize; 2]) -> Self {
+        Self {
+            count: 0,
+            fixes: vec![FixSums::default(); layout.fixes()],
+            residual_products: vec![0.0; layout.len()],
+            layout: layout.clone(),
+            pair,
+            pair_products: [0.0; 4],
+        }
+    }
+
+    /// Adds `other` to these sums.
+    ///
+    /// # Panics
+    /// When the two sums do not have the same layout and pair.
+    pub fn merge(&mut self, other: &Self) {
+        assert!(
+            self.layout == other.layout && self.pair == other.pair,
+            "sums of different ensembles"
+        );
+        self.count += other.count;
+        for (a, b) in self.pair_products.iter_mut().zip(&other.pair_products) {
+            *a += b;
+        }
+        for (a, b) in self.fixes.iter_mut().zip(&other.fixes) {
+            a.prior.merge(&b.prior);
+            a.post.merge(&b.post);
+            a.nis += b.nis;
+        }
+        for (a, b) in self
+            .residual_products
+            .iter_mut()
+            .zip(&other.residual_products)
+        {
+            *a += b;
+        }
+    }
+
+    /// Adds Σ_q ρ_q·ρ_qᵀ over the stacked residual vectors of a batch (the first `filled` rows of
+    /// `batch`, each of length 2·fixes). Batching reads and writes the large packed triangle once
+    /// per [`BATCH`] realizations instead of once per realization.
+    pub(super) fn add_residual_batch(&mut self, batch: &mut [f64], filled: usize) {
+        let m = 2 * self.fixes.len();
+        debug_assert_eq!(batch.len(), BATCH * m);
+        // Unused rows contribute nothing: zero them so the fixed-size inner loop stays exact.
+        batch[filled * m..].fill(0.0);
+        let rows: [&[f64]; BATCH] = std::array::from_fn(|q| &batch[q * m..(q + 1) * m]);
+        let [pm, pi] = self.pair;
+        for row in rows.iter().take(filled) {
+            for (c, p) in self.pair_products.iter_mut().enumerate() {
+                *p += row[2 * pi + c / 2] * row[2 * pm + c % 2];
+            }
+        }
+        let mut start = 0;
+        for a in 0..m {
+            let first = self.layout.first_col(a);
+            let len = a + 1 - first;
+            let coef: [f64; BATCH] = std::array::from_fn(|q| rows[q][a]);
+            let dst = &mut self.residual_products[start..start + len];
+            let cols: [&[f64]; BATCH] = std::array::from_fn(|q| &rows[q][first..=a]);
+            // Row a += Σ_q ρ_q[a] · ρ_q[first..=a].
+            for (b, d) in dst.iter_mut().enumerate() {
+                let mut s = 0.0;
+                for q in 0..BATCH {
+                    s += coef[q] * cols[q][b];
+                }
+                *d += s;
+            }
+            start += len;
+        }
+    }
+}
+
+/// Realizations whose residual products are accumulated in one pass.
+pub(super) const BATCH: usize = 8;

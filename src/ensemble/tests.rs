@@ -1,0 +1,98 @@
+use super::*;
+
+use crate::config::Config;
+use crate::filter::Vector3;
+
+fn small() -> (Model, FilterSchedule) {
+    let mut c = Config::default();
+    c.profile.duration_s = 2.0;
+    let m = Model::new(&c).unwrap();
+    let s = FilterSchedule::new(&m.timeline, &m.filter_stats).unwrap();
+    (m, s)
+}
+
+#[test]
+fn merged_chunks_equal_one_pass_up_to_rounding() {
+    let (m, s) = small();
+    let whole = accumulate(&m, &s, 5, 0..300);
+    let mut parts = accumulate(&m, &s, 5, 0..100);
+    parts.merge(&accumulate(&m, &s, 5, 100..300));
+    assert_eq!(whole.count, parts.count);
+    for (a, b) in whole.residual_products.iter().zip(&parts.residual_products) {
+        assert!((a - b).abs() <= 1e-9 * a.abs().max(1.0));
+    }
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(1.0);
+    for (a, b) in whole.fixes.iter().zip(&parts.fixes) {
+        for (x, y) in [(&a.prior, &b.prior), (&a.post, &b.post)] {
+            assert!(x.e.iter().zip(y.e.iter()).all(|(p, q)| close(*p, *q)));
+            assert!(x.ee.iter().zip(&y.ee).all(|(p, q)| close(*p, *q)));
+            assert!(x.ex.iter().zip(y.ex.iter()).all(|(p, q)| close(*p, *q)));
+            assert!(x.xx.iter().zip(y.xx.iter()).all(|(p, q)| close(*p, *q)));
+            assert!(close(x.nees, y.nees));
+        }
+        assert!(close(a.nis, b.nis));
+    }
+}
+
+#[test]
+fn parallel_run_is_independent_of_the_thread_count() {
+    let (m, s) = small();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let three = rayon::ThreadPoolBuilder::new()
+        .num_threads(3)
+        .build()
+        .unwrap();
+    let a = one.install(|| run(&m, &s, 9, 1000, |_| {}));
+    let b = three.install(|| run(&m, &s, 9, 1000, |_| {}));
+    assert_eq!(a, b);
+}
+
+#[test]
+fn streaming_moments_match_a_two_pass_computation() {
+    struct Keep(Vec<FixState>);
+    impl Observer for Keep {
+        fn fix(&mut self, f: &FixState) {
+            self.0.push(*f);
+        }
+    }
+    let (m, s) = small();
+    let n = 200u64;
+    let stats = EnsembleStats::from_sums(&accumulate(&m, &s, 3, 0..n), &s);
+    let runs: Vec<Vec<FixState>> = (0..n)
+        .map(|l| {
+            let mut k = Keep(Vec::new());
+            run_realization(&m, &s, 3, l, &mut k);
+            k.0
+        })
+        .collect();
+    let i = 4;
+    let errs: Vec<Vector3> = runs.iter().map(|r| r[i].delta_x - r[i].post).collect();
+    let mean = errs.iter().sum::<Vector3>() / n as f64;
+    let var_v = errs.iter().map(|e| (e[1] - mean[1]).powi(2)).sum::<f64>() / (n as f64 - 1.0);
+    let got = &stats.fixes[i].post;
+    approx::assert_relative_eq!(got.mean_error[1], mean[1], max_relative = 1e-9);
+    approx::assert_relative_eq!(got.ensemble_cov[1][1], var_v, max_relative = 1e-9);
+    // Orthogonality (1/N) Σ (e − ē) x̂ᵀ, entry (velocity error, bias estimate).
+    let xs: Vec<Vector3> = runs.iter().map(|r| r[i].post).collect();
+    let ortho = errs
+        .iter()
+        .zip(&xs)
+        .map(|(e, x)| (e[1] - mean[1]) * x[2])
+        .sum::<f64>()
+        / n as f64;
+    approx::assert_relative_eq!(got.orthogonality[1][2], ortho, max_relative = 1e-8);
+    // NEES (1/N) Σ eᵀ P⁻¹ e with the filter's a posteriori P.
+    let p_inv = s.fixes[i].p_post.try_inverse().unwrap();
+    let nees = errs.iter().map(|e| e.dot(&(p_inv * e))).sum::<f64>() / n as f64;
+    approx::assert_relative_eq!(got.nees_avg, nees, max_relative = 1e-8);
+    let r = |l: usize, a: usize| runs[l][a / 2].residual[a % 2];
+    let m12: f64 = (0..n as usize).map(|l| r(l, 7) * r(l, 2)).sum::<f64>() / n as f64;
+    approx::assert_relative_eq!(
+        stats.residual_moment(2, 7).unwrap(),
+        m12,
+        max_relative = 1e-9
+    );
+}

@@ -1,0 +1,110 @@
+//! The sensitivity study as JSON: the data contract of `accelcal sensitivity --json` and of
+//! data.json's `sensitivity`.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::FinalSigma;
+use crate::checks::CheckId;
+use crate::sensitivity::Sensitivity;
+
+/// One statistic at one factor.
+#[derive(Clone, Debug, Serialize)]
+pub struct CaseRecord {
+    /// The `[filter]` key varied.
+    pub parameter: &'static str,
+    /// The factor on its standard deviation.
+    pub factor: f64,
+    /// The filter's σ at the last fix.
+    pub claimed_sigma_final: FinalSigma,
+    /// The actual error's σ at the last fix.
+    pub actual_sigma_final: FinalSigma,
+    /// tr(P⁻¹·P_actual) at the last fix.
+    pub expected_nees_final: f64,
+    /// tr(S⁻¹·S_actual) at the last fix.
+    pub expected_nis_final: f64,
+    /// Probability that each check fails: predicted where closed-form, else measured.
+    pub detection: BTreeMap<&'static str, f64>,
+    /// How each detection probability was obtained: "closed_form" or "monte_carlo".
+    pub detection_method: BTreeMap<&'static str, &'static str>,
+    /// Bounds [largest member, sum of members] of each closed-form probability.
+    pub detection_bounds: BTreeMap<&'static str, [f64; 2]>,
+    /// The Monte Carlo measurement.
+    pub monte_carlo: MonteCarloRecord,
+}
+
+/// The Monte Carlo part of a [`CaseRecord`].
+#[derive(Clone, Debug, Serialize)]
+pub struct MonteCarloRecord {
+    /// Realizations per ensemble.
+    pub realizations: u64,
+    /// Independent ensembles.
+    pub ensembles: u64,
+    /// Fraction of the ensembles in which each check failed.
+    pub detected: BTreeMap<&'static str, f64>,
+}
+
+/// The whole study as written to JSON.
+#[derive(Clone, Debug, Serialize)]
+pub struct SensitivityRecord {
+    /// The study-wide false-alarm rate of the checks.
+    pub false_alarm_rate: f64,
+    /// The factors on the standard deviations.
+    pub factors: Vec<f64>,
+    /// The filter's σ at the last fix with the configured statistics.
+    pub tuned_sigma_final: FinalSigma,
+    /// One per statistic and factor.
+    pub cases: Vec<CaseRecord>,
+}
+
+/// The record of `s`.
+pub fn record(s: &Sensitivity) -> SensitivityRecord {
+    let per_check = |f: &dyn Fn(CheckId) -> Option<(&'static str, f64)>| -> BTreeMap<_, _> {
+        CheckId::ALL.iter().filter_map(|&id| f(id)).collect()
+    };
+    SensitivityRecord {
+        false_alarm_rate: s.false_alarm_rate,
+        factors: s.plan.factors.clone(),
+        tuned_sigma_final: FinalSigma::from(s.tuned_sigma_final),
+        cases: s
+            .cases
+            .iter()
+            .map(|c| CaseRecord {
+                parameter: c.parameter.name(),
+                factor: c.factor,
+                claimed_sigma_final: FinalSigma::from(c.claimed_sigma_final),
+                actual_sigma_final: FinalSigma::from(c.actual_sigma_final),
+                expected_nees_final: c.expected_nees_final,
+                expected_nis_final: c.expected_nis_final,
+                detection: per_check(&|id| Some((id.name(), c.detection(id)))),
+                detection_method: CheckId::ALL
+                    .iter()
+                    .map(|&id| {
+                        let method = match c.predicted[id.index()] {
+                            Some(_) => "closed_form",
+                            None => "monte_carlo",
+                        };
+                        (id.name(), method)
+                    })
+                    .collect(),
+                detection_bounds: CheckId::ALL
+                    .iter()
+                    .filter_map(|&id| {
+                        c.predicted[id.index()].map(|d| (id.name(), [d.lower, d.upper]))
+                    })
+                    .collect(),
+                monte_carlo: MonteCarloRecord {
+                    realizations: s.plan.realizations,
+                    ensembles: c.ensembles,
+                    detected: per_check(&|id| Some((id.name(), c.detected[id.index()]))),
+                },
+            })
+            .collect(),
+    }
+}
+
+/// Serializes the `accelcal sensitivity` output.
+pub fn sensitivity_json(s: &Sensitivity) -> String {
+    serde_json::to_string_pretty(&record(s)).expect("finite numbers serialize")
+}

@@ -1,0 +1,243 @@
+//! Logs of the sensors as CSV files with a header row: the accelerometer log, the GPS log, and
+//! the truth of a simulated run.
+//!
+//! | file | columns |
+//! |---|---|
+//! | accelerometer | `t_s,accel_m_s2`: every output a_c(t_j) |
+//! | GPS | `t_s,position_m,velocity_m_s`: every fix z_p, z_v |
+//! | truth | `t_s,position_m,velocity_m_s,bias_m_s2`: p, v, b at every sample |
+//!
+//! [`read`] streams a log row by row and refuses bad input with a [`LogError`] naming the file,
+//! the line and what was expected; [`write`](mod@write) formats every number so that it reads back bit for
+//! bit; [`steps`] finds the median time step of a log in bounded memory.
+
+pub mod read;
+pub mod steps;
+pub mod write;
+
+use thiserror::Error;
+
+/// Columns of the accelerometer log.
+pub const ACCEL_COLUMNS: [&str; 2] = ["t_s", "accel_m_s2"];
+/// Columns of the GPS log.
+pub const GPS_COLUMNS: [&str; 3] = ["t_s", "position_m", "velocity_m_s"];
+/// Columns of the truth of a simulated run.
+pub const TRUTH_COLUMNS: [&str; 4] = ["t_s", "position_m", "velocity_m_s", "bias_m_s2"];
+
+/// File name of the accelerometer log that `simulate --logs` writes.
+pub const ACCEL_FILE: &str = "accelerometer.csv";
+/// File name of the GPS log that `simulate --logs` writes.
+pub const GPS_FILE: &str = "gps.csv";
+/// File name of the truth that `simulate --logs` writes.
+pub const TRUTH_FILE: &str = "truth.csv";
+
+/// A log that cannot be accepted: the file, the line (when one is to blame) and the problem.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[error("{file}{}: {problem}", line_words(.line))]
+pub struct LogError {
+    /// The file as the user named it.
+    pub file: String,
+    /// The line, counting the header as line 1.
+    pub line: Option<u64>,
+    /// What is wrong and what was expected.
+    pub problem: LogProblem,
+}
+
+fn line_words(line: &Option<u64>) -> String {
+    line.map(|l| format!(", line {l}")).unwrap_or_default()
+}
+
+/// What is wrong with a log, with what was expected.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum LogProblem {
+    /// The operating system could not open or read the file.
+    #[error("cannot read the file: {message}")]
+    Unreadable {
+        /// The operating system's words.
+        message: String,
+    },
+    /// A line is not UTF-8 text.
+    #[error("not text: expected comma-separated numbers in UTF-8")]
+    NotText,
+    /// The file holds nothing.
+    #[error("the file is empty: expected the header `{header}` and data rows")]
+    Empty {
+        /// The expected header.
+        header: String,
+    },
+    /// A required column is not in the header.
+    #[error("the header has no column `{column}`: found `{found}`, expected `{header}`")]
+    MissingColumn {
+        /// The missing column.
+        column: &'static str,
+        /// The header as found.
+        found: String,
+        /// The expected header.
+        header: String,
+    },
+    /// A column appears twice in the header.
+    #[error("the header names the column `{column}` twice")]
+    DuplicateColumn {
+        /// The repeated column.
+        column: String,
+    },
+    /// Too few data rows.
+    #[error("found {found} data row(s) after the header; a log needs at least {needed}")]
+    TooFewRows {
+        /// Rows found.
+        found: u64,
+        /// Rows needed.
+        needed: u64,
+    },
+    /// A row with another number of fields than the header.
+    #[error("{found} comma-separated fields, expected {expected} as in the header `{header}`")]
+    FieldCount {
+        /// Fields in the header.
+        expected: usize,
+        /// Fields in the row.
+        found: usize,
+        /// The header.
+        header: String,
+    },
+    /// A field that is not a number.
+    #[error("`{column}` = `{text}` is not a number")]
+    NotANumber {
+        /// The column.
+        column: &'static str,
+        /// The field as written.
+        text: String,
+    },
+    /// A field that is NaN or infinite.
+    #[error("`{column}` = `{text}` is not a finite number")]
+    NotFinite {
+        /// The column.
+        column: &'static str,
+        /// The field as written.
+        text: String,
+    },
+    /// A time stamp not after the one before it.
+    #[error(
+        "time stamp {t_s} s is not after the previous one, {previous_s} s: time stamps must be \
+         strictly increasing"
+    )]
+    NotIncreasing {
+        /// The time stamp, s.
+        t_s: f64,
+        /// The previous time stamp, s.
+        previous_s: f64,
+    },
+    /// A step far from the median step: samples lost or repeated.
+    #[error(
+        "the step from {previous_s} s to {t_s} s is {} s, {ratio:.3} times the median step {} s: \
+         accepted steps lie between {low} and {high} times the median (a longer step is a gap, a \
+         shorter one an extra sample)",
+        crate::format::short(*.step_s),
+        crate::format::short(*.median_s),
+        low = crate::logs::steps::ACCEPTED_STEP_RATIO.0,
+        high = crate::logs::steps::ACCEPTED_STEP_RATIO.1
+    )]
+    Gap {
+        /// Time stamp of the previous sample, s.
+        previous_s: f64,
+        /// Time stamp of this sample, s.
+        t_s: f64,
+        /// The step, s.
+        step_s: f64,
+        /// The step over the median step.
+        ratio: f64,
+        /// The median step, s.
+        median_s: f64,
+    },
+    /// A GPS fix before the first or after the last accelerometer sample.
+    #[error(
+        "the fix at {t_s} s is outside the accelerometer log, whose samples run from {first_s} s \
+         to {last_s} s: a fix must lie within half the median step ({} s) of a sample",
+        crate::format::short(*.tolerance_s)
+    )]
+    FixOutsideSpan {
+        /// Time of the fix, s.
+        t_s: f64,
+        /// First accelerometer time stamp, s.
+        first_s: f64,
+        /// Last accelerometer time stamp, s.
+        last_s: f64,
+        /// Half the median step, s.
+        tolerance_s: f64,
+    },
+    /// A GPS fix that falls between two accelerometer samples.
+    #[error(
+        "the fix at {t_s} s falls between the accelerometer samples at {before_s} s and {after_s} \
+         s: a fix must lie within half the median step ({} s) of a sample",
+        crate::format::short(*.tolerance_s)
+    )]
+    FixBetweenSamples {
+        /// Time of the fix, s.
+        t_s: f64,
+        /// The sample before it, s.
+        before_s: f64,
+        /// The sample after it, s.
+        after_s: f64,
+        /// Half the median step, s.
+        tolerance_s: f64,
+    },
+    /// Two GPS fixes on one accelerometer sample.
+    #[error(
+        "the fix at {t_s} s falls on the accelerometer sample at {sample_s} s, which the fix on \
+         line {other_line} already takes: at most one fix per sample"
+    )]
+    FixOnTakenSample {
+        /// Time of the fix, s.
+        t_s: f64,
+        /// The sample, s.
+        sample_s: f64,
+        /// Line of the fix that took the sample.
+        other_line: u64,
+    },
+    /// A second reading of the file differs from the first.
+    #[error("the file changed while it was being read: its second reading differs from the first")]
+    Changed,
+}
+
+impl LogError {
+    /// An error of `file` at `line`.
+    pub fn at(file: &str, line: u64, problem: LogProblem) -> Self {
+        Self {
+            file: file.to_string(),
+            line: Some(line),
+            problem,
+        }
+    }
+
+    /// An error of `file` as a whole.
+    pub fn of_file(file: &str, problem: LogProblem) -> Self {
+        Self {
+            file: file.to_string(),
+            line: None,
+            problem,
+        }
+    }
+}
+
+/// One row of an accelerometer log.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AccelSample {
+    /// Line in the file.
+    pub line: u64,
+    /// Time stamp t_j, s.
+    pub t_s: f64,
+    /// Output a_c(t_j), m/s².
+    pub accel_m_s2: f64,
+}
+
+/// One row of a GPS log.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GpsFix {
+    /// Line in the file.
+    pub line: u64,
+    /// Time of the fix t_i, s.
+    pub t_s: f64,
+    /// Measured position z_p, m.
+    pub position_m: f64,
+    /// Measured velocity z_v, m/s.
+    pub velocity_m_s: f64,
+}

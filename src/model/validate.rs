@@ -1,0 +1,356 @@
+//! Validation of a parsed [`Config`]: every field against its accepted range, once, naming the
+//! first offending field. A configuration that passes builds a [`super::Model`].
+
+use super::{
+    ALL_PAIRS_MAX_FIXES, DEFAULT_MAX_LAG, FILTER_FLOOR, MAX_FIXES, MAX_REALIZATIONS, MAX_STEPS,
+    MAX_SUMS_BYTES, WHOLE_TOL,
+};
+use crate::config::Config;
+use crate::error::ConfigError;
+
+/// `x` rounded to the nearest whole number when it is one within [`WHOLE_TOL`].
+pub(super) fn whole(x: f64) -> Option<u64> {
+    let r = x.round();
+    (x.is_finite() && r >= 0.0 && (x - r).abs() <= WHOLE_TOL * r.max(1.0)).then_some(r as u64)
+}
+
+/// A number as a person would write it: exponent notation when it is very small or large.
+fn show(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e7).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+fn finite_in(
+    field: &'static str,
+    x: f64,
+    lo: f64,
+    hi: f64,
+    lo_open: bool,
+) -> Result<(), ConfigError> {
+    let ok = x.is_finite() && (if lo_open { x > lo } else { x >= lo }) && x <= hi;
+    if ok {
+        Ok(())
+    } else {
+        let open = if lo_open { "(" } else { "[" };
+        Err(ConfigError::invalid(
+            field,
+            show(x),
+            format!(
+                "must be a finite number in {open}{}, {}]",
+                show(lo),
+                show(hi)
+            ),
+        ))
+    }
+}
+
+fn positive(field: &'static str, x: f64, hi: f64) -> Result<(), ConfigError> {
+    finite_in(field, x, 0.0, hi, true)
+}
+
+fn non_negative(field: &'static str, x: f64, hi: f64) -> Result<(), ConfigError> {
+    finite_in(field, x, 0.0, hi, false)
+}
+
+/// Checks every field against its accepted range, in file order.
+pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
+    let p = &c.profile;
+    non_negative("profile.accel_amplitude_m_s2", p.accel_amplitude_m_s2, 1e4)?;
+    finite_in(
+        "profile.accel_angular_freq_rad_s",
+        p.accel_angular_freq_rad_s,
+        1e-9,
+        1e4,
+        false,
+    )?;
+    positive("profile.duration_s", p.duration_s, 1e5)?;
+
+    let a = &c.accelerometer;
+    positive("accelerometer.sample_rate_hz", a.sample_rate_hz, 1e6)?;
+    non_negative("accelerometer.noise_var_m2_s4", a.noise_var_m2_s4, 1e6)?;
+    non_negative("accelerometer.bias_var_m2_s4", a.bias_var_m2_s4, 1e6)?;
+    match whole(p.duration_s * a.sample_rate_hz) {
+        Some(n) if n >= 1 && n as usize <= MAX_STEPS => {}
+        _ => {
+            return Err(ConfigError::invalid(
+                "profile.duration_s",
+                p.duration_s,
+                format!(
+                    "duration_s × accelerometer.sample_rate_hz ({} Hz) must be a whole number of \
+                     samples in [1, {MAX_STEPS}]",
+                    a.sample_rate_hz
+                ),
+            ));
+        }
+    }
+
+    let g = &c.gps;
+    positive("gps.sample_rate_hz", g.sample_rate_hz, a.sample_rate_hz)?;
+    if whole(a.sample_rate_hz / g.sample_rate_hz).is_none() {
+        return Err(ConfigError::invalid(
+            "gps.sample_rate_hz",
+            g.sample_rate_hz,
+            format!(
+                "must divide accelerometer.sample_rate_hz ({} Hz) into a whole number of samples \
+                 per fix",
+                a.sample_rate_hz
+            ),
+        ));
+    }
+    positive("gps.position_sigma_m", g.position_sigma_m, 1e6)?;
+    positive("gps.velocity_sigma_m_s", g.velocity_sigma_m_s, 1e6)?;
+    let steps = whole(p.duration_s * a.sample_rate_hz).expect("checked above");
+    let per_fix = whole(a.sample_rate_hz / g.sample_rate_hz).expect("checked above");
+    let fixes = steps / per_fix + u64::from(g.fix_at_start);
+    if !(2..=MAX_FIXES as u64).contains(&fixes) {
+        return Err(ConfigError::invalid(
+            "profile.duration_s",
+            p.duration_s,
+            format!(
+                "must hold between 2 and {MAX_FIXES} GPS fixes at gps.sample_rate_hz = {} Hz \
+                 (it holds {fixes})",
+                g.sample_rate_hz
+            ),
+        ));
+    }
+
+    let i = &c.initial;
+    finite_in(
+        "initial.position_mean_m",
+        i.position_mean_m,
+        -1e9,
+        1e9,
+        false,
+    )?;
+    non_negative("initial.position_sigma_m", i.position_sigma_m, 1e6)?;
+    finite_in(
+        "initial.velocity_mean_m_s",
+        i.velocity_mean_m_s,
+        -1e6,
+        1e6,
+        false,
+    )?;
+    non_negative("initial.velocity_sigma_m_s", i.velocity_sigma_m_s, 1e6)?;
+
+    // The filter's statistics must keep its covariance positive definite: all strictly positive.
+    let f = &c.filter;
+    let filter_fields: [(&'static str, Option<f64>); 6] = [
+        ("filter.accel_noise_var_m2_s4", f.accel_noise_var_m2_s4),
+        ("filter.bias_var_m2_s4", f.bias_var_m2_s4),
+        ("filter.gps_position_sigma_m", f.gps_position_sigma_m),
+        ("filter.gps_velocity_sigma_m_s", f.gps_velocity_sigma_m_s),
+        (
+            "filter.initial_position_sigma_m",
+            f.initial_position_sigma_m,
+        ),
+        (
+            "filter.initial_velocity_sigma_m_s",
+            f.initial_velocity_sigma_m_s,
+        ),
+    ];
+    // Floors keep S and P well inside double precision; below them the covariance recursion
+    // cannot stay positive definite.
+    for (field, value) in filter_fields {
+        if let Some(x) = value {
+            finite_in(field, x, FILTER_FLOOR, 1e6, false)?;
+        }
+    }
+    let resolved: [(&'static str, f64); 4] = [
+        ("accel_noise_var_m2_s4", c.filter_accel_noise_var_m2_s4()),
+        ("bias_var_m2_s4", c.filter_bias_var_m2_s4()),
+        (
+            "initial_position_sigma_m",
+            c.filter_initial_position_sigma_m(),
+        ),
+        (
+            "initial_velocity_sigma_m_s",
+            c.filter_initial_velocity_sigma_m_s(),
+        ),
+    ];
+    for (name, x) in resolved {
+        if x < FILTER_FLOOR {
+            return Err(ConfigError::invalid(
+                "filter",
+                format!("{name} = {x} (taken from the truth)"),
+                format!(
+                    "the filter needs {name} ≥ {FILTER_FLOOR}; set filter.{name} to a value in [{FILTER_FLOOR}, 1000000]"
+                ),
+            ));
+        }
+    }
+
+    let e = &c.ensemble;
+    if !(2..=MAX_REALIZATIONS).contains(&e.realizations) {
+        return Err(ConfigError::invalid(
+            "ensemble.realizations",
+            e.realizations,
+            format!("must be a whole number in [2, {MAX_REALIZATIONS}]"),
+        ));
+    }
+
+    let sens = &c.sensitivity;
+    if sens.factors.is_empty() {
+        return Err(ConfigError::invalid(
+            "sensitivity.factors",
+            "[]",
+            "must list at least one factor",
+        ));
+    }
+    if let Some(f) = sens
+        .factors
+        .iter()
+        .find(|f| !(f.is_finite() && **f > 0.0 && **f <= 1e3))
+    {
+        return Err(ConfigError::invalid(
+            "sensitivity.factors",
+            show(*f),
+            "every factor must be a finite number in (0, 1000]",
+        ));
+    }
+    if sens.ensembles > 10_000 {
+        return Err(ConfigError::invalid(
+            "sensitivity.ensembles",
+            sens.ensembles,
+            "must be a whole number in [0, 10000]",
+        ));
+    }
+
+    let k = &c.checks;
+    finite_in(
+        "checks.false_alarm_rate",
+        k.false_alarm_rate,
+        0.0,
+        0.5,
+        true,
+    )?;
+    if k.residual_max_lag == Some(0) {
+        return Err(ConfigError::invalid(
+            "checks.residual_max_lag",
+            0,
+            "must be a whole number of fixes ≥ 1 (or left out)",
+        ));
+    }
+    // The running sums of one chunk of realizations must fit the memory budget: 51 floats per
+    // fix and the kept residual products (every pair, or a band of lags).
+    let f = fixes as f64;
+    let lag = match k.residual_max_lag {
+        Some(l) => Some(f64::from(l)),
+        None if fixes as usize <= ALL_PAIRS_MAX_FIXES => None,
+        None => Some(DEFAULT_MAX_LAG as f64),
+    };
+    let products = match lag {
+        Some(l) if l + 1.0 < f => 2.0 * f * (2.0 * l + 2.0),
+        _ => f * (2.0 * f + 1.0),
+    };
+    let bytes = 8.0 * (51.0 * f + products);
+    if bytes > MAX_SUMS_BYTES as f64 {
+        let budget = MAX_SUMS_BYTES as f64 / 8.0 - 51.0 * f;
+        let most = ((budget / (2.0 * f) - 2.0) / 2.0).floor();
+        let mib = |b: f64| format!("{:.0} MiB", b / 1048576.0);
+        return Err(match k.residual_max_lag {
+            Some(l) if most >= 1.0 => ConfigError::invalid(
+                "checks.residual_max_lag",
+                l,
+                format!(
+                    "with {fixes} fixes the running sums would take {} per chunk of realizations; \
+                     at most {} lags keep them within {}",
+                    mib(bytes),
+                    most,
+                    mib(MAX_SUMS_BYTES as f64)
+                ),
+            ),
+            _ => ConfigError::invalid(
+                "gps.sample_rate_hz",
+                g.sample_rate_hz,
+                format!(
+                    "the run would hold {fixes} fixes, whose running sums would take {} per chunk \
+                     of realizations (at most {}): lower the GPS rate or shorten the run",
+                    mib(bytes),
+                    mib(MAX_SUMS_BYTES as f64)
+                ),
+            ),
+        });
+    }
+    let Some([tm, ti]) = k.residual_pair_s else {
+        return Ok(());
+    };
+    let period = per_fix as f64 / a.sample_rate_hz;
+    let first = if g.fix_at_start { 0.0 } else { period };
+    let last = (steps / per_fix) as f64 * period;
+    // The index of the fix at `t`, when `t` is a fix time of the run.
+    let fix_index = |t: f64| {
+        (t.is_finite() && t >= first - 1e-9 && t <= last + 1e-9)
+            .then(|| whole(t / period))
+            .flatten()
+    };
+    let ordered = matches!((fix_index(tm), fix_index(ti)), (Some(m), Some(i)) if m < i);
+    if !ordered {
+        return Err(ConfigError::invalid(
+            "checks.residual_pair_s",
+            format!("[{tm}, {ti}]"),
+            format!(
+                "must be two GPS fix times [t_m, t_i] with t_m < t_i, multiples of {period} s in \
+                 [{first}, {last}]"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::config::Config;
+    use crate::error::ConfigError;
+    use crate::model::Model;
+
+    #[test]
+    fn residual_pair_must_name_two_different_fixes() {
+        let mut c = Config::default();
+        c.checks.residual_pair_s = Some([10.0, 10.000_000_000_1]);
+        assert_eq!(field_of(&c), "checks.residual_pair_s");
+        c.checks.residual_pair_s = Some([10.0, 10.2]);
+        assert!(Model::new(&c).is_ok());
+    }
+
+    fn field_of(c: &Config) -> &'static str {
+        match Model::new(c) {
+            Err(ConfigError::Invalid { field, .. }) => field,
+            Err(e) => panic!("unexpected {e}"),
+            Ok(_) => panic!("accepted an invalid configuration"),
+        }
+    }
+
+    #[test]
+    fn invalid_fields_are_named() {
+        let mut c = Config::default();
+        c.gps.sample_rate_hz = 7.0;
+        assert_eq!(field_of(&c), "gps.sample_rate_hz");
+        let mut c = Config::default();
+        c.accelerometer.noise_var_m2_s4 = -1.0;
+        assert_eq!(field_of(&c), "accelerometer.noise_var_m2_s4");
+        let mut c = Config::default();
+        c.profile.duration_s = f64::NAN;
+        assert_eq!(field_of(&c), "profile.duration_s");
+        let mut c = Config::default();
+        c.ensemble.realizations = 1;
+        assert_eq!(field_of(&c), "ensemble.realizations");
+        let mut c = Config::default();
+        c.checks.residual_pair_s = Some([20.0, 10.0]);
+        assert_eq!(field_of(&c), "checks.residual_pair_s");
+        let mut c = Config::default();
+        c.filter.gps_position_sigma_m = Some(0.0);
+        assert_eq!(field_of(&c), "filter.gps_position_sigma_m");
+        let mut c = Config::default();
+        c.accelerometer.noise_var_m2_s4 = 0.0;
+        assert_eq!(field_of(&c), "filter");
+        let mut c = Config::default();
+        c.filter.gps_position_sigma_m = Some(1e-200);
+        assert_eq!(field_of(&c), "filter.gps_position_sigma_m");
+        let mut c = Config::default();
+        c.profile.accel_angular_freq_rad_s = 1e-300;
+        assert_eq!(field_of(&c), "profile.accel_angular_freq_rad_s");
+    }
+}

@@ -1,0 +1,353 @@
+//! The figures of a calibration from logs: the bias estimate, the corrected trajectory, the
+//! residuals and the NIS of every fix. Each takes the per-fix series of a
+//! [`Calibration`](crate::calibrate::summary::Calibration), so a log of any length draws from
+//! O(fixes) points.
+
+use plotters::style::{Color, ShapeStyle};
+
+use super::axis::{Axis, y_label_area};
+use super::geometry::{Point, extent, padded, settled_from, time_span};
+use super::legend::{Entry, Swatch, draw_legend, legend_height};
+use super::panel::{Layout, Panel, columns, render, rows};
+use super::{BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotError, PlotResult, VERMILLION, WIDTH_PX};
+use crate::calibrate::NisTest;
+use crate::calibrate::summary::FixReport;
+
+/// Height of one row, px.
+const ROW_PX: u32 = 260;
+/// Up to this many fixes are drawn as markers; more as a line through them.
+const MAX_MARKERS: usize = 600;
+
+/// Markers at `points`, or a thin line through them when there are too many to tell apart.
+fn markers(panel: &Panel<'_>, points: Vec<Point>, style: ShapeStyle) -> Result<(), PlotError> {
+    if points.len() <= MAX_MARKERS {
+        panel.dots(points, 3, style)
+    } else {
+        panel.line(points, style.stroke_width(1))
+    }
+}
+
+/// A linear axis fitted to `values`, padded.
+fn fitted(name: &str, unit: &str, values: impl IntoIterator<Item = f64>, ticks: usize) -> Axis {
+    let range = extent(values).map_or((-1.0, 1.0), |e| padded(e, 0.08));
+    Axis::linear(name, unit, range, ticks)
+}
+
+fn layout(y_area_px: u32, last: bool) -> Layout {
+    Layout {
+        y_area_px,
+        x_title: last,
+        title: true,
+    }
+}
+
+/// Top: the bias estimate at every fix, filtered (a posteriori) and smoothed, each with ±1σ.
+/// Bottom: the two σ on a log axis. The axes of the top panel are fitted after the first second
+/// (or quarter of the log), where the prior's σ has collapsed.
+pub fn calibration_bias(fixes: &[FixReport]) -> PlotResult {
+    let (t0, t1) = time_span(fixes.iter().map(|f| f.t_s));
+    let settle = settled_from(t0, t1);
+    let time = Axis::linear("time", "s", (t0, t1), 8);
+    let late = || fixes.iter().filter(|f| f.t_s >= settle);
+    let bias_axis = fitted(
+        "bias",
+        "m/s²",
+        late().flat_map(|f| {
+            let (b, s) = (f.filtered[2], f.filtered_sigma[2]);
+            let (bs, ss) = (f.smoothed[2], f.smoothed_sigma[2]);
+            [b - s, b + s, bs - ss, bs + ss]
+        }),
+        6,
+    );
+    let sigmas = fixes
+        .iter()
+        .flat_map(|f| [f.filtered_sigma[2], f.smoothed_sigma[2]]);
+    let sigma_axis = Axis::log10(
+        "σ of the bias",
+        "m/s²",
+        extent(sigmas.filter(|s| *s > 0.0)).unwrap_or((1e-4, 1e-1)),
+    );
+    let y_area_px = y_label_area(&[&bias_axis, &sigma_axis]);
+    let legend = [
+        Entry::new(
+            Swatch::Line(VERMILLION.stroke_width(2)),
+            "filtered (a posteriori)",
+        ),
+        Entry::new(Swatch::Block(ORANGE.mix(0.3).filled()), "filtered ±1σ"),
+        Entry::new(Swatch::Line(BLUE.stroke_width(2)), "smoothed"),
+        Entry::new(Swatch::Block(BLUE.mix(0.2).filled()), "smoothed ±1σ"),
+    ];
+    let legend_px = legend_height(&legend);
+    render(legend_px + 2 * ROW_PX + 30, |root| {
+        let parts = rows(root, &[legend_px, ROW_PX]);
+        draw_legend(&parts[0], &legend)?;
+        let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
+        let p = Panel::new(
+            &parts[1],
+            "Bias estimate at each fix, ±1σ",
+            time.clone(),
+            bias_axis,
+            layout(y_area_px, false),
+        )?;
+        let band = |k: &dyn Fn(&FixReport) -> (f64, f64), sign: f64| -> Vec<f64> {
+            fixes
+                .iter()
+                .map(|f| {
+                    let (x, s) = k(f);
+                    x + sign * s
+                })
+                .collect()
+        };
+        let filtered = |f: &FixReport| (f.filtered[2], f.filtered_sigma[2]);
+        let smoothed = |f: &FixReport| (f.smoothed[2], f.smoothed_sigma[2]);
+        p.band(
+            &t,
+            &band(&filtered, -1.0),
+            &band(&filtered, 1.0),
+            ORANGE.mix(0.3),
+        )?;
+        p.band(
+            &t,
+            &band(&smoothed, -1.0),
+            &band(&smoothed, 1.0),
+            BLUE.mix(0.2),
+        )?;
+        p.line(
+            fixes.iter().map(|f| (f.t_s, f.filtered[2])),
+            VERMILLION.stroke_width(2),
+        )?;
+        p.line(
+            fixes.iter().map(|f| (f.t_s, f.smoothed[2])),
+            BLUE.stroke_width(2),
+        )?;
+        let q = Panel::new(
+            &parts[2],
+            "σ of the bias: filtered and smoothed",
+            time,
+            sigma_axis,
+            layout(y_area_px, true),
+        )?;
+        q.line(
+            fixes.iter().map(|f| (f.t_s, f.filtered_sigma[2])),
+            VERMILLION.stroke_width(2),
+        )?;
+        q.line(
+            fixes.iter().map(|f| (f.t_s, f.smoothed_sigma[2])),
+            BLUE.stroke_width(2),
+        )?;
+        Ok(())
+    })
+}
+
+/// Left: velocity and position at every fix — the GPS fix, the integrated accelerometer (eq. 3)
+/// and the corrected (smoothed) trajectory. Right: what separates the integration from the
+/// truth, δ = GPS − integration at each fix, with the smoothed estimate of the drift and ±1σ.
+pub fn calibration_trajectory(fixes: &[FixReport]) -> PlotResult {
+    let (t0, t1) = time_span(fixes.iter().map(|f| f.t_s));
+    let time = Axis::linear("time", "s", (t0, t1), 6);
+    let corrected = |f: &FixReport, k: usize| f.integrated[k] + f.smoothed[k];
+    let names = [("velocity", "m/s"), ("position", "m")];
+    let comp = [1usize, 0];
+    let left: Vec<Axis> = comp
+        .iter()
+        .zip(names)
+        .map(|(&k, (name, unit))| {
+            fitted(
+                name,
+                unit,
+                fixes
+                    .iter()
+                    .flat_map(|f| [f.z[k], f.integrated[k], corrected(f, k)]),
+                6,
+            )
+        })
+        .collect();
+    let right: Vec<Axis> = comp
+        .iter()
+        .zip(names)
+        .map(|(&k, (name, unit))| {
+            fitted(
+                &format!("{name} drift"),
+                unit,
+                fixes.iter().flat_map(|f| {
+                    let (x, s) = (f.smoothed[k], f.smoothed_sigma[k]);
+                    [f.z[k] - f.integrated[k], x - s, x + s]
+                }),
+                6,
+            )
+        })
+        .collect();
+    let left_px = y_label_area(&left.iter().collect::<Vec<_>>());
+    let right_px = y_label_area(&right.iter().collect::<Vec<_>>());
+    let legend = [
+        Entry::new(Swatch::Marker(BLACK.filled()), "GPS fix"),
+        Entry::new(
+            Swatch::Line(ORANGE.stroke_width(2)),
+            "integrated accelerometer",
+        ),
+        Entry::new(Swatch::Line(BLUE.stroke_width(2)), "corrected (smoothed)"),
+        Entry::new(Swatch::Block(BLUE.mix(0.2).filled()), "smoothed ±1σ"),
+    ];
+    let legend_px = legend_height(&legend);
+    render(legend_px + 2 * ROW_PX + 30, |root| {
+        let parts = rows(root, &[legend_px, ROW_PX]);
+        draw_legend(&parts[0], &legend)?;
+        let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
+        for (row, &k) in comp.iter().enumerate() {
+            let last = row == 1;
+            let cols = columns(&parts[row + 1], &[WIDTH_PX / 2]);
+            let (name, _) = names[row];
+            let p = Panel::new(
+                &cols[0],
+                &format!("{}: GPS, integrated, corrected", super::capitalized(name)),
+                time.clone(),
+                left[row].clone(),
+                layout(left_px, last),
+            )?;
+            p.line(
+                fixes.iter().map(|f| (f.t_s, f.integrated[k])),
+                ORANGE.stroke_width(2),
+            )?;
+            p.line(
+                fixes.iter().map(|f| (f.t_s, corrected(f, k))),
+                BLUE.stroke_width(2),
+            )?;
+            markers(
+                &p,
+                fixes.iter().map(|f| (f.t_s, f.z[k])).collect(),
+                BLACK.filled(),
+            )?;
+            let q = Panel::new(
+                &cols[1],
+                &format!("{} drift of the integration", super::capitalized(name)),
+                time.clone(),
+                right[row].clone(),
+                layout(right_px, last),
+            )?;
+            let lo: Vec<f64> = fixes
+                .iter()
+                .map(|f| f.smoothed[k] - f.smoothed_sigma[k])
+                .collect();
+            let hi: Vec<f64> = fixes
+                .iter()
+                .map(|f| f.smoothed[k] + f.smoothed_sigma[k])
+                .collect();
+            q.band(&t, &lo, &hi, BLUE.mix(0.2))?;
+            markers(
+                &q,
+                fixes
+                    .iter()
+                    .map(|f| (f.t_s, f.z[k] - f.integrated[k]))
+                    .collect(),
+                BLACK.filled(),
+            )?;
+            q.line(
+                fixes.iter().map(|f| (f.t_s, f.smoothed[k])),
+                BLUE.stroke_width(2),
+            )?;
+        }
+        Ok(())
+    })
+}
+
+/// The residual r = δz − H·δx̂⁻ of every fix, position and velocity, within the ±√S the filter
+/// predicts for it (±1σ and ±2σ). Axes are fitted after the first second, as the prior's σ
+/// makes the first residuals large.
+pub fn calibration_residuals(fixes: &[FixReport]) -> PlotResult {
+    let (t0, t1) = time_span(fixes.iter().map(|f| f.t_s));
+    let settle = settled_from(t0, t1);
+    let time = Axis::linear("time", "s", (t0, t1), 8);
+    let names = [("position residual", "m"), ("velocity residual", "m/s")];
+    let axes: Vec<Axis> = (0..2)
+        .map(|k| {
+            let (name, unit) = names[k];
+            fitted(
+                name,
+                unit,
+                fixes.iter().filter(|f| f.t_s >= settle).flat_map(|f| {
+                    let s = f.residual_sigma[k];
+                    [f.residual[k], -2.0 * s, 2.0 * s]
+                }),
+                6,
+            )
+        })
+        .collect();
+    let y_area_px = y_label_area(&axes.iter().collect::<Vec<_>>());
+    let legend = [
+        Entry::new(Swatch::Marker(BLUE.filled()), "residual r"),
+        Entry::new(Swatch::Block(ORANGE.mix(0.35).filled()), "±√S (1σ)"),
+        Entry::new(Swatch::Block(ORANGE.mix(0.15).filled()), "±2√S"),
+    ];
+    let legend_px = legend_height(&legend);
+    render(legend_px + 2 * ROW_PX + 30, |root| {
+        let parts = rows(root, &[legend_px, ROW_PX]);
+        draw_legend(&parts[0], &legend)?;
+        let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
+        for k in 0..2 {
+            let p = Panel::new(
+                &parts[k + 1],
+                &format!("{} at each fix", super::capitalized(names[k].0)),
+                time.clone(),
+                axes[k].clone(),
+                layout(y_area_px, k == 1),
+            )?;
+            let s: Vec<f64> = fixes.iter().map(|f| f.residual_sigma[k]).collect();
+            let scaled = |c: f64| s.iter().map(|v| c * v).collect::<Vec<_>>();
+            p.band(&t, &scaled(-2.0), &scaled(2.0), ORANGE.mix(0.15))?;
+            p.band(&t, &scaled(-1.0), &scaled(1.0), ORANGE.mix(0.35))?;
+            p.hline(0.0, BLACK.mix(0.5).stroke_width(1))?;
+            markers(
+                &p,
+                fixes.iter().map(|f| (f.t_s, f.residual[k])).collect(),
+                BLUE.filled(),
+            )?;
+        }
+        Ok(())
+    })
+}
+
+/// The NIS rᵀS⁻¹r of every fix on a log axis, against its expected value 2 and the per-fix χ²(2)
+/// band of `test`; the title gives the test of the whole sequence.
+pub fn calibration_nis(fixes: &[FixReport], test: &NisTest) -> PlotResult {
+    let (t0, t1) = time_span(fixes.iter().map(|f| f.t_s));
+    let time = Axis::linear("time", "s", (t0, t1), 8);
+    let values = fixes
+        .iter()
+        .map(|f| f.nis)
+        .chain([test.per_fix_lower, test.per_fix_upper])
+        .filter(|v| *v > 0.0);
+    let axis = Axis::log10("NIS", "", extent(values).unwrap_or((1e-3, 10.0)));
+    let y_area_px = y_label_area(&[&axis]);
+    let legend = [
+        Entry::new(Swatch::Marker(BLUISH_GREEN.filled()), "NIS of a fix"),
+        Entry::new(
+            Swatch::Line(BLACK.mix(0.4).stroke_width(1)),
+            "expected value 2",
+        ),
+        Entry::new(Swatch::Line(BLACK.stroke_width(1)), "per-fix χ²(2) band"),
+    ];
+    let legend_px = legend_height(&legend);
+    render(legend_px + ROW_PX + 30, |root| {
+        let parts = rows(root, &[legend_px]);
+        draw_legend(&parts[0], &legend)?;
+        let p = Panel::new(
+            &parts[1],
+            &format!(
+                "NIS per fix; mean {:.3} over {} fixes, sequence test: {}",
+                test.mean, test.fixes, test.verdict
+            ),
+            time,
+            axis,
+            layout(y_area_px, true),
+        )?;
+        p.hline(2.0, BLACK.mix(0.4).stroke_width(1))?;
+        p.hline(test.per_fix_lower, BLACK.stroke_width(1))?;
+        p.hline(test.per_fix_upper, BLACK.stroke_width(1))?;
+        markers(
+            &p,
+            fixes.iter().map(|f| (f.t_s, f.nis)).collect(),
+            BLUISH_GREEN.filled(),
+        )?;
+        Ok(())
+    })
+}

@@ -1,0 +1,322 @@
+//! The page of a calibration from logs: a short report in the study's style — the bias with its
+//! σ, how the logs were processed, four figures and the NIS test — self-contained like the
+//! study's page. Pure: it returns the HTML and the caller writes it.
+
+use askama::Template;
+use serde::Serialize;
+
+use super::RenderError;
+use super::rich::rich;
+use super::view::FigureView;
+use crate::calibrate::StepMode;
+use crate::calibrate::summary::{Calibration, Summary};
+use crate::format::{count, percent, short, sig};
+use crate::plot;
+
+/// A row of a two-column table: the quantity (HTML) and its value.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    /// The quantity, as HTML.
+    pub quantity_html: String,
+    /// Its value with its unit.
+    pub value: String,
+}
+
+/// Everything the calibration page shows, as text.
+#[derive(Clone, Debug, Serialize)]
+pub struct CalibrationView {
+    /// The program's version.
+    pub version: String,
+    /// The bias estimate with its σ and unit.
+    pub bias: String,
+    /// Time stamp of the last sample, s.
+    pub end_time: String,
+    /// The logs and their extent.
+    pub logs: Vec<Row>,
+    /// How the step and the fixes were handled, as HTML.
+    pub method_html: Vec<String>,
+    /// The estimates at the start and the end of the log.
+    pub results: Vec<Row>,
+    /// The NIS test in words, as HTML.
+    pub nis_html: String,
+    /// "pass" or "fail".
+    pub nis_verdict: String,
+    /// The filter's assumptions.
+    pub settings: Vec<Row>,
+    /// The four figures.
+    pub figures: Vec<FigureView>,
+    /// The command that wrote the page.
+    pub command: String,
+}
+
+/// The calibration page.
+#[derive(Template)]
+#[template(path = "calibration.html")]
+pub struct CalibrationPage<'a> {
+    /// The view.
+    pub v: &'a CalibrationView,
+    /// The stylesheet.
+    pub style: &'a str,
+}
+
+fn row(quantity: &str, value: String) -> Row {
+    Row {
+        quantity_html: rich(quantity),
+        value,
+    }
+}
+
+/// `x ± s unit` with σ to two significant digits and `x` to the same decimal place.
+fn with_sigma(x: f64, s: f64, unit: &str) -> String {
+    let digits = if s > 0.0 && x != 0.0 {
+        (x.abs().log10().floor() - s.log10().floor()).max(0.0) as usize + 2
+    } else {
+        3
+    };
+    format!("{} ± {} {unit}", sig(x, digits.min(12)), sig(s, 2))
+}
+
+fn seconds(x: f64) -> String {
+    if x.abs() < 1.0 && x != 0.0 {
+        format!("{} ms", short(1e3 * x))
+    } else {
+        format!("{} s", short(x))
+    }
+}
+
+fn method(s: &Summary) -> Vec<String> {
+    let mode = match s.dt_mode {
+        StepMode::Nominal => format!(
+            "Every step of the accelerometer log equals the configured Δt = {} to a relative \
+             10^{{−9}}, so the filter ran with that constant Δt and the study's recursion, \
+             operation for operation (Δt mode ",
+            seconds(s.nominal_dt_s)
+        ),
+        StepMode::PerStep => format!(
+            "The steps of the accelerometer log run from {} to {} (median {}), not all equal to \
+             the configured Δt = {}: each step Δt_{{j}} was taken from its pair of time stamps, \
+             with Φ(Δt_{{j}}) and Q(Δt_{{j}}) (Δt mode ",
+            seconds(s.min_step_s),
+            seconds(s.max_step_s),
+            seconds(s.median_step_s),
+            seconds(s.nominal_dt_s)
+        ),
+    };
+    vec![
+        rich(
+            "The accelerometer output a_{c} is integrated by eq. (3) of the study from the \
+             configured prior means, p_{c}(t_{0}) and v_{c}(t_{0}); the error-state filter \
+             propagates δx = (δp, δv, b) with Φ and Q, and at each GPS fix updates it with \
+             δz = z − (p_{c}, v_{c}).",
+        ),
+        format!("{}<code>{}</code>).", rich(&mode), s.dt_mode.name()),
+        rich(&format!(
+            "Steps between {} and {} (0.5 to 1.5 times the median step) are accepted; a longer \
+             one is a gap and a shorter one an extra sample, and either refuses the log. Each \
+             GPS fix is applied at the accelerometer sample whose time stamp is within {} (half \
+             the median step) of its own.",
+            seconds(s.accepted_step_s[0]),
+            seconds(s.accepted_step_s[1]),
+            seconds(s.fix_tolerance_s)
+        )),
+        rich(
+            "A fixed-interval Rauch–Tung–Striebel smoother runs backward over the fixes and gives \
+             the smoothed δp, δv, b and their σ at every sample; the bias is constant, so its \
+             smoothed estimate is the same at every time, and at the end of the log filtered and \
+             smoothed agree.",
+        ),
+    ]
+}
+
+/// Builds the view of `cal`; `command` wrote it.
+///
+/// # Errors
+/// [`RenderError::Figure`] when a figure cannot be drawn.
+pub fn build(cal: &Calibration, command: &str) -> Result<CalibrationView, RenderError> {
+    let s = &cal.summary;
+    let fig = |id: &str, svg: Result<String, plot::PlotError>| {
+        svg.map_err(|source| RenderError::Figure {
+            figure: id.to_string(),
+            source,
+        })
+    };
+    let n = &s.nis;
+    let figures = vec![
+        FigureView {
+            id: "fig-bias".into(),
+            number: 1,
+            title: "The bias estimate".into(),
+            caption_html: rich(
+                "The filtered (a posteriori) bias estimate at each fix and the smoothed one, each \
+                 with ±1σ; below, the two σ. The smoothed estimate uses every fix, so it holds \
+                 its final value from the start.",
+            ),
+            svg: fig("fig-bias", plot::calibration_bias(&cal.fixes))?,
+        },
+        FigureView {
+            id: "fig-trajectory".into(),
+            number: 2,
+            title: "The corrected trajectory".into(),
+            caption_html: rich(
+                "Left: velocity and position from the GPS, from the integrated accelerometer \
+                 (p_{c}, v_{c}) and corrected by the smoothed error estimate (p_{c} + δp̂, \
+                 v_{c} + δv̂). Right: the integration's drift, GPS minus integration at each fix, \
+                 with its smoothed estimate ±1σ.",
+            ),
+            svg: fig("fig-trajectory", plot::calibration_trajectory(&cal.fixes))?,
+        },
+        FigureView {
+            id: "fig-residuals".into(),
+            number: 3,
+            title: "Residuals".into(),
+            caption_html: rich(
+                "The residual r = δz − Hδx̂^{−} of each fix within the ±√S and ±2√S the filter \
+                 predicts for it (the diagonal of S = HP^{−}H^{T} + R).",
+            ),
+            svg: fig("fig-residuals", plot::calibration_residuals(&cal.fixes))?,
+        },
+        FigureView {
+            id: "fig-nis".into(),
+            number: 4,
+            title: "Normalized innovations squared".into(),
+            caption_html: rich(&format!(
+                "The NIS r^{{T}}S^{{−1}}r of each fix, χ²(2) for a consistent filter, with its \
+                 expected value 2 and the per-fix band [{}, {}] that holds it with probability \
+                 1 − α = {}.",
+                sig(n.per_fix_lower, 3),
+                sig(n.per_fix_upper, 3),
+                percent(1.0 - n.false_alarm_rate)
+            )),
+            svg: fig("fig-nis", plot::calibration_nis(&cal.fixes, n))?,
+        },
+    ];
+    let start = &s.start_smoothed;
+    let end = &s.end_estimate;
+    let f = &s.filter;
+    Ok(CalibrationView {
+        version: s.accelcal_version.to_string(),
+        bias: with_sigma(s.bias_m_s2, s.bias_sigma_m_s2, "m/s²"),
+        end_time: short(s.end_s),
+        logs: vec![
+            row("accelerometer log", s.accelerometer_log.clone()),
+            row("GPS log", s.gps_log.clone()),
+            row("samples", count(s.samples)),
+            row("GPS fixes", count(s.fixes as u64)),
+            row(
+                "time span",
+                format!(
+                    "{} s to {} s ({} s)",
+                    short(s.start_s),
+                    short(s.end_s),
+                    short(s.duration_s)
+                ),
+            ),
+            row("median step", seconds(s.median_step_s)),
+            row("Δt mode", s.dt_mode.name().to_string()),
+        ],
+        method_html: method(s),
+        results: vec![
+            row(
+                "bias b̂ at the end",
+                with_sigma(end.bias_m_s2, end.sigma_bias_m_s2, "m/s²"),
+            ),
+            row(
+                "position error δp̂ at the end",
+                with_sigma(end.dp_m, end.sigma_dp_m, "m"),
+            ),
+            row(
+                "velocity error δv̂ at the end",
+                with_sigma(end.dv_m_s, end.sigma_dv_m_s, "m/s"),
+            ),
+            row(
+                "initial position p(t_{0}) = p_{c}(t_{0}) + δp̂^{s}",
+                with_sigma(
+                    f.initial_position_mean_m + start.dp_m,
+                    start.sigma_dp_m,
+                    "m",
+                ),
+            ),
+            row(
+                "initial velocity v(t_{0}) = v_{c}(t_{0}) + δv̂^{s}",
+                with_sigma(
+                    f.initial_velocity_mean_m_s + start.dv_m_s,
+                    start.sigma_dv_m_s,
+                    "m/s",
+                ),
+            ),
+        ],
+        nis_html: rich(&format!(
+            "The NIS of the {} fixes sum to {} (mean {}). For a consistent filter the sum is \
+             χ²({}) and lies in [{}, {}] with probability 1 − α = {} (α/2 in each tail, \
+             α = checks.false_alarm_rate): {}. {} of the fixes fall outside the per-fix band; \
+             about {} would by chance. This is the only consistency check real data allows: it \
+             needs no truth.",
+            count(n.fixes as u64),
+            sig(n.sum, 5),
+            sig(n.mean, 4),
+            count(n.dof),
+            sig(n.lower, 5),
+            sig(n.upper, 5),
+            percent(1.0 - n.false_alarm_rate),
+            if n.verdict == "pass" {
+                "the sum is inside, the residuals are as large as the filter predicts"
+            } else if n.sum > n.upper {
+                "the sum is above the band, the residuals are larger than the filter predicts \
+                 (its noise statistics are too small, or the model misses something)"
+            } else {
+                "the sum is below the band, the residuals are smaller than the filter predicts \
+                 (its noise statistics are too large)"
+            },
+            count(n.outside_per_fix as u64),
+            sig(n.expected_outside_per_fix, 2)
+        )),
+        nis_verdict: n.verdict.to_string(),
+        settings: vec![
+            row(
+                "p_{c}(t_{0}), mean of p(0)",
+                format!("{} m", short(f.initial_position_mean_m)),
+            ),
+            row(
+                "v_{c}(t_{0}), mean of v(0)",
+                format!("{} m/s", short(f.initial_velocity_mean_m_s)),
+            ),
+            row(
+                "σ of p(0)",
+                format!("{} m", short(f.initial_position_sigma_m)),
+            ),
+            row(
+                "σ of v(0)",
+                format!("{} m/s", short(f.initial_velocity_sigma_m_s)),
+            ),
+            row(
+                "σ of the bias prior",
+                format!("{} m/s²", short(f.bias_var_m2_s4.sqrt())),
+            ),
+            row(
+                "accelerometer noise variance W",
+                format!("{} (m/s²)²", short(f.accel_noise_var_m2_s4)),
+            ),
+            row(
+                "GPS position σ",
+                format!("{} m", short(f.gps_position_sigma_m)),
+            ),
+            row(
+                "GPS velocity σ",
+                format!("{} m/s", short(f.gps_velocity_sigma_m_s)),
+            ),
+            row("configured Δt", seconds(s.nominal_dt_s)),
+        ],
+        figures,
+        command: command.to_string(),
+    })
+}
+
+/// Renders the page of `cal` as HTML; `command` wrote it.
+///
+/// # Errors
+/// [`RenderError`] when a figure cannot be drawn or the template cannot be filled.
+pub fn render(cal: &Calibration, command: &str) -> Result<String, RenderError> {
+    let view = build(cal, command)?;
+    let style = include_str!("../../assets/report.css");
+    Ok(CalibrationPage { v: &view, style }.render()?)
+}

@@ -1,0 +1,350 @@
+//! Exact draws of an ensemble's fix-level sums without simulating its realizations.
+//!
+//! In the model-exact world a realization's joint state z = (e, δx̂) is linear and Gaussian:
+//! between fixes z ← F·z + G·w (the error takes the truth's process noise, the estimate is only
+//! propagated), at a fix the innovation r = H·e + η moves δx̂ by K·r and e by −K·r. Every check
+//! except the residual whiteness sees an ensemble of N realizations only through two statistics
+//! per fix: the mean z̄ and the scatter S = Σ (z − z̄)(z − z̄)ᵀ. Both are Markov chains over the
+//! fixes, independent of each other:
+//!
+//! - z̄ moves like one realization with its noise divided by √N;
+//! - S starts Wishart(n, P(0)) with n = N − 1 and moves by a noncentral Wishart step: with any
+//!   L such that L·Lᵀ = S, S ← (F·L + G·B)(F·L + G·B)ᵀ + G·W·Gᵀ, where B (r × d) has
+//!   independent standard normal entries and W is Wishart(n − d, I_r).
+//!
+//! The step follows from writing the n centred realizations as L·Uᵀ with U orthonormal: the noise
+//! splits into its projection on U (B) and the rest (W), independent by rotational invariance. One
+//! draw of the sums of an ensemble of any size therefore costs about as much as one realization at
+//! fix level, which makes the detection probability of a check, whose members are strongly
+//! correlated across fixes, a matter of thousands of cheap draws.
+
+use nalgebra::{SMatrix, SVector};
+use rand::{RngExt, SeedableRng};
+use rand_distr::{ChiSquared, Distribution, StandardNormal};
+use rand_pcg::Pcg64Mcg;
+use rayon::prelude::*;
+
+use crate::checks::{self, Budget, CheckId};
+use crate::ensemble::{Accumulator, EnsembleStats, ResidualLayout, StageSums};
+use crate::filter::{ErrorStateModel, FilterSchedule, Matrix2, Matrix3};
+use crate::model::{NoiseStats, Timeline};
+
+type M6 = SMatrix<f64, 6, 6>;
+type M8 = SMatrix<f64, 8, 8>;
+type V6 = SVector<f64, 6>;
+
+/// The transitions of one fix: the propagation from the previous fix and the update.
+#[derive(Clone, Debug)]
+struct FixStep {
+    /// z ← F·z over the interval.
+    f: M6,
+    /// Noise loading over the interval: G·Gᵀ is the truth's accumulated process noise.
+    g: SMatrix<f64, 6, 3>,
+    /// (z, η) ↦ z⁺ at the fix.
+    update: SMatrix<f64, 6, 8>,
+    /// (z, η) ↦ r at the fix.
+    residual: SMatrix<f64, 2, 8>,
+    p_prior_inv: Matrix3,
+    p_post_inv: Matrix3,
+    s_inv: Matrix2,
+}
+
+/// Draws the sums of ensembles of the filter `schedule` in the world of `truth`.
+#[derive(Clone, Debug)]
+pub struct Sampler {
+    realizations: u64,
+    /// A square root of the truth's P(0).
+    p0_root: Matrix3,
+    /// A square root of the truth's R.
+    r_root: Matrix2,
+    steps: Vec<FixStep>,
+    layout: ResidualLayout,
+    pair: [usize; 2],
+}
+
+impl Sampler {
+    /// The sampler of ensembles of `realizations` (at least 7, the joint dimension plus one) of
+    /// the filter `schedule` over `timeline`, in the model-exact world with the statistics
+    /// `truth`. The residual products are kept at lag 0 only and the single pair `pair` is not
+    /// drawn (its products are NaN).
+    pub fn new(
+        timeline: &Timeline,
+        schedule: &FilterSchedule,
+        truth: &NoiseStats,
+        realizations: u64,
+        pair: [usize; 2],
+    ) -> Self {
+        assert!(realizations > 6, "the joint state has 6 dimensions");
+        let world = ErrorStateModel::new(timeline.dt_s, truth);
+        let h = schedule.model.h;
+        let mut j = 0;
+        let steps = timeline
+            .fix_steps
+            .iter()
+            .zip(&schedule.fixes)
+            .map(|(&jf, fix)| {
+                let mut q = Matrix3::zeros();
+                let mut phi = Matrix3::identity();
+                while j < jf {
+                    q = world.propagate(&q);
+                    phi = world.phi * phi;
+                    j += 1;
+                }
+                let mut f = M6::zeros();
+                f.fixed_view_mut::<3, 3>(0, 0).copy_from(&phi);
+                f.fixed_view_mut::<3, 3>(3, 3).copy_from(&phi);
+                let mut g = SMatrix::<f64, 6, 3>::zeros();
+                g.fixed_view_mut::<3, 3>(0, 0).copy_from(&root(&q));
+                let k = fix.gain;
+                let kh = k * h;
+                let mut update = SMatrix::<f64, 6, 8>::zeros();
+                update
+                    .fixed_view_mut::<3, 3>(0, 0)
+                    .copy_from(&(Matrix3::identity() - kh));
+                update.fixed_view_mut::<3, 2>(0, 6).copy_from(&(-k));
+                update.fixed_view_mut::<3, 3>(3, 0).copy_from(&kh);
+                update
+                    .fixed_view_mut::<3, 3>(3, 3)
+                    .copy_from(&Matrix3::identity());
+                update.fixed_view_mut::<3, 2>(3, 6).copy_from(&k);
+                let mut residual = SMatrix::<f64, 2, 8>::zeros();
+                residual.fixed_view_mut::<2, 3>(0, 0).copy_from(&h);
+                residual
+                    .fixed_view_mut::<2, 2>(0, 6)
+                    .copy_from(&Matrix2::identity());
+                FixStep {
+                    f,
+                    g,
+                    update,
+                    residual,
+                    p_prior_inv: fix.p_prior_inv,
+                    p_post_inv: fix.p_post_inv,
+                    s_inv: fix.s_inv,
+                }
+            })
+            .collect::<Vec<_>>();
+        Self {
+            realizations,
+            p0_root: root(&world.p0),
+            r_root: root(&world.r),
+            layout: ResidualLayout::new(steps.len(), Some(0)),
+            steps,
+            pair,
+        }
+    }
+
+    /// One draw of the sums of an ensemble, as [`crate::ensemble::run`] would add them up.
+    pub fn draw<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> Accumulator {
+        let n_real = self.realizations as f64;
+        let n = self.realizations - 1;
+        let sqrt_n = n_real.sqrt();
+        let mut acc = Accumulator::new(&self.layout, self.pair);
+        acc.count = self.realizations;
+        acc.pair_products = [f64::NAN; 4];
+
+        // Start: e ~ N(0, P(0)), δx̂ = 0.
+        let mut scatter = M6::zeros();
+        let w0 = wishart::<3, _>(n, rng);
+        scatter
+            .fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&(self.p0_root * w0 * self.p0_root.transpose()));
+        let mut mean = V6::zeros();
+        let e0: SVector<f64, 3> = normals(rng);
+        mean.fixed_rows_mut::<3>(0)
+            .copy_from(&(self.p0_root * e0 / sqrt_n));
+
+        for (i, step) in self.steps.iter().enumerate() {
+            // Propagation to the fix.
+            let l = psd_cholesky(&scatter);
+            let b: SMatrix<f64, 3, 6> = normals(rng);
+            let a = step.f * l + step.g * b;
+            let w = wishart::<3, _>(n - 6, rng);
+            scatter = symmetric(a * a.transpose() + step.g * w * step.g.transpose());
+            let noise: SVector<f64, 3> = normals(rng);
+            mean = step.f * mean + step.g * noise / sqrt_n;
+            let prior = stage_sums(&scatter, &mean, n_real, &step.p_prior_inv);
+
+            // The joint (z, η) at the fix.
+            let l = psd_cholesky(&scatter);
+            let b: SMatrix<f64, 2, 6> = normals(rng);
+            let mut a = SMatrix::<f64, 8, 6>::zeros();
+            a.fixed_view_mut::<6, 6>(0, 0).copy_from(&l);
+            a.fixed_view_mut::<2, 6>(6, 0).copy_from(&(self.r_root * b));
+            let w = wishart::<2, _>(n - 6, rng);
+            let mut joint: M8 = a * a.transpose();
+            let wr = self.r_root * w * self.r_root.transpose();
+            for (x, y) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+                joint[(6 + x, 6 + y)] += wr[(x, y)];
+            }
+            let joint = symmetric(joint);
+            let eta: SVector<f64, 2> = normals(rng);
+            let mut joint_mean = SVector::<f64, 8>::zeros();
+            joint_mean.fixed_rows_mut::<6>(0).copy_from(&mean);
+            joint_mean
+                .fixed_rows_mut::<2>(6)
+                .copy_from(&(self.r_root * eta / sqrt_n));
+
+            let r_scatter = step.residual * joint * step.residual.transpose();
+            let r_mean = step.residual * joint_mean;
+            let rr = r_scatter + r_mean * r_mean.transpose() * n_real;
+            scatter = symmetric(step.update * joint * step.update.transpose());
+            mean = step.update * joint_mean;
+            let post = stage_sums(&scatter, &mean, n_real, &step.p_post_inv);
+
+            let sums = &mut acc.fixes[i];
+            sums.prior = prior;
+            sums.post = post;
+            sums.nis = (step.s_inv * rr).trace();
+            for (x, y) in [(0, 0), (1, 0), (1, 1)] {
+                let k = self
+                    .layout
+                    .index(2 * i + x, 2 * i + y)
+                    .expect("lag 0 is kept");
+                acc.residual_products[k] = rr[(x, y)];
+            }
+        }
+        acc
+    }
+}
+
+impl Sampler {
+    /// The fraction of `draws` ensembles in which each check fails within `budget`, in
+    /// [`CheckId::ALL`] order; `None` for the residual whiteness, whose products across fixes the
+    /// fix-level sums do not carry. Draw k has its own generator seeded from (`seed`, k), so the
+    /// fractions do not depend on the thread count.
+    pub fn detection(
+        &self,
+        schedule: &FilterSchedule,
+        budget: &Budget,
+        draws: u64,
+        seed: u64,
+    ) -> Vec<Option<f64>> {
+        let stats = |k: u64| {
+            let mut rng = Pcg64Mcg::seed_from_u64(mix(seed, k));
+            EnsembleStats::from_sums(&self.draw(&mut rng), schedule)
+        };
+        // The bands depend only on N and the members: judged once, reused for every draw.
+        let reference = checks::evaluate(&stats(0), budget).checks;
+        let failed = (0..draws)
+            .into_par_iter()
+            .map(|k| {
+                let s = stats(k);
+                reference
+                    .iter()
+                    .map(|c| u64::from(checks::fails_again(c, &s)))
+                    .collect::<Vec<_>>()
+            })
+            .reduce(
+                || vec![0; reference.len()],
+                |a, b| a.iter().zip(&b).map(|(x, y)| x + y).collect(),
+            );
+        CheckId::ALL
+            .iter()
+            .zip(failed)
+            .map(|(&id, f)| {
+                (id != CheckId::ResidualWhiteness && draws > 0).then(|| f as f64 / draws as f64)
+            })
+            .collect()
+    }
+}
+
+/// The seed of draw `k` under `seed` (SplitMix64 finalizer).
+fn mix(seed: u64, k: u64) -> u64 {
+    let mut z = seed ^ 0xD1B5_4A32_D192_ED03 ^ k.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The raw sums Σ e, Σ e·eᵀ, … of one stage from the scatter and the mean of z = (e, δx̂).
+fn stage_sums(scatter: &M6, mean: &V6, n: f64, p_inv: &Matrix3) -> StageSums {
+    let raw = scatter + mean * mean.transpose() * n;
+    let ee: Matrix3 = raw.fixed_view::<3, 3>(0, 0).into_owned();
+    StageSums {
+        e: mean.fixed_rows::<3>(0) * n,
+        ee: [
+            ee[(0, 0)],
+            ee[(0, 1)],
+            ee[(0, 2)],
+            ee[(1, 1)],
+            ee[(1, 2)],
+            ee[(2, 2)],
+        ],
+        ex: raw.fixed_view::<3, 3>(0, 3).into_owned(),
+        x: mean.fixed_rows::<3>(3) * n,
+        xx: raw.fixed_view::<3, 3>(3, 3).diagonal(),
+        nees: (p_inv * ee).trace(),
+    }
+}
+
+/// A matrix of independent standard normal draws.
+fn normals<const R: usize, const C: usize, G: rand::Rng + ?Sized>(
+    rng: &mut G,
+) -> SMatrix<f64, R, C> {
+    SMatrix::from_fn(|_, _| rng.sample(StandardNormal))
+}
+
+/// A Wishart(ν, I_D) draw by the Bartlett decomposition T·Tᵀ, T lower triangular with
+/// T_kk² ~ χ²(ν − k) and standard normal entries below the diagonal.
+fn wishart<const D: usize, G: rand::Rng + ?Sized>(nu: u64, rng: &mut G) -> SMatrix<f64, D, D> {
+    let mut t = SMatrix::<f64, D, D>::zeros();
+    for k in 0..D {
+        let chi = ChiSquared::new((nu - k as u64) as f64).expect("positive degrees of freedom");
+        t[(k, k)] = chi.sample(rng).sqrt();
+        for c in 0..k {
+            t[(k, c)] = rng.sample(StandardNormal);
+        }
+    }
+    t * t.transpose()
+}
+
+/// A lower-triangular L with L·Lᵀ = S for a positive semi-definite S: a Cholesky factorization
+/// that leaves a column at zero where the pivot has vanished (to rounding, relative to the
+/// diagonal), as the scatter of an estimate that has not moved yet needs.
+fn psd_cholesky<const D: usize>(s: &SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
+    let mut l = SMatrix::<f64, D, D>::zeros();
+    for j in 0..D {
+        let mut d = s[(j, j)];
+        for k in 0..j {
+            d -= l[(j, k)] * l[(j, k)];
+        }
+        if d <= 1e-12 * s[(j, j)].abs() || d <= 0.0 {
+            continue;
+        }
+        let d = d.sqrt();
+        l[(j, j)] = d;
+        for i in j + 1..D {
+            let mut v = s[(i, j)];
+            for k in 0..j {
+                v -= l[(i, k)] * l[(j, k)];
+            }
+            l[(i, j)] = v / d;
+        }
+    }
+    l
+}
+
+/// A square root of a small covariance (zero rows and columns allowed).
+fn root<const D: usize>(s: &SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
+    psd_cholesky(s)
+}
+
+fn symmetric<const D: usize>(m: SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
+    (m + m.transpose()) * 0.5
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn semi_definite_cholesky_reproduces_its_matrix() {
+        let v = SMatrix::<f64, 4, 2>::new(1.0, 0.0, 2.0, 1.0, 0.0, 3.0, 1.0, 1.0);
+        let s = v * v.transpose(); // rank 2
+        let l = psd_cholesky(&s);
+        assert!((l * l.transpose() - s).abs().max() < 1e-12);
+        let spd = s + SMatrix::<f64, 4, 4>::identity();
+        let l = psd_cholesky(&spd);
+        assert!((l - spd.cholesky().expect("definite").l()).abs().max() < 1e-12);
+    }
+}

@@ -1,0 +1,150 @@
+//! Quantiles of the null distributions the checks use: the standard normal and χ².
+//!
+//! statrs supplies the distributions; χ² tails are refined by bisection on the tail probability
+//! itself, which stays accurate far into either tail and for one or two degrees of freedom.
+
+use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
+
+/// Which tail of a distribution a probability refers to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tail {
+    /// P(X ≤ x).
+    Lower,
+    /// P(X > x).
+    Upper,
+}
+
+/// Two-sided standard normal bound at rate `p`: the b with P(|Z| > b) = p.
+///
+/// # Formula
+/// b = Φ⁻¹(1 − p/2), Φ the standard normal CDF.
+///
+/// # Panics
+/// When `p` is not in (0, 1].
+///
+/// # Examples
+/// ```
+/// let b = accelcal::stats::normal_bound(0.05);
+/// assert!((b - 1.959_963_984_540_054).abs() < 1e-9);
+/// ```
+pub fn normal_bound(p: f64) -> f64 {
+    assert!(p > 0.0 && p <= 1.0, "a two-sided rate in (0, 1], not {p}");
+    Normal::standard().inverse_cdf(1.0 - p / 2.0)
+}
+
+/// Two-sided band of χ²(dof)/scale at rate `p`: `p/2` in each tail.
+///
+/// # Panics
+/// When `dof` is not positive or `p` not in (0, 1].
+pub fn chi_squared_band(dof: f64, scale: f64, p: f64) -> (f64, f64) {
+    assert!(p > 0.0 && p <= 1.0, "a two-sided rate in (0, 1], not {p}");
+    (
+        chi_squared_quantile(dof, p / 2.0, Tail::Lower) / scale,
+        chi_squared_quantile(dof, p / 2.0, Tail::Upper) / scale,
+    )
+}
+
+/// The χ²(dof) quantile whose `tail` holds probability `p`.
+///
+/// statrs' inverse CDF is the starting point; it is then refined by bisection in log space on the
+/// tail probability, where the inverse alone can be off by a large factor.
+///
+/// # Panics
+/// When `dof` is not positive.
+pub fn chi_squared_quantile(dof: f64, p: f64, tail: Tail) -> f64 {
+    let chi = ChiSquared::new(dof).expect("positive degrees of freedom");
+    let start = chi.inverse_cdf(match tail {
+        Tail::Lower => p,
+        Tail::Upper => 1.0 - p,
+    });
+    // tail(x) − p changes sign once: increasing for the lower tail, decreasing for the upper.
+    let miss = |x: f64| match tail {
+        Tail::Lower => chi.cdf(x) - p,
+        Tail::Upper => p - chi.sf(x),
+    };
+    let (mut lo, mut hi) = (start.max(f64::MIN_POSITIVE), start.max(f64::MIN_POSITIVE));
+    while miss(lo) > 0.0 && lo > 1e-300 {
+        lo /= 4.0;
+    }
+    while miss(hi) < 0.0 && hi < 1e300 {
+        hi *= 4.0;
+    }
+    for _ in 0..200 {
+        let mid = (lo * hi).sqrt();
+        if miss(mid) < 0.0 {
+            lo = mid
+        } else {
+            hi = mid
+        }
+        if hi / lo - 1.0 < 1e-14 {
+            break;
+        }
+    }
+    (lo * hi).sqrt()
+}
+
+/// The median of χ²(dof).
+pub fn chi_squared_median(dof: f64) -> f64 {
+    chi_squared_quantile(dof, 0.5, Tail::Lower)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normal_bound_is_the_two_sided_quantile() {
+        // Pinned from an independent source (scipy.stats.norm.ppf(1 - 0.5e-6)).
+        approx::assert_relative_eq!(
+            normal_bound(1e-6),
+            4.891_638_475_714_78,
+            max_relative = 1e-9
+        );
+        approx::assert_relative_eq!(
+            normal_bound(0.05),
+            1.959_963_984_540_054,
+            max_relative = 1e-9
+        );
+    }
+
+    #[test]
+    fn chi_squared_quantiles_are_exact_for_one_and_two_degrees_of_freedom() {
+        let p = 5.5e-6;
+        // χ²(1) is the square of a standard normal: its p-quantile is Φ⁻¹((1 + p)/2)².
+        let exact = Normal::standard().inverse_cdf(0.5 + p / 2.0).powi(2);
+        approx::assert_relative_eq!(
+            chi_squared_quantile(1.0, p, Tail::Lower),
+            exact,
+            max_relative = 1e-6
+        );
+        // χ²(2) is exponential with mean 2.
+        approx::assert_relative_eq!(
+            chi_squared_quantile(2.0, p, Tail::Lower),
+            -2.0 * (-p).ln_1p(),
+            max_relative = 1e-9
+        );
+        approx::assert_relative_eq!(
+            chi_squared_quantile(2.0, p, Tail::Upper),
+            -2.0 * p.ln(),
+            max_relative = 1e-9
+        );
+    }
+
+    #[test]
+    fn chi_squared_band_matches_wilson_hilferty_for_large_dof() {
+        let k = 30_000.0;
+        let (lo, hi) = chi_squared_band(k, k, 1e-6);
+        let z = normal_bound(1e-6);
+        let wh = |z: f64| (1.0 - 2.0 / (9.0 * k) + z * (2.0 / (9.0 * k)).sqrt()).powi(3);
+        approx::assert_relative_eq!(lo, wh(-z), max_relative = 1e-4);
+        approx::assert_relative_eq!(hi, wh(z), max_relative = 1e-4);
+    }
+
+    #[test]
+    fn chi_squared_band_holds_its_rate_in_each_tail() {
+        // Pinned from an independent source (scipy.stats.chi2.ppf(0.005, 10) and ppf(0.995, 10)).
+        let (lo, hi) = chi_squared_band(10.0, 1.0, 0.01);
+        approx::assert_relative_eq!(lo, 2.155_856_481_304_639, max_relative = 1e-9);
+        approx::assert_relative_eq!(hi, 25.188_179_571_971_17, max_relative = 1e-9);
+    }
+}

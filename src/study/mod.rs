@@ -1,0 +1,161 @@
+//! A whole study: an ensemble for each case (truth model and accelerometer output), each with
+//! its verdicts, the mean error its deterministic part predicts and the accuracy it achieves,
+//! and one recorded realization of a consistent case. Numbers only, no formatting.
+//!
+//! This is the orchestration every command shares; it reports progress through a [`Progress`]
+//! it is handed, and knows nothing of terminals or pages.
+
+pub mod analysis;
+
+use crate::checks::{self, Budget, Verdicts};
+use crate::config::Case;
+use crate::ensemble::{self, EnsembleRun};
+use crate::error::FilterError;
+use crate::filter::FilterSchedule;
+use crate::model::Model;
+pub use crate::progress::{Progress, Silent};
+use crate::realization::{self, Realization};
+use crate::sensitivity::{self, Plan, Sensitivity, SensitivityError};
+pub use analysis::{MeanErrorPrediction, max_mean_over_sigma};
+
+/// The samples of the recorded realization that the report keeps, at most about: a run with
+/// more is thinned to what its figures can show.
+pub const FIGURE_SAMPLES: usize = 20_000;
+
+/// One case's ensemble and what it shows.
+#[derive(Clone, Debug)]
+pub struct CaseOutcome {
+    /// The simulated case.
+    pub case: Case,
+    /// The statistics and the run time.
+    pub run: EnsembleRun,
+    /// The checks' verdicts.
+    pub verdicts: Verdicts,
+    /// Largest |a posteriori mean error| / σ per state over all fixes (σ the filter's).
+    pub max_mean_over_sigma: [f64; 3],
+    /// The predicted mean error and how well it explains the measured one.
+    pub prediction: MeanErrorPrediction,
+    /// Achieved RMS a posteriori error of each state at every fix, (m, m/s, m/s²).
+    pub achieved_rms: Vec<[f64; 3]>,
+}
+
+impl CaseOutcome {
+    /// The achieved RMS error at the last fix.
+    pub fn achieved_rms_final(&self) -> [f64; 3] {
+        *self.achieved_rms.last().expect("at least two fixes")
+    }
+}
+
+/// Runs the ensemble of `model` (its configured case, size and seed) and judges it.
+pub fn run_case(
+    model: &Model,
+    schedule: &FilterSchedule,
+    progress: &mut dyn Progress,
+) -> CaseOutcome {
+    progress.start(&model.case().id(), model.config.ensemble.realizations);
+    let run = ensemble::run_model(model, schedule, |done| progress.advance(done));
+    progress.finish();
+    judge_case(model, schedule, run)
+}
+
+/// Judges the finished ensemble `run` of `model`: verdicts, predicted mean error, achieved
+/// accuracy. Used for a whole run and for merged shards alike.
+pub fn judge_case(model: &Model, schedule: &FilterSchedule, run: EnsembleRun) -> CaseOutcome {
+    let case = model.case();
+    let budget = Budget::study(model.config.checks.false_alarm_rate);
+    let verdicts = checks::evaluate(&run.stats, &budget);
+    let predicted = analysis::predicted_mean_error(model, schedule);
+    CaseOutcome {
+        case,
+        max_mean_over_sigma: max_mean_over_sigma(&run.stats),
+        prediction: analysis::explain_mean_error(predicted, &run.stats, schedule),
+        achieved_rms: analysis::achieved_rms(&run.stats),
+        run,
+        verdicts,
+    }
+}
+
+/// Everything the report shows.
+#[derive(Clone, Debug)]
+pub struct Study {
+    /// The configured model.
+    pub model: Model,
+    /// The filter's covariances and gains (the same for every case).
+    pub schedule: FilterSchedule,
+    /// One outcome per case: [`Case::REPORT`] in order, then the configured case when it is
+    /// not one of them.
+    pub cases: Vec<CaseOutcome>,
+    /// Realization 0 of a consistent case (see [`Study::realization_case`]), at every sample.
+    pub realization: Realization,
+    /// The case of the recorded realization: the first of (analytic truth, interval means),
+    /// (euler truth, point samples) whose checks all pass, else the first of them.
+    pub realization_case: Case,
+    /// The sensitivity to the assumed statistics, when it was run ([`Study::with_sensitivity`]).
+    pub sensitivity: Option<Sensitivity>,
+}
+
+impl Study {
+    /// Runs every case of `model` and records one realization.
+    ///
+    /// # Errors
+    /// [`FilterError`] when the filter's covariance stops being positive definite.
+    pub fn run(model: &Model, progress: &mut dyn Progress) -> Result<Self, FilterError> {
+        let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
+        let mut cases: Vec<Case> = Case::REPORT.to_vec();
+        if !cases.contains(&model.case()) {
+            cases.push(model.case());
+        }
+        let cases: Vec<CaseOutcome> = cases
+            .into_iter()
+            .map(|case| run_case(&model.with_case(case), &schedule, progress))
+            .collect();
+        let preferred = [Case::REPORT[2], Case::REPORT[0]];
+        let realization_case = preferred
+            .into_iter()
+            .find(|c| {
+                cases
+                    .iter()
+                    .any(|o| o.case == *c && o.verdicts.all_passed())
+            })
+            .unwrap_or(preferred[0]);
+        let realization = realization::record_for_figures(
+            &model.with_case(realization_case),
+            &schedule,
+            model.config.ensemble.seed,
+            0,
+            FIGURE_SAMPLES,
+        );
+        Ok(Self {
+            model: model.clone(),
+            schedule,
+            cases,
+            realization,
+            realization_case,
+            sensitivity: None,
+        })
+    }
+
+    /// The study with its sensitivity to the assumed statistics (the configuration's plan).
+    ///
+    /// # Errors
+    /// [`SensitivityError`] when a scaled statistic is out of range or breaks the filter.
+    pub fn with_sensitivity(
+        mut self,
+        progress: &mut dyn Progress,
+    ) -> Result<Self, SensitivityError> {
+        let config = &self.model.config;
+        self.sensitivity = Some(sensitivity::run(config, &Plan::of(config), progress)?);
+        Ok(self)
+    }
+
+    /// The outcome of `case`.
+    ///
+    /// # Panics
+    /// When `case` was not run.
+    pub fn case(&self, case: Case) -> &CaseOutcome {
+        self.cases
+            .iter()
+            .find(|o| o.case == case)
+            .expect("the case was run")
+    }
+}

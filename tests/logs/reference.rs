@@ -1,0 +1,211 @@
+//! An independent processing of the logs, written here with plain arrays and the textbook
+//! formulas: per-step Δt_j from the time stamps, Euler integration (eq. 3), Φ(Δt_j) and
+//! Q(Δt_j) = W·g·gᵀ, the short-form update P⁺ = P⁻ − K·S·Kᵀ with an explicit 2×2 inverse, and a
+//! Rauch–Tung–Striebel smoother over every sample with explicit 3×3 inverses. It shares no code
+//! with the library's filter.
+// Matrix formulas read best with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
+pub type M3 = [[f64; 3]; 3];
+/// An accelerometer log: (t, a_c).
+pub type AccelLog = Vec<(f64, f64)>;
+/// A GPS log: (t, z_p, z_v).
+pub type GpsLog = Vec<(f64, f64, f64)>;
+
+/// The filter's assumptions.
+#[derive(Clone, Copy, Debug)]
+pub struct Prior {
+    pub p0_m: f64,
+    pub v0_m_s: f64,
+    pub sigma_p0_m: f64,
+    pub sigma_v0_m_s: f64,
+    pub bias_var: f64,
+    pub accel_noise_var: f64,
+    pub gps_p_sigma_m: f64,
+    pub gps_v_sigma_m_s: f64,
+}
+
+impl Prior {
+    /// The default configuration's.
+    pub fn default_config() -> Self {
+        Prior {
+            p0_m: 0.0,
+            v0_m_s: 100.0,
+            sigma_p0_m: 10.0,
+            sigma_v0_m_s: 1.0,
+            bias_var: 0.01,
+            accel_noise_var: 0.0004,
+            gps_p_sigma_m: 1.0,
+            gps_v_sigma_m_s: 0.04,
+        }
+    }
+}
+
+/// Filtered and smoothed estimates at every sample.
+pub struct Processed {
+    pub t: Vec<f64>,
+    pub pc: Vec<f64>,
+    pub x: Vec<[f64; 3]>,
+    pub p: Vec<M3>,
+    pub xs: Vec<[f64; 3]>,
+    pub ps: Vec<M3>,
+}
+
+fn mul(a: &M3, b: &M3) -> M3 {
+    let mut c = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            for k in 0..3 {
+                c[i][j] += a[i][k] * b[k][j];
+            }
+        }
+    }
+    c
+}
+
+fn transpose(a: &M3) -> M3 {
+    let mut t = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            t[i][j] = a[j][i];
+        }
+    }
+    t
+}
+
+fn mul_v(a: &M3, v: &[f64; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|i| a[i][0] * v[0] + a[i][1] * v[1] + a[i][2] * v[2])
+}
+
+fn add(a: &M3, b: &M3, sign: f64) -> M3 {
+    let mut c = *a;
+    for i in 0..3 {
+        for j in 0..3 {
+            c[i][j] += sign * b[i][j];
+        }
+    }
+    c
+}
+
+/// Inverse by cofactors.
+fn inverse(a: &M3) -> M3 {
+    let c = |i: usize, j: usize| {
+        let (r0, r1) = ((i + 1) % 3, (i + 2) % 3);
+        let (c0, c1) = ((j + 1) % 3, (j + 2) % 3);
+        a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0]
+    };
+    let det = a[0][0] * c(0, 0) + a[0][1] * c(0, 1) + a[0][2] * c(0, 2);
+    let mut inv = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            inv[j][i] = c(i, j) / det;
+        }
+    }
+    inv
+}
+
+/// Processes an accelerometer log `(t, a_c)` and a GPS log `(t, z_p, z_v)`; each fix is applied
+/// at the sample nearest to it.
+pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> Processed {
+    let n = accel.len();
+    let mut fix_at = vec![None; n];
+    for &(tf, zp, zv) in gps {
+        let k = (0..n)
+            .min_by(|&a, &b| (accel[a].0 - tf).abs().total_cmp(&(accel[b].0 - tf).abs()))
+            .unwrap();
+        fix_at[k] = Some((zp, zv));
+    }
+    let (rp, rv) = (prior.gps_p_sigma_m.powi(2), prior.gps_v_sigma_m_s.powi(2));
+    let mut x = [0.0; 3];
+    let mut p = [
+        [prior.sigma_p0_m.powi(2), 0.0, 0.0],
+        [0.0, prior.sigma_v0_m_s.powi(2), 0.0],
+        [0.0, 0.0, prior.bias_var],
+    ];
+    let (mut pc, mut vc) = (prior.p0_m, prior.v0_m_s);
+    let mut out = Processed {
+        t: Vec::with_capacity(n),
+        pc: Vec::with_capacity(n),
+        x: Vec::with_capacity(n),
+        p: Vec::with_capacity(n),
+        xs: vec![],
+        ps: vec![],
+    };
+    // Per step: the a priori estimate at the next sample and the transition, for the smoother.
+    let mut x_prior_next = Vec::with_capacity(n);
+    let mut p_prior_next = Vec::with_capacity(n);
+    let mut f_step = Vec::with_capacity(n);
+    for k in 0..n {
+        if let Some((zp, zv)) = fix_at[k] {
+            // S = H P Hᵀ + R, H = [I₂ 0].
+            let s = [[p[0][0] + rp, p[0][1]], [p[1][0], p[1][1] + rv]];
+            let det = s[0][0] * s[1][1] - s[0][1] * s[1][0];
+            let si = [
+                [s[1][1] / det, -s[0][1] / det],
+                [-s[1][0] / det, s[0][0] / det],
+            ];
+            // K = P Hᵀ S⁻¹ (3×2).
+            let k_gain: [[f64; 2]; 3] = [0, 1, 2].map(|i| {
+                [
+                    p[i][0] * si[0][0] + p[i][1] * si[1][0],
+                    p[i][0] * si[0][1] + p[i][1] * si[1][1],
+                ]
+            });
+            let r = [zp - pc - x[0], zv - vc - x[1]];
+            for i in 0..3 {
+                x[i] += k_gain[i][0] * r[0] + k_gain[i][1] * r[1];
+            }
+            // P⁺ = P⁻ − K S Kᵀ.
+            let mut p_new = p;
+            for i in 0..3 {
+                for j in 0..3 {
+                    let mut ksk = 0.0;
+                    for a in 0..2 {
+                        for b in 0..2 {
+                            ksk += k_gain[i][a] * s[a][b] * k_gain[j][b];
+                        }
+                    }
+                    p_new[i][j] -= ksk;
+                }
+            }
+            p = p_new;
+        }
+        out.t.push(accel[k].0);
+        out.pc.push(pc);
+        out.x.push(x);
+        out.p.push(p);
+        if k + 1 < n {
+            let dt = accel[k + 1].0 - accel[k].0;
+            let a = accel[k].1;
+            pc += vc * dt + a * dt * dt / 2.0;
+            vc += a * dt;
+            let f = [[1.0, dt, -dt * dt / 2.0], [0.0, 1.0, -dt], [0.0, 0.0, 1.0]];
+            let g = [-dt * dt / 2.0, -dt, 0.0];
+            x = mul_v(&f, &x);
+            p = mul(&mul(&f, &p), &transpose(&f));
+            for i in 0..3 {
+                for j in 0..3 {
+                    p[i][j] += prior.accel_noise_var * g[i] * g[j];
+                }
+            }
+            x_prior_next.push(x);
+            p_prior_next.push(p);
+            f_step.push(f);
+        }
+    }
+    // Rauch–Tung–Striebel over every sample.
+    out.xs = out.x.clone();
+    out.ps = out.p.clone();
+    for k in (0..n.saturating_sub(1)).rev() {
+        let c = mul(
+            &mul(&out.p[k], &transpose(&f_step[k])),
+            &inverse(&p_prior_next[k]),
+        );
+        let dx = [0, 1, 2].map(|i| out.xs[k + 1][i] - x_prior_next[k][i]);
+        let corr = mul_v(&c, &dx);
+        out.xs[k] = [0, 1, 2].map(|i| out.x[k][i] + corr[i]);
+        let dp = add(&out.ps[k + 1], &p_prior_next[k], -1.0);
+        out.ps[k] = add(&out.p[k], &mul(&mul(&c, &dp), &transpose(&c)), 1.0);
+    }
+    out
+}

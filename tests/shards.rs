@@ -1,0 +1,268 @@
+//! Ensembles split across processes: shards merged in any order, on any thread count, give the
+//! summary of one run number for number; partial files of another ensemble, repeated, missing
+//! or truncated are refused with exit code 2. And long runs: the whiteness check falls back to
+//! lags when every pair of fixes would be too many.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+const CONFIG: &str =
+    "[profile]\nduration_s = 4.0\n[ensemble]\nrealizations = 1500\ntruth = \"euler\"\n";
+
+fn accelcal(args: &[&str], dir: &Path, threads: usize) -> Output {
+    Command::new(common::bin())
+        .args(args)
+        .current_dir(dir)
+        .env("RAYON_NUM_THREADS", threads.to_string())
+        .output()
+        .expect("the binary runs")
+}
+
+fn ok(o: &Output) {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// The JSON of `path` without its timing fields.
+fn summary(path: &Path) -> serde_json::Value {
+    fn strip(v: &mut serde_json::Value) {
+        match v {
+            serde_json::Value::Object(m) => {
+                m.remove("elapsed_s");
+                m.remove("realizations_per_s");
+                m.values_mut().for_each(strip);
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    let mut v = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    strip(&mut v);
+    v
+}
+
+fn shard(dir: &Path, k: usize, m: usize, seed: &str, file: &str, threads: usize) {
+    ok(&accelcal(
+        &[
+            "ensemble",
+            "--config",
+            "c.toml",
+            "--seed",
+            seed,
+            "--shard",
+            &format!("{k}/{m}"),
+            "--partial",
+            file,
+            "--quiet",
+        ],
+        dir,
+        threads,
+    ));
+}
+
+#[test]
+fn three_shards_merged_in_any_order_equal_one_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("c.toml"), CONFIG).unwrap();
+    ok(&accelcal(
+        &[
+            "ensemble",
+            "--config",
+            "c.toml",
+            "--json",
+            "whole.json",
+            "--quiet",
+        ],
+        d,
+        2,
+    ));
+    for (k, threads) in [(1, 1), (2, 2), (3, 3)] {
+        shard(d, k, 3, "2017", &format!("p{k}.bin"), threads);
+    }
+    let whole = summary(&d.join("whole.json"));
+    for order in [
+        ["p1.bin", "p2.bin", "p3.bin"],
+        ["p3.bin", "p1.bin", "p2.bin"],
+    ] {
+        let mut args = vec!["merge"];
+        args.extend(order);
+        args.extend(["--json", "merged.json", "--quiet"]);
+        ok(&accelcal(&args, d, 2));
+        assert_eq!(summary(&d.join("merged.json")), whole, "order {order:?}");
+    }
+    // A differing ensemble is seen: the comparison is not vacuous.
+    ok(&accelcal(
+        &[
+            "ensemble",
+            "--config",
+            "c.toml",
+            "--seed",
+            "9",
+            "--json",
+            "other.json",
+            "--quiet",
+        ],
+        d,
+        2,
+    ));
+    assert_ne!(summary(&d.join("other.json")), whole);
+}
+
+/// `merge` with `files` must exit 2 naming `culprit` and write nothing.
+fn refused(d: &Path, files: &[&str], culprit: &str, why: &str) {
+    let mut args = vec!["merge"];
+    args.extend(files);
+    args.extend(["--json", "out.json"]);
+    let o = accelcal(&args, d, 2);
+    let msg = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{files:?}: {msg}");
+    assert!(
+        msg.contains(culprit) && msg.contains(why),
+        "{files:?}: {msg}"
+    );
+    assert!(!d.join("out.json").exists());
+}
+
+#[test]
+fn partials_of_another_ensemble_or_split_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("c.toml"), CONFIG).unwrap();
+    for k in 1..=3 {
+        shard(d, k, 3, "2017", &format!("p{k}.bin"), 2);
+    }
+    shard(d, 2, 3, "5", "seed5.bin", 2);
+    shard(d, 2, 4, "2017", "of4.bin", 2);
+    refused(d, &["p1.bin", "seed5.bin", "p3.bin"], "seed5.bin", "seed 5");
+    refused(d, &["p1.bin", "p3.bin"], "p1.bin", "shard 2/3 is missing");
+    refused(
+        d,
+        &["p1.bin", "p2.bin", "p2.bin", "p3.bin"],
+        "p2.bin",
+        "given twice",
+    );
+    refused(d, &["p1.bin", "of4.bin", "p3.bin"], "of4.bin", "split");
+    let bytes = std::fs::read(d.join("p2.bin")).unwrap();
+    std::fs::write(d.join("cut.bin"), &bytes[..bytes.len() - 100]).unwrap();
+    refused(d, &["p1.bin", "cut.bin", "p3.bin"], "cut.bin", "truncated");
+    std::fs::write(d.join("text.bin"), "hello\n").unwrap();
+    refused(
+        d,
+        &["p1.bin", "text.bin", "p3.bin"],
+        "text.bin",
+        "not an accelcal partial",
+    );
+    refused(
+        d,
+        &["p1.bin", "absent.bin", "p3.bin"],
+        "absent.bin",
+        "cannot open",
+    );
+    for bad in ["0/3", "4/3", "2", "a/b", "1/999"] {
+        let o = accelcal(
+            &[
+                "ensemble",
+                "--config",
+                "c.toml",
+                "--shard",
+                bad,
+                "--partial",
+                "x.bin",
+            ],
+            d,
+            2,
+        );
+        let msg = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {msg}");
+        assert!(msg.contains("--shard"), "{bad}: {msg}");
+        assert!(!d.join("x.bin").exists());
+    }
+}
+
+#[test]
+fn long_runs_test_lags_and_say_so() {
+    // 10 min at 100 Hz with a fix every second: 600 fixes, lags up to 20 by configuration.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("c.toml"),
+        "[profile]\nduration_s = 600.0\n[accelerometer]\nsample_rate_hz = 100.0\n[gps]\nsample_rate_hz = 1.0\n[ensemble]\nrealizations = 300\ntruth = \"euler\"\n[checks]\nresidual_max_lag = 20\n",
+    )
+    .unwrap();
+    ok(&accelcal(
+        &[
+            "ensemble", "--config", "c.toml", "--json", "e.json", "--quiet",
+        ],
+        d,
+        2,
+    ));
+    let e = summary(&d.join("e.json"));
+    let s = &e["summary"];
+    assert_eq!(s["all_passed"], true, "{}", s["checks"]);
+    assert_eq!(s["residual_pairs"]["all_pairs"], false);
+    assert_eq!(s["residual_pairs"]["max_lag"], 20);
+    let whiteness = s["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["id"] == "residual_whiteness")
+        .unwrap();
+    // Pairs (i, m) with 1 ≤ i − m ≤ 20 over 600 fixes, four component pairs each.
+    let pairs: u64 = (1..=20).map(|lag| 600 - lag).sum();
+    assert_eq!(whiteness["members"], 4 * pairs);
+    assert_eq!(e["residual_whiteness_by_lag"].as_array().unwrap().len(), 20);
+}
+
+#[test]
+fn the_slurm_example_runs_each_array_task_as_a_shard() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("c.toml"), CONFIG).unwrap();
+    let bin_dir = Path::new(common::bin()).parent().unwrap();
+    let path = format!(
+        "{}:{}",
+        bin_dir.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/slurm-ensemble.sh");
+    for task in 1..=3 {
+        let o = Command::new("bash")
+            .arg(&script)
+            .args(["c.toml", "out"])
+            .current_dir(d)
+            .env("PATH", &path)
+            .env("SLURM_ARRAY_TASK_COUNT", "3")
+            .env("SLURM_ARRAY_TASK_ID", task.to_string())
+            .output()
+            .unwrap();
+        ok(&o);
+    }
+    ok(&accelcal(
+        &[
+            "merge",
+            "out/part-1.bin",
+            "out/part-2.bin",
+            "out/part-3.bin",
+            "--json",
+            "m.json",
+            "--quiet",
+        ],
+        d,
+        2,
+    ));
+    ok(&accelcal(
+        &[
+            "ensemble",
+            "--config",
+            "c.toml",
+            "--json",
+            "whole.json",
+            "--quiet",
+        ],
+        d,
+        2,
+    ));
+    assert_eq!(summary(&d.join("m.json")), summary(&d.join("whole.json")));
+}
