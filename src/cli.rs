@@ -133,6 +133,10 @@ pub struct SensitivityArgs {
     /// overriding sensitivity.ensembles.
     #[arg(long, value_name = "K")]
     pub ensembles: Option<u64>,
+    /// Sampled ensembles per statistic and factor that predict the detection probabilities
+    /// (0: no prediction), overriding sensitivity.draws.
+    #[arg(long, value_name = "D")]
+    pub draws: Option<u64>,
     /// Write the JSON here instead of to standard output.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,

@@ -88,9 +88,58 @@ pub fn chi_squared_median(dof: f64) -> f64 {
     chi_squared_quantile(dof, 0.5, Tail::Lower)
 }
 
+/// One-sided Clopper–Pearson confidence bounds on a binomial probability from `successes` in
+/// `trials`: the (lower, upper) bounds, each holding with probability at least `confidence`.
+///
+/// # Formula
+/// lower = B⁻¹(1 − c; k, n − k + 1) (0 when k = 0), upper = B⁻¹(c; k + 1, n − k) (1 when k = n),
+/// B⁻¹ the Beta quantile, c the confidence.
+///
+/// # Panics
+/// When `successes > trials`, `trials` is 0 or `confidence` is not in (0, 1).
+///
+/// # Examples
+/// ```
+/// // 60 detections in 60 ensembles: the probability is at least 0.951 with 95 % confidence.
+/// let (lo, hi) = accelcal::stats::clopper_pearson(60, 60, 0.95);
+/// assert!((lo - 0.05f64.powf(1.0 / 60.0)).abs() < 1e-9 && hi == 1.0);
+/// ```
+pub fn clopper_pearson(successes: u64, trials: u64, confidence: f64) -> (f64, f64) {
+    use statrs::distribution::Beta;
+    assert!(successes <= trials && trials > 0 && confidence > 0.0 && confidence < 1.0);
+    let (k, n) = (successes as f64, trials as f64);
+    let lower = if successes == 0 {
+        0.0
+    } else {
+        Beta::new(k, n - k + 1.0)
+            .expect("positive shapes")
+            .inverse_cdf(1.0 - confidence)
+    };
+    let upper = if successes == trials {
+        1.0
+    } else {
+        Beta::new(k + 1.0, n - k)
+            .expect("positive shapes")
+            .inverse_cdf(confidence)
+    };
+    (lower, upper)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn clopper_pearson_matches_the_tabulated_interval() {
+        // 5 of 10: the two-sided 90 % Clopper–Pearson interval is [0.2224, 0.7776].
+        let (lo, hi) = clopper_pearson(5, 10, 0.95);
+        assert!(
+            (lo - 0.222_441).abs() < 1e-5 && (hi - 0.777_559).abs() < 1e-5,
+            "{lo} {hi}"
+        );
+        assert_eq!(clopper_pearson(0, 7, 0.95).0, 0.0);
+        assert!((clopper_pearson(0, 7, 0.95).1 - (1.0 - 0.05f64.powf(1.0 / 7.0))).abs() < 1e-9);
+    }
 
     #[test]
     fn normal_bound_is_the_two_sided_quantile() {

@@ -365,6 +365,8 @@ fn sensitivity_refuses_bad_parameters_and_factors() {
     sensitivity_refuses(&["--factors", "inf"], "--factors");
     sensitivity_refuses(&["--factors", "nan"], "--factors");
     sensitivity_refuses(&["--factors", ""], "--factors");
+    sensitivity_refuses(&["--ensembles", "10001"], "--ensembles");
+    sensitivity_refuses(&["--draws", "1000001"], "--draws");
 }
 
 #[test]
@@ -413,5 +415,50 @@ fn sensitivity_writes_the_cases_of_the_data_contract() {
         assert_eq!(c["monte_carlo"]["ensembles"], 2);
         assert_eq!(c["monte_carlo"]["realizations"], 200);
         assert_eq!(c["monte_carlo"]["detected"].as_object().unwrap().len(), 7);
+        assert_eq!(
+            c["detection_method"]["nees"],
+            "sampled_sufficient_statistics"
+        );
+        assert_eq!(c["detection_method"]["residual_whiteness"], "monte_carlo");
     }
+}
+
+#[test]
+fn sensitivity_without_ensembles_writes_null_measurements() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("c.toml"),
+        "[profile]\nduration_s = 2.0\n[ensemble]\nrealizations = 200\n",
+    )
+    .unwrap();
+    let o = run(
+        &[
+            "sensitivity",
+            "--config",
+            "c.toml",
+            "--parameters",
+            "gps_position_sigma_m",
+            "--factors",
+            "0.5",
+            "--ensembles",
+            "0",
+            "--draws",
+            "50",
+            "--json",
+            "s.json",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.json")).unwrap()).unwrap();
+    let c = &doc["cases"][0];
+    assert!(c["monte_carlo"]["detected"].is_null(), "{c}");
+    assert_eq!(c["monte_carlo"]["ensembles"], 0);
+    // Nothing measures the residual whiteness; the other checks are sampled.
+    assert!(c["detection"]["residual_whiteness"].is_null(), "{c}");
+    assert!(c["detection_method"]["residual_whiteness"].is_null(), "{c}");
+    assert!(c["detection"]["nees"].is_number(), "{c}");
+    assert_eq!(c["detection_draws"], 50);
 }

@@ -110,18 +110,23 @@ impl Bar {
 
 impl Progress for Bar {
     fn start(&mut self, label: &str, total: u64) {
+        self.start_in(label, total, "realizations");
+    }
+
+    fn start_in(&mut self, label: &str, total: u64, unit: &str) {
         if self.quiet {
             return;
         }
         let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
         bar.set_style(
             ProgressStyle::with_template(
-                "{prefix:>9} [{bar:40}] {pos}/{len} realizations, {elapsed} elapsed, eta {eta}",
+                "{prefix:>9} [{bar:40}] {pos}/{len} {msg}, {elapsed} elapsed, eta {eta}",
             )
             .expect("valid template")
             .progress_chars("=> "),
         );
         bar.set_prefix(label.to_string());
+        bar.set_message(unit.to_string());
         self.bar = Some(bar);
     }
 

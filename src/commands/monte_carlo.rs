@@ -121,11 +121,28 @@ fn sensitivity_plan(args: &SensitivityArgs, config: &Config) -> Result<Plan, Con
             })
             .collect::<Result<_, _>>()?
     };
+    let ensembles = args.ensembles.unwrap_or(config.sensitivity.ensembles);
+    if ensembles > 10_000 {
+        return Err(ConfigError::invalid(
+            "--ensembles",
+            ensembles,
+            "must be a whole number in [0, 10000]",
+        ));
+    }
+    let draws = args.draws.unwrap_or(config.sensitivity.draws);
+    if draws > 1_000_000 {
+        return Err(ConfigError::invalid(
+            "--draws",
+            draws,
+            "must be a whole number in [0, 1000000]",
+        ));
+    }
     Ok(Plan {
         parameters,
         factors,
         realizations: config.ensemble.realizations,
-        ensembles: args.ensembles.unwrap_or(config.sensitivity.ensembles),
+        ensembles,
+        draws,
     })
 }
 

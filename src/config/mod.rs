@@ -220,6 +220,8 @@ pub struct SensitivityConfig {
     pub factors: Vec<f64>,
     /// Independent Monte Carlo ensembles of `ensemble.realizations` per statistic and factor.
     pub ensembles: u64,
+    /// Sampled ensembles per statistic and factor that predict the detection probabilities.
+    pub draws: u64,
 }
 
 impl Default for SensitivityConfig {
@@ -227,6 +229,7 @@ impl Default for SensitivityConfig {
         Self {
             factors: vec![0.25, 0.5, 2.0, 4.0],
             ensembles: 1,
+            draws: 1000,
         }
     }
 }

@@ -24,11 +24,16 @@ pub struct CaseRecord {
     pub expected_nees_final: f64,
     /// tr(S⁻¹·S_actual) at the last fix.
     pub expected_nis_final: f64,
-    /// Probability that each check fails: predicted where closed-form, else measured.
-    pub detection: BTreeMap<&'static str, f64>,
-    /// How each detection probability was obtained: "closed_form" or "monte_carlo".
-    pub detection_method: BTreeMap<&'static str, &'static str>,
-    /// Bounds [largest member, sum of members] of each closed-form probability.
+    /// Probability that each check fails: predicted from sampled ensembles where the sums carry
+    /// the check, else measured by the Monte Carlo, else null.
+    pub detection: BTreeMap<&'static str, Option<f64>>,
+    /// How each detection probability was obtained: "sampled_sufficient_statistics",
+    /// "monte_carlo", or null.
+    pub detection_method: BTreeMap<&'static str, Option<&'static str>>,
+    /// Sampled ensembles behind each "sampled_sufficient_statistics" probability.
+    pub detection_draws: u64,
+    /// Exact bounds [largest member, sum of members] on the detection probability, from the
+    /// members' closed-form distributions (mean error, variance, NEES, NIS).
     pub detection_bounds: BTreeMap<&'static str, [f64; 2]>,
     /// The Monte Carlo measurement.
     pub monte_carlo: MonteCarloRecord,
@@ -41,8 +46,8 @@ pub struct MonteCarloRecord {
     pub realizations: u64,
     /// Independent ensembles.
     pub ensembles: u64,
-    /// Fraction of the ensembles in which each check failed.
-    pub detected: BTreeMap<&'static str, f64>,
+    /// Fraction of the ensembles in which each check failed; null when none ran.
+    pub detected: Option<BTreeMap<&'static str, f64>>,
 }
 
 /// The whole study as written to JSON.
@@ -60,9 +65,6 @@ pub struct SensitivityRecord {
 
 /// The record of `s`.
 pub fn record(s: &Sensitivity) -> SensitivityRecord {
-    let per_check = |f: &dyn Fn(CheckId) -> Option<(&'static str, f64)>| -> BTreeMap<_, _> {
-        CheckId::ALL.iter().filter_map(|&id| f(id)).collect()
-    };
     SensitivityRecord {
         false_alarm_rate: s.false_alarm_rate,
         factors: s.plan.factors.clone(),
@@ -77,27 +79,35 @@ pub fn record(s: &Sensitivity) -> SensitivityRecord {
                 actual_sigma_final: FinalSigma::from(c.actual_sigma_final),
                 expected_nees_final: c.expected_nees_final,
                 expected_nis_final: c.expected_nis_final,
-                detection: per_check(&|id| Some((id.name(), c.detection(id)))),
+                detection: CheckId::ALL
+                    .iter()
+                    .map(|&id| (id.name(), c.detection(id)))
+                    .collect(),
                 detection_method: CheckId::ALL
                     .iter()
                     .map(|&id| {
-                        let method = match c.predicted[id.index()] {
-                            Some(_) => "closed_form",
-                            None => "monte_carlo",
+                        let method = if c.predicted[id.index()].is_some() {
+                            Some("sampled_sufficient_statistics")
+                        } else {
+                            c.detected.as_ref().map(|_| "monte_carlo")
                         };
                         (id.name(), method)
                     })
                     .collect(),
+                detection_draws: c.draws,
                 detection_bounds: CheckId::ALL
                     .iter()
-                    .filter_map(|&id| {
-                        c.predicted[id.index()].map(|d| (id.name(), [d.lower, d.upper]))
-                    })
+                    .filter_map(|&id| c.bounds[id.index()].map(|d| (id.name(), [d.lower, d.upper])))
                     .collect(),
                 monte_carlo: MonteCarloRecord {
                     realizations: s.plan.realizations,
                     ensembles: c.ensembles,
-                    detected: per_check(&|id| Some((id.name(), c.detected[id.index()]))),
+                    detected: c.detected.as_ref().map(|d| {
+                        CheckId::ALL
+                            .iter()
+                            .map(|&id| (id.name(), d[id.index()]))
+                            .collect()
+                    }),
                 },
             })
             .collect(),

@@ -217,6 +217,13 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
             "must be a whole number in [0, 10000]",
         ));
     }
+    if sens.draws > 1_000_000 {
+        return Err(ConfigError::invalid(
+            "sensitivity.draws",
+            sens.draws,
+            "must be a whole number in [0, 1000000]",
+        ));
+    }
 
     let k = &c.checks;
     finite_in(

@@ -10,21 +10,16 @@ use crate::format::{count, fixed, short, sig};
 use crate::plot::{self, SensitivitySeries};
 use crate::sensitivity::{AssumedStatistic, Sensitivity, SensitivityCase};
 
-/// Whether check `id` surely detects case `c`: the closed-form lower bound is at least 0.95,
-/// or, without a closed form, every Monte Carlo ensemble failed it.
+/// Whether check `id` surely detects case `c`: its detection probability is at least 0.95 by a
+/// bound that holds with 95 % confidence (exact, sampled or measured).
 fn sure(c: &SensitivityCase, id: CheckId) -> bool {
-    match c.predicted[id.index()] {
-        Some(d) => d.lower >= 0.95,
-        None => c.ensembles > 0 && c.detected[id.index()] >= 1.0,
-    }
+    c.detection_interval(id).is_some_and(|(lo, _)| lo >= 0.95)
 }
 
-/// Whether check `id` surely misses case `c`.
+/// Whether check `id` surely misses case `c`: its detection probability is below 0.05 by such a
+/// bound.
 fn missed(c: &SensitivityCase, id: CheckId) -> bool {
-    match c.predicted[id.index()] {
-        Some(d) => d.upper < 0.05,
-        None => c.ensembles > 0 && c.detected[id.index()] <= 0.0,
-    }
+    c.detection_interval(id).is_some_and(|(_, hi)| hi < 0.05)
 }
 
 fn cases_of(s: &Sensitivity, p: AssumedStatistic) -> Vec<&SensitivityCase> {
@@ -123,15 +118,13 @@ fn findings(s: &Sensitivity) -> Vec<String> {
         seen.push(format!("{} ({})", p.title(), sides.join("; ")));
     }
     out.push(format!(
-        "The checks sure to detect each mistuning at the mildest factor on either side — with probability at least 0.95 by the lower bound of the closed-form prediction, or in every Monte Carlo ensemble where there is none — are the first to see it as the assumption drifts: {}.",
+        "The checks sure to detect each mistuning at the mildest factor on either side — with probability at least 0.95 by a bound that holds with 95 % confidence: the exact closed-form bound, or the Clopper–Pearson bound of the sampled ensembles, or of the Monte Carlo ensembles for the residual whiteness — are the first to see it as the assumption drifts: {}.",
         seen.join("; ")
     ));
     out
 }
 
 fn cell(c: &SensitivityCase, id: CheckId) -> DetectionCell {
-    let k = c.ensembles;
-    let measured = (c.detected[id.index()] * k as f64).round() as u64;
     let level = if sure(c, id) {
         "high"
     } else if missed(c, id) {
@@ -140,12 +133,13 @@ fn cell(c: &SensitivityCase, id: CheckId) -> DetectionCell {
         "mid"
     };
     DetectionCell {
-        predicted: c.predicted[id.index()]
-            .map_or_else(|| "—".to_string(), |d| fixed(d.probability, 2)),
-        measured: if k > 0 {
-            format!("{}/{}", count(measured), count(k))
-        } else {
-            "—".to_string()
+        predicted: c.predicted[id.index()].map_or_else(|| "—".to_string(), |p| fixed(p, 2)),
+        measured: match &c.detected {
+            Some(d) => {
+                let failed = (d[id.index()] * c.ensembles as f64).round() as u64;
+                format!("{}/{}", count(failed), count(c.ensembles))
+            }
+            None => "—".to_string(),
         },
         level: level.to_string(),
     }
@@ -200,6 +194,7 @@ pub fn view(s: &Sensitivity, numbers: &mut Numbering) -> Result<SensitivityView,
         rows,
         realizations: count(s.plan.realizations),
         ensembles: count(s.plan.ensembles),
+        draws: count(s.cases.first().map_or(0, |c| c.draws)),
         ensembles_words: match s.plan.ensembles {
             0 => "no Monte Carlo ensemble".to_string(),
             1 => "one independent Monte Carlo ensemble".to_string(),

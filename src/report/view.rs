@@ -350,6 +350,8 @@ pub struct SensitivityView {
     pub realizations: String,
     /// Ensembles per case.
     pub ensembles: String,
+    /// Sampled ensembles per case behind the predictions.
+    pub draws: String,
     /// Ensembles per case, in words: "one independent Monte Carlo ensemble".
     pub ensembles_words: String,
     /// Words derived from the numbers, one paragraph each.

@@ -58,6 +58,57 @@ pub fn actual_covariance(
     out
 }
 
+/// The filter's claimed covariance and the actual error covariance at one accelerometer sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampleCovariance {
+    /// Sample index j.
+    pub sample: usize,
+    /// Time of the sample, s.
+    pub time_s: f64,
+    /// The filter's own covariance P, (m, m/s, m/s²)²: a posteriori at a fix.
+    pub claimed: Matrix3,
+    /// The actual error covariance, likewise.
+    pub actual: Matrix3,
+}
+
+/// Visits the claimed and the actual covariance of the filter `schedule` at every accelerometer
+/// sample j = 0, …, steps, in time order (a posteriori at a fix), when the truth has the
+/// statistics `truth`. Memory does not grow with the run: nothing is kept between samples.
+///
+/// # Formula
+/// As [`actual_covariance`], with the filter's own P propagated beside it by its assumed model
+/// and set to its a posteriori P⁺ at every fix.
+pub fn covariance_at_samples(
+    timeline: &Timeline,
+    schedule: &FilterSchedule,
+    truth: &NoiseStats,
+    mut visit: impl FnMut(SampleCovariance),
+) {
+    let world = ErrorStateModel::new(timeline.dt_s, truth);
+    let filter = &schedule.model;
+    let h = &filter.h;
+    let (mut claimed, mut actual) = (filter.p0, world.p0);
+    let mut fixes = timeline.fix_steps.iter().zip(&schedule.fixes).peekable();
+    for j in 0..=timeline.steps {
+        if j > 0 {
+            claimed = filter.propagate(&claimed);
+            actual = world.propagate(&actual);
+        }
+        if let Some((_, fix)) = fixes.next_if(|(jf, _)| **jf == j) {
+            let i_kh = Matrix3::identity() - fix.gain * h;
+            let post = i_kh * actual * i_kh.transpose() + fix.gain * world.r * fix.gain.transpose();
+            actual = (post + post.transpose()) * 0.5;
+            claimed = fix.p_post;
+        }
+        visit(SampleCovariance {
+            sample: j,
+            time_s: timeline.time_s(j),
+            claimed,
+            actual,
+        });
+    }
+}
+
 /// tr(A⁻¹·B) and tr((A⁻¹·B)²) for symmetric positive definite A: the sum and the sum of squares
 /// of the weights λ of a quadratic form xᵀA⁻¹x with x ~ N(0, B), which is Σ λ_k χ²(1).
 pub fn weights<const D: usize>(

@@ -4,8 +4,10 @@
 //! χ² sums for NEES and NIS, approximated by the scaled χ² with the same mean and variance.
 //!
 //! A check fails when any of its members does. Whatever the dependence between members, that
-//! probability lies between the largest member's and the sum of all (Fréchet bounds); the point
-//! prediction treats the members as independent, which stays within those bounds.
+//! probability lies between the largest member's and the sum of all (Fréchet bounds), which are
+//! what the study reports from here. The point value that treats the members as independent is
+//! kept for comparison only: members are strongly correlated across fixes and it overstates the
+//! probability (the sampled prediction of [`super::sampler`] replaces it).
 
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 

@@ -1,11 +1,13 @@
 //! Sensitivity to the assumed statistics: what a wrong assumption costs and whether the checks
 //! see it. For each statistic the filter assumes and each factor, the filter assumes that
 //! statistic's standard deviation times the factor while the truth keeps its value; the exact
-//! actual covariance gives the accuracy reached against the accuracy claimed and the closed-form
-//! detection probabilities, and independent Monte Carlo ensembles measure the detection.
+//! actual covariance gives the accuracy reached against the accuracy claimed and, per check, exact
+//! bounds on the detection probability; draws of the ensemble's fix-level sums ([`sampler`])
+//! predict the detection probability itself, and independent Monte Carlo ensembles measure it.
 //!
 //! The world is the one the filter's model assumes (euler truth, point samples), so that the
-//! mistuning is the only discrepancy.
+//! mistuning is the only discrepancy: `ensemble.truth` and `accelerometer.output` of the
+//! configuration are not used here.
 
 pub mod covariance;
 pub mod detection;
@@ -18,7 +20,7 @@ use crate::error::{ConfigError, FilterError};
 use crate::filter::FilterSchedule;
 use crate::model::Model;
 use crate::progress::Progress;
-pub use covariance::{ActualFix, actual_covariance};
+pub use covariance::{ActualFix, SampleCovariance, actual_covariance, covariance_at_samples};
 pub use detection::Detection;
 
 /// A statistic the filter assumes (a key of the configuration's `[filter]` section).
@@ -120,17 +122,21 @@ pub struct Plan {
     pub realizations: u64,
     /// Independent Monte Carlo ensembles per case; 0 skips the Monte Carlo.
     pub ensembles: u64,
+    /// Draws of the ensemble's sums per case that predict the detection probabilities; 0 skips
+    /// the prediction.
+    pub draws: u64,
 }
 
 impl Plan {
     /// The plan of `config`: every assumed statistic, `sensitivity.factors`,
-    /// `sensitivity.ensembles` ensembles of `ensemble.realizations`.
+    /// `sensitivity.ensembles` ensembles of `ensemble.realizations`, `sensitivity.draws` draws.
     pub fn of(config: &Config) -> Self {
         Self {
             parameters: AssumedStatistic::ALL.to_vec(),
             factors: config.sensitivity.factors.clone(),
             realizations: config.ensemble.realizations,
             ensembles: config.sensitivity.ensembles,
+            draws: config.sensitivity.draws,
         }
     }
 }
@@ -175,21 +181,51 @@ pub struct SensitivityCase {
     pub expected_nees_final: f64,
     /// Expected average NIS at the last fix, tr(S⁻¹·S_actual).
     pub expected_nis_final: f64,
-    /// Predicted detection probability per check, in [`CheckId::ALL`] order; `None` where it
-    /// is measured by Monte Carlo only.
-    pub predicted: Vec<Option<Detection>>,
+    /// Predicted detection probability per check, in [`CheckId::ALL`] order: the fraction of
+    /// [`SensitivityCase::draws`] sampled ensembles in which the check fails; `None` for the
+    /// residual whiteness, which the sampled sums do not carry, and when nothing was drawn.
+    pub predicted: Vec<Option<f64>>,
+    /// Sampled ensembles behind [`SensitivityCase::predicted`].
+    pub draws: u64,
+    /// Exact bounds on the detection probability from the members' closed-form distributions,
+    /// in [`CheckId::ALL`] order; `None` for the correlation scores, which have none.
+    pub bounds: Vec<Option<Detection>>,
     /// Monte Carlo ensembles run.
     pub ensembles: u64,
-    /// Fraction of the ensembles in which each check failed, in [`CheckId::ALL`] order.
-    pub detected: Vec<f64>,
+    /// Fraction of the ensembles in which each check failed, in [`CheckId::ALL`] order; `None`
+    /// when no ensemble ran.
+    pub detected: Option<Vec<f64>>,
 }
 
+/// The confidence of each one-sided bound on a sampled or measured detection probability.
+pub const CONFIDENCE: f64 = 0.95;
+
 impl SensitivityCase {
-    /// The detection probability of `id`: predicted where it has a closed form, else measured.
-    pub fn detection(&self, id: CheckId) -> f64 {
-        match self.predicted[id.index()] {
-            Some(d) => d.probability,
-            None => self.detected[id.index()],
+    /// The detection probability of `id`: predicted where the sums are sampled, else measured,
+    /// else unknown.
+    pub fn detection(&self, id: CheckId) -> Option<f64> {
+        self.predicted[id.index()].or_else(|| Some(self.detected.as_ref()?[id.index()]))
+    }
+
+    /// Bounds (lower, upper) on the detection probability of `id`, each holding with at least
+    /// [`CONFIDENCE`]: the tighter of the exact closed-form bounds and the one-sided
+    /// Clopper–Pearson bounds of the sampled fraction or, where nothing was sampled, of the
+    /// measured one. `None` when there is neither.
+    pub fn detection_interval(&self, id: CheckId) -> Option<(f64, f64)> {
+        let i = id.index();
+        let exact = self.bounds[i].map(|d| (d.lower, d.upper));
+        let counted = match (self.predicted[i], &self.detected) {
+            (Some(p), _) => Some((p, self.draws)),
+            (None, Some(m)) if self.ensembles > 0 => Some((m[i], self.ensembles)),
+            _ => None,
+        };
+        let binomial = counted.map(|(fraction, trials)| {
+            let failed = (fraction * trials as f64).round() as u64;
+            crate::stats::clopper_pearson(failed, trials, CONFIDENCE)
+        });
+        match (exact, binomial) {
+            (Some((a, b)), Some((c, d))) => Some((a.max(c), b.min(d))),
+            (e, b) => e.or(b),
         }
     }
 }
@@ -221,9 +257,34 @@ fn sigma(p: &crate::filter::Matrix3) -> [f64; 3] {
     std::array::from_fn(|k| p[(k, k)].sqrt())
 }
 
+/// The filter of `parameter` × `factor` in `world`, with its schedule.
+fn mistuned(
+    world: &Config,
+    parameter: AssumedStatistic,
+    factor: f64,
+) -> Result<(Model, FilterSchedule), SensitivityError> {
+    let name = parameter.name();
+    let model = Model::new(&parameter.scaled(world, factor)).map_err(|source| {
+        SensitivityError::Config {
+            parameter: name,
+            factor,
+            source,
+        }
+    })?;
+    let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats).map_err(|source| {
+        SensitivityError::Filter {
+            parameter: name,
+            factor,
+            source,
+        }
+    })?;
+    Ok((model, schedule))
+}
+
 /// Runs `plan` on `base` (its statistics are the truth's; its `[filter]` the starting point).
-/// The Monte Carlo ensembles of case c, ensemble k draw from seed `ensemble.seed` mixed with
-/// (c, k): results do not depend on the thread count.
+/// The sampled ensembles and the Monte Carlo ensembles of a case draw from seeds derived from
+/// `ensemble.seed`, the statistic and the factor (not the case's place in the plan), so a case
+/// gives the same numbers in any plan and on any thread count.
 ///
 /// # Errors
 /// [`SensitivityError`] when a scaled statistic is out of range or breaks the filter.
@@ -247,40 +308,73 @@ pub fn run(
                 source,
             }
         })?;
-    let total =
-        (plan.parameters.len() * plan.factors.len()) as u64 * plan.ensembles * plan.realizations;
-    progress.start("sensitivity", total);
-    let mut done = 0;
-    let mut cases = Vec::new();
-    for &parameter in &plan.parameters {
-        for &factor in &plan.factors {
-            let config = parameter.scaled(&world, factor);
-            let name = parameter.name();
-            let model = Model::new(&config).map_err(|source| SensitivityError::Config {
-                parameter: name,
-                factor,
-                source,
-            })?;
-            let schedule =
-                FilterSchedule::new(&model.timeline, &model.filter_stats).map_err(|source| {
-                    SensitivityError::Filter {
-                        parameter: name,
-                        factor,
-                        source,
-                    }
-                })?;
-            let actual = actual_covariance(&model.timeline, &schedule, &model.truth_stats);
-            let (last_fix, last_actual) = (
-                schedule.fixes.last().expect("fixes"),
-                actual.last().expect("fixes"),
-            );
-            let predicted = CheckId::ALL
-                .iter()
-                .map(|&id| detection::predicted(id, &schedule, &actual, plan.realizations, &budget))
-                .collect();
+    let grid: Vec<(AssumedStatistic, f64)> = plan
+        .parameters
+        .iter()
+        .flat_map(|&p| plan.factors.iter().map(move |&f| (p, f)))
+        .collect();
+    // The sampler needs more realizations than the joint state has dimensions.
+    let draws = if plan.realizations > 6 { plan.draws } else { 0 };
+    let seed = base.ensemble.seed;
+
+    // Exact and sampled predictions, no simulation.
+    progress.start_in("predict", grid.len() as u64 * draws, "sampled ensembles");
+    let mut cases = Vec::with_capacity(grid.len());
+    for &(parameter, factor) in &grid {
+        let (model, schedule) = mistuned(&world, parameter, factor)?;
+        let actual = actual_covariance(&model.timeline, &schedule, &model.truth_stats);
+        let (last_fix, last_actual) = (
+            schedule.fixes.last().expect("fixes"),
+            actual.last().expect("fixes"),
+        );
+        let bounds = CheckId::ALL
+            .iter()
+            .map(|&id| detection::predicted(id, &schedule, &actual, plan.realizations, &budget))
+            .collect();
+        let predicted = if draws > 0 {
+            sampler::Sampler::new(
+                &model.timeline,
+                &schedule,
+                &model.truth_stats,
+                plan.realizations,
+                model.residual_pair,
+            )
+            .detection(
+                &schedule,
+                &budget,
+                draws,
+                case_seed(seed, SAMPLED, parameter, factor),
+            )
+        } else {
+            vec![None; CheckId::ALL.len()]
+        };
+        progress.advance((cases.len() as u64 + 1) * draws);
+        cases.push(SensitivityCase {
+            parameter,
+            factor,
+            claimed_sigma_final: sigma(&last_fix.p_post),
+            actual_sigma_final: sigma(&last_actual.post),
+            expected_nees_final: covariance::weights(&last_fix.p_post_inv, &last_actual.post).0,
+            expected_nis_final: covariance::weights(&last_fix.s_inv, &last_actual.innovation).0,
+            predicted,
+            draws,
+            bounds,
+            ensembles: plan.ensembles,
+            detected: None,
+        });
+    }
+    progress.finish();
+
+    // Independent Monte Carlo ensembles of every case.
+    if plan.ensembles > 0 {
+        let total = grid.len() as u64 * plan.ensembles * plan.realizations;
+        progress.start("sensitivity", total);
+        let mut done = 0;
+        for case in &mut cases {
+            let (model, schedule) = mistuned(&world, case.parameter, case.factor)?;
             let mut failures = [0u64; 7];
             for k in 0..plan.ensembles {
-                let seed = mix(base.ensemble.seed, cases.len() as u64, k);
+                let seed = mix(case_seed(seed, ENSEMBLES, case.parameter, case.factor), k);
                 let acc = ensemble::run(&model, &schedule, seed, plan.realizations, |d| {
                     progress.advance(done + d)
                 });
@@ -291,23 +385,15 @@ pub fn run(
                     failures[c.id.index()] += u64::from(c.verdict == Verdict::Fail);
                 }
             }
-            cases.push(SensitivityCase {
-                parameter,
-                factor,
-                claimed_sigma_final: sigma(&last_fix.p_post),
-                actual_sigma_final: sigma(&last_actual.post),
-                expected_nees_final: covariance::weights(&last_fix.p_post_inv, &last_actual.post).0,
-                expected_nis_final: covariance::weights(&last_fix.s_inv, &last_actual.innovation).0,
-                predicted,
-                ensembles: plan.ensembles,
-                detected: failures
+            case.detected = Some(
+                failures
                     .iter()
-                    .map(|&f| f as f64 / plan.ensembles.max(1) as f64)
+                    .map(|&f| f as f64 / plan.ensembles as f64)
                     .collect(),
-            });
+            );
         }
+        progress.finish();
     }
-    progress.finish();
     Ok(Sensitivity {
         plan: plan.clone(),
         false_alarm_rate: base.checks.false_alarm_rate,
@@ -316,9 +402,24 @@ pub fn run(
     })
 }
 
-/// The seed of ensemble `k` of case `case` under `seed`.
-fn mix(seed: u64, case: u64, k: u64) -> u64 {
-    let mut z = seed ^ 0x5E45_171F_17E5_0000 ^ (case << 32) ^ k;
+/// Domains of the seeds a case derives: its sampled ensembles and its Monte Carlo ensembles.
+const SAMPLED: u64 = 0x5A;
+const ENSEMBLES: u64 = 0xE5;
+
+/// The seed of `parameter` × `factor` in `domain` under `seed`.
+fn case_seed(seed: u64, domain: u64, parameter: AssumedStatistic, factor: f64) -> u64 {
+    let index = AssumedStatistic::ALL
+        .iter()
+        .position(|p| *p == parameter)
+        .expect("every statistic is in ALL") as u64;
+    mix(mix(mix(seed, domain), index), factor.to_bits())
+}
+
+/// `seed` mixed with `value` (SplitMix64's finalizer on their combination).
+fn mix(seed: u64, value: u64) -> u64 {
+    let mut z = seed
+        .wrapping_add(0x9E37_79B9_7F4A_7C15)
+        .wrapping_add(value.wrapping_mul(0xD1B5_4A32_D192_ED03));
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
