@@ -5,6 +5,9 @@
 //! into the total in chunk order. The chunk boundaries depend on N alone, so the result is
 //! bit-for-bit the same on one thread or many.
 
+pub mod epoch;
+pub mod kernel;
+mod lane_sums;
 mod layout;
 pub mod partial;
 mod stats;
@@ -15,8 +18,12 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::filter::FilterSchedule;
+use crate::lanes::LANES;
 use crate::model::Model;
-use crate::simulation::{FixState, Observer, run_realization};
+use crate::simulation::stream_key;
+use epoch::EpochPlan;
+pub use lane_sums::{FixSink as LaneFixSink, LaneFix};
+use lane_sums::{FixSink, LaneSums};
 pub use layout::ResidualLayout;
 pub use stats::{EnsembleStats, FixStats, StageStats};
 use sums::BATCH;
@@ -28,26 +35,69 @@ pub const CHUNK: u64 = 64;
 /// Memory the chunk accumulators in flight may take together, bytes.
 const WINDOW_BYTES: u64 = 256 << 20;
 
-/// Feeds one realization's fixes into an [`Accumulator`].
-struct Summer<'a> {
-    acc: &'a mut Accumulator,
-    schedule: &'a FilterSchedule,
-    /// This realization's residuals, stacked: (r_p(t_0), r_v(t_0), r_p(t_1), …).
-    stacked: &'a mut [f64],
+/// How an ensemble's realizations are simulated.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Engine {
+    /// Every accelerometer sample drawn and integrated, as the problem statement describes it.
+    #[default]
+    Sample,
+    /// One exact draw of the accelerometer noise's effect per GPS interval (see [`epoch`]): the
+    /// same distribution at the fixes with about a tenth of the random numbers.
+    Epoch,
 }
 
-impl Observer for Summer<'_> {
-    #[inline]
-    fn fix(&mut self, f: &FixState) {
-        let cov = &self.schedule.fixes[f.index];
-        let sums = &mut self.acc.fixes[f.index];
-        sums.prior
-            .add(&(f.delta_x - f.prior), &f.prior, &cov.p_prior_inv);
-        sums.post
-            .add(&(f.delta_x - f.post), &f.post, &cov.p_post_inv);
-        sums.nis += f.residual.dot(&(cov.s_inv * f.residual));
-        self.stacked[2 * f.index] = f.residual[0];
-        self.stacked[2 * f.index + 1] = f.residual[1];
+impl Engine {
+    /// The lowercase name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Sample => "sample",
+            Engine::Epoch => "epoch",
+        }
+    }
+}
+
+impl std::fmt::Display for Engine {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What an engine needs besides the model, built once per ensemble.
+#[derive(Clone, Debug)]
+pub enum Prepared {
+    /// The per-sample engine needs nothing more.
+    Sample,
+    /// The epoch engine's plan.
+    Epoch(EpochPlan),
+}
+
+impl Prepared {
+    /// Prepares `engine` for `model` under `schedule`.
+    pub fn new(engine: Engine, model: &Model, schedule: &FilterSchedule) -> Self {
+        match engine {
+            Engine::Sample => Prepared::Sample,
+            Engine::Epoch => Prepared::Epoch(EpochPlan::new(model, schedule)),
+        }
+    }
+
+    /// The engine.
+    pub fn engine(&self) -> Engine {
+        match self {
+            Prepared::Sample => Engine::Sample,
+            Prepared::Epoch(_) => Engine::Epoch,
+        }
     }
 }
 
@@ -56,8 +106,52 @@ pub fn layout_of(model: &Model) -> ResidualLayout {
     ResidualLayout::new(model.timeline.fixes(), model.residual_max_lag())
 }
 
-/// Sums realizations `range` of `model` into a fresh accumulator.
+/// Sums realizations `range` of `model` into a fresh accumulator, with the per-sample engine.
 pub fn accumulate(
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    range: std::ops::Range<u64>,
+) -> Accumulator {
+    accumulate_with(&Prepared::Sample, model, schedule, seed, range)
+}
+
+/// The sink of a chunk: per-lane sums, and each lane's residuals stacked in its batch row.
+struct ChunkSink<'a> {
+    lanes: &'a mut LaneSums,
+    batch: &'a mut [f64],
+    /// Residuals per realization, 2·fixes.
+    m: usize,
+}
+
+impl FixSink for ChunkSink<'_> {
+    #[inline(always)]
+    fn fix(&mut self, i: usize, f: &LaneFix) {
+        self.lanes.add(i, f);
+        for k in 0..LANES {
+            self.batch[k * self.m + 2 * i] = f.residual[0].0[k];
+            self.batch[k * self.m + 2 * i + 1] = f.residual[1].0[k];
+        }
+    }
+}
+
+crate::lanes::vectorized! {
+    /// Sums realizations `range` of `model` into a fresh accumulator with the engine `prepared`.
+    /// Realizations go in lane groups of [`LANES`] consecutive indices from `range.start`; each
+    /// lane keeps its own sums, added up in lane order at the end, and each group's residuals are
+    /// added as one batch.
+    pub fn accumulate_with(
+        prepared: &Prepared,
+        model: &Model,
+        schedule: &FilterSchedule,
+        seed: u64,
+        range: std::ops::Range<u64>,
+    ) -> Accumulator => accumulate_lanes
+}
+
+#[inline(always)]
+fn accumulate_lanes(
+    prepared: &Prepared,
     model: &Model,
     schedule: &FilterSchedule,
     seed: u64,
@@ -65,25 +159,34 @@ pub fn accumulate(
 ) -> Accumulator {
     let m = 2 * model.timeline.fixes();
     let mut acc = Accumulator::new(&layout_of(model), model.residual_pair);
+    let mut lanes = LaneSums::new(schedule);
     let mut batch = vec![0.0; BATCH * m];
-    let mut filled = 0;
-    for l in range {
-        let mut summer = Summer {
-            acc: &mut acc,
-            schedule,
-            stacked: &mut batch[filled * m..(filled + 1) * m],
+    let key = stream_key(seed, model.case());
+    let mut first = range.start;
+    while first < range.end {
+        let active = (range.end - first).min(LANES as u64) as usize;
+        let mut on_fix = ChunkSink {
+            lanes: &mut lanes,
+            batch: &mut batch,
+            m,
         };
-        run_realization(model, schedule, seed, l, &mut summer);
-        acc.count += 1;
-        filled += 1;
-        if filled == BATCH {
-            acc.add_residual_batch(&mut batch, filled);
-            filled = 0;
+        match prepared {
+            Prepared::Sample => kernel::run_group(model, schedule, key, first, active, &mut on_fix),
+            Prepared::Epoch(plan) => epoch::run_group(
+                plan,
+                model,
+                schedule,
+                epoch::epoch_key(key),
+                first,
+                active,
+                &mut on_fix,
+            ),
         }
+        acc.add_residual_batch(&mut batch, active);
+        first += LANES as u64;
     }
-    if filled > 0 {
-        acc.add_residual_batch(&mut batch, filled);
-    }
+    lanes.reduce_into(&mut acc);
+    acc.count = range.end - range.start;
     acc
 }
 
@@ -155,9 +258,34 @@ pub fn run_blocks(
     seed: u64,
     n: u64,
     blocks: std::ops::Range<u64>,
+    progress: impl FnMut(u64),
+    on_block: impl FnMut(u64, Accumulator),
+) {
+    run_blocks_with(
+        Engine::Sample,
+        model,
+        schedule,
+        seed,
+        n,
+        blocks,
+        progress,
+        on_block,
+    );
+}
+
+/// [`run_blocks`] with the engine `engine`.
+#[allow(clippy::too_many_arguments)]
+pub fn run_blocks_with(
+    engine: Engine,
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    n: u64,
+    blocks: std::ops::Range<u64>,
     mut progress: impl FnMut(u64),
     mut on_block: impl FnMut(u64, Accumulator),
 ) {
+    let prepared = Prepared::new(engine, model, schedule);
     let partition = Partition::new(n);
     let layout = layout_of(model);
     // A window of chunks in flight at once; only its size depends on the thread count, never the
@@ -180,7 +308,10 @@ pub fn run_blocks(
         let last = (first + window).min(chunks.end);
         let parts: Vec<Accumulator> = (first..last)
             .into_par_iter()
-            .map(|c| accumulate(model, schedule, seed, partition.chunk_realizations(c)))
+            .map(|c| {
+                let range = partition.chunk_realizations(c);
+                accumulate_with(&prepared, model, schedule, seed, range)
+            })
             .collect();
         for (c, part) in (first..last).zip(&parts) {
             sums.merge(part);
@@ -207,8 +338,21 @@ pub fn run(
     n: u64,
     progress: impl FnMut(u64),
 ) -> Accumulator {
+    run_with(Engine::Sample, model, schedule, seed, n, progress)
+}
+
+/// [`run`] with the engine `engine`.
+pub fn run_with(
+    engine: Engine,
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    n: u64,
+    progress: impl FnMut(u64),
+) -> Accumulator {
     let mut total = Accumulator::new(&layout_of(model), model.residual_pair);
-    run_blocks(
+    run_blocks_with(
+        engine,
         model,
         schedule,
         seed,
@@ -227,6 +371,8 @@ pub struct EnsembleRun {
     pub stats: EnsembleStats,
     /// Wall-clock time of the realizations, s.
     pub elapsed_s: f64,
+    /// The engine that simulated the realizations.
+    pub engine: Engine,
 }
 
 impl EnsembleRun {
@@ -242,13 +388,24 @@ pub fn run_model(
     schedule: &FilterSchedule,
     progress: impl FnMut(u64),
 ) -> EnsembleRun {
+    run_model_with(Engine::Sample, model, schedule, progress)
+}
+
+/// [`run_model`] with the engine `engine`.
+pub fn run_model_with(
+    engine: Engine,
+    model: &Model,
+    schedule: &FilterSchedule,
+    progress: impl FnMut(u64),
+) -> EnsembleRun {
     let e = &model.config.ensemble;
     let start = Instant::now();
-    let acc = run(model, schedule, e.seed, e.realizations, progress);
+    let acc = run_with(engine, model, schedule, e.seed, e.realizations, progress);
     let elapsed_s = start.elapsed().as_secs_f64();
     EnsembleRun {
         stats: EnsembleStats::from_sums(&acc, schedule),
         elapsed_s,
+        engine,
     }
 }
 

@@ -25,22 +25,6 @@ pub struct StageSums {
 const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
 
 impl StageSums {
-    #[inline]
-    pub(super) fn add(&mut self, e: &Vector3, x: &Vector3, p_inv: &Matrix3) {
-        self.e += e;
-        let mut nees = 0.0;
-        for (s, &(r, c)) in self.ee.iter_mut().zip(&UPPER) {
-            let prod = e[r] * e[c];
-            *s += prod;
-            // eᵀP⁻¹e over the upper triangle: off-diagonal terms count twice.
-            nees += if r == c { 1.0 } else { 2.0 } * p_inv[(r, c)] * prod;
-        }
-        self.ex += e * x.transpose();
-        self.x += x;
-        self.xx += x.component_mul(x);
-        self.nees += nees;
-    }
-
     /// Σ e·eᵀ as a full matrix.
     pub fn ee_matrix(&self) -> Matrix3 {
         let mut m = Matrix3::zeros();
@@ -135,6 +119,7 @@ impl Accumulator {
     /// Adds Σ_q ρ_q·ρ_qᵀ over the stacked residual vectors of a batch (the first `filled` rows of
     /// `batch`, each of length 2·fixes). Batching reads and writes the large packed triangle once
     /// per [`BATCH`] realizations instead of once per realization.
+    #[inline(always)]
     pub(super) fn add_residual_batch(&mut self, batch: &mut [f64], filled: usize) {
         let m = 2 * self.fixes.len();
         debug_assert_eq!(batch.len(), BATCH * m);
