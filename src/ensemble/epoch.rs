@@ -17,9 +17,9 @@
 //! per-sample engine, so every error, estimate and residual at the fixes has the same joint
 //! distribution with about a tenth of the random numbers.
 
-use super::kernel::lane_mask;
-use super::lane_sums::{FixSink, LaneFix};
-use crate::filter::FilterSchedule;
+use super::kernel::{LaneGroup, lane_mask};
+use super::lane_sums::LaneFix;
+use crate::filter::{FilterSchedule, FixCovariance};
 use crate::lanes::{Lanes, Real};
 use crate::model::Model;
 use crate::random::LaneStreams;
@@ -103,50 +103,76 @@ pub fn epoch_key(key: u64) -> u64 {
     crate::random::splitmix64(key ^ 0x0E90_C4E9_0C4E_90C4)
 }
 
-/// Runs the realizations `first..first + LANES` (see [`crate::lanes::LANES`]) of the epoch streams `key` (only the first
-/// `active` count) and hands each fix to `on_fix`.
-#[inline(always)]
-pub fn run_group(
-    plan: &EpochPlan,
-    model: &Model,
-    schedule: &FilterSchedule,
-    key: u64,
-    first: u64,
-    active: usize,
-    on_fix: &mut impl FixSink,
-) {
-    let ts = &model.truth_stats;
-    let mask = lane_mask(active);
-    let mut rng = LaneStreams::new(key, first);
-    let s = Lanes::splat;
-    let dp0 = s(ts.initial_position_sigma_m) * rng.normal();
-    let dv0 = s(ts.initial_velocity_sigma_m_s) * rng.normal();
-    let b = s(ts.bias_var_m2_s4.sqrt()) * rng.normal();
-    let (eta_p_sigma, eta_v_sigma) = (s(ts.gps_position_sigma_m), s(ts.gps_velocity_sigma_m_s));
-    let (mut np, mut nv) = (Lanes::default(), Lanes::default());
-    let mut estimate = [Lanes::default(); 3];
-    for (i, fix) in schedule.fixes.iter().enumerate() {
+/// The epoch-level simulation of realizations `first..first + LANES` (see
+/// [`crate::lanes::LANES`]; only the first `active` count, the others zeroed at every fix).
+pub struct EpochGroup<'a> {
+    plan: &'a EpochPlan,
+    rng: LaneStreams,
+    mask: Lanes,
+    /// δp(0), δv(0), b.
+    dp0: Lanes,
+    dv0: Lanes,
+    b: Lanes,
+    eta_sigma: [f64; 2],
+    /// The accumulated accelerometer noise (N_p, N_v).
+    noise: [Lanes; 2],
+    estimate: [Lanes; 3],
+}
+
+impl<'a> EpochGroup<'a> {
+    /// The group of realizations `first..` of the epoch streams `key`, its initial values drawn.
+    #[inline(always)]
+    pub fn new(plan: &'a EpochPlan, model: &Model, key: u64, first: u64, active: usize) -> Self {
+        let ts = &model.truth_stats;
+        let mut rng = LaneStreams::new(key, first);
+        let s = Lanes::splat;
+        let dp0 = s(ts.initial_position_sigma_m) * rng.normal();
+        let dv0 = s(ts.initial_velocity_sigma_m_s) * rng.normal();
+        let b = s(ts.bias_var_m2_s4.sqrt()) * rng.normal();
+        Self {
+            plan,
+            rng,
+            mask: lane_mask(active),
+            dp0,
+            dv0,
+            b,
+            eta_sigma: [ts.gps_position_sigma_m, ts.gps_velocity_sigma_m_s],
+            noise: [Lanes::default(); 2],
+            estimate: [Lanes::default(); 3],
+        }
+    }
+}
+
+impl LaneGroup for EpochGroup<'_> {
+    #[inline(always)]
+    fn next_fix(&mut self, i: usize, fix: &FixCovariance) -> LaneFix {
+        let plan = self.plan;
+        let s = Lanes::splat;
         let [l11, l21, l22] = plan.chol[i];
-        let (u1, u2) = (rng.normal(), rng.normal());
+        let (u1, u2) = (self.rng.normal(), self.rng.normal());
+        let [mut np, mut nv] = self.noise;
         np += s(plan.tau_s[i]) * nv + s(l11) * u1;
         nv += s(l21) * u1 + s(l22) * u2;
+        self.noise = [np, nv];
         let [op, ov] = plan.offsets[i];
-        let dp = s(op) + dp0 + dv0 * s(plan.t_s[i]) - b * s(plan.half_t2[i]) - np;
-        let dv = s(ov) + dv0 - b * s(plan.t_s[i]) - nv;
+        let b = self.b;
+        let dp = s(op) + self.dp0 + self.dv0 * s(plan.t_s[i]) - b * s(plan.half_t2[i]) - np;
+        let dv = s(ov) + self.dv0 - b * s(plan.t_s[i]) - nv;
+        let mask = self.mask;
         let delta_x = [dp * mask, dv * mask, b * mask];
-        let eta = [eta_p_sigma * rng.normal(), eta_v_sigma * rng.normal()];
+        let eta = [
+            s(self.eta_sigma[0]) * self.rng.normal(),
+            s(self.eta_sigma[1]) * self.rng.normal(),
+        ];
         let dz = [(dp + eta[0]) * mask, (dv + eta[1]) * mask];
-        let (prior, post, residual) = fix.step(&estimate, &dz);
-        estimate = post;
-        on_fix.fix(
-            i,
-            &LaneFix {
-                delta_x,
-                prior,
-                post,
-                residual,
-            },
-        );
+        let (prior, post, residual) = fix.step(&self.estimate, &dz);
+        self.estimate = post;
+        LaneFix {
+            delta_x,
+            prior,
+            post,
+            residual,
+        }
     }
 }
 

@@ -1,10 +1,10 @@
-//! The running sums of a chunk kept per lane: each lane of a [`LaneGroup`](super::kernel) adds its
-//! realization's fix into its own column, with no branch and no reduction, and the lanes are
-//! added up once, in lane order, when the chunk is done.
+//! The running sums of one fix of a chunk kept per lane: each lane of every lane group of the
+//! chunk adds its realization's fix into its own column, with no branch and no reduction, and the
+//! lanes are added up once, in lane order, when every group has passed the fix.
 // Lane loops index several arrays by the lane k; iterators would hide that.
 #![allow(clippy::needless_range_loop)]
 
-use super::sums::{Accumulator, StageSums};
+use super::sums::{FixSums, StageSums};
 use crate::filter::{FilterSchedule, Matrix3};
 use crate::lanes::Lanes;
 
@@ -23,12 +23,6 @@ pub struct LaneFix {
     pub post: [Lanes; 3],
     /// r(t_i).
     pub residual: [Lanes; 2],
-}
-
-/// Receives what a lane group produces at every fix.
-pub trait FixSink {
-    /// Fix `i` of the group.
-    fn fix(&mut self, i: usize, f: &LaneFix);
 }
 
 /// One stage's sums per lane; fields as in [`StageSums`].
@@ -97,10 +91,10 @@ struct Weights {
     s: [f64; 3],
 }
 
-/// The sums of a chunk, per lane and fix.
+/// The per-lane sums of the fix being summed, and the weights of every fix's quadratic forms.
 #[derive(Clone, Debug)]
 pub struct LaneSums {
-    fixes: Vec<LaneFixSums>,
+    current: LaneFixSums,
     weights: Vec<Weights>,
 }
 
@@ -114,7 +108,7 @@ impl LaneSums {
             })
         };
         Self {
-            fixes: vec![LaneFixSums::default(); schedule.fixes.len()],
+            current: LaneFixSums::default(),
             weights: schedule
                 .fixes
                 .iter()
@@ -127,11 +121,11 @@ impl LaneSums {
         }
     }
 
-    /// Adds fix `i` of a lane group.
+    /// Adds a lane group's fix `i`.
     #[inline(always)]
     pub fn add(&mut self, i: usize, f: &LaneFix) {
         let w = &self.weights[i];
-        let sums = &mut self.fixes[i];
+        let sums = &mut self.current;
         sums.prior.add(&f.delta_x, &f.prior, &w.prior);
         sums.post.add(&f.delta_x, &f.post, &w.post);
         let [r0, r1] = f.residual;
@@ -140,12 +134,13 @@ impl LaneSums {
             + Lanes([w.s[2]; 8]) * r1 * r1;
     }
 
-    /// Writes the lanes' totals into the per-fix sums of `acc` (replacing them).
-    pub fn reduce_into(&self, acc: &mut Accumulator) {
-        for (a, s) in acc.fixes.iter_mut().zip(&self.fixes) {
-            s.prior.reduce(&mut a.prior);
-            s.post.reduce(&mut a.post);
-            a.nis = s.nis.sum();
-        }
+    /// Writes the lanes' totals of the fix into `out` (replacing it) and starts the next fix.
+    #[inline(always)]
+    pub fn finish_fix(&mut self, out: &mut FixSums) {
+        let c = &self.current;
+        c.prior.reduce(&mut out.prior);
+        c.post.reduce(&mut out.post);
+        out.nis = c.nis.sum();
+        self.current = LaneFixSums::default();
     }
 }

@@ -17,16 +17,18 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use crate::config::TruthModel;
 use crate::filter::FilterSchedule;
 use crate::lanes::LANES;
 use crate::model::Model;
 use crate::simulation::stream_key;
+use epoch::EpochGroup;
 use epoch::EpochPlan;
-pub use lane_sums::{FixSink as LaneFixSink, LaneFix};
-use lane_sums::{FixSink, LaneSums};
+use kernel::{LaneGroup, SampleGroup};
+pub use lane_sums::LaneFix;
+use lane_sums::LaneSums;
 pub use layout::ResidualLayout;
 pub use stats::{EnsembleStats, FixStats, StageStats};
-use sums::BATCH;
 pub use sums::{Accumulator, FixSums, StageSums};
 
 /// Realizations summed sequentially into one accumulator before it is merged.
@@ -116,37 +118,44 @@ pub fn accumulate(
     accumulate_with(&Prepared::Sample, model, schedule, seed, range)
 }
 
-/// The sink of a chunk: per-lane sums, and each lane's residuals stacked in its batch row.
-struct ChunkSink<'a> {
-    lanes: &'a mut LaneSums,
-    batch: &'a mut [f64],
-    /// Residuals per realization, 2·fixes.
-    m: usize,
-}
-
-impl FixSink for ChunkSink<'_> {
-    #[inline(always)]
-    fn fix(&mut self, i: usize, f: &LaneFix) {
-        self.lanes.add(i, f);
-        for k in 0..LANES {
-            self.batch[k * self.m + 2 * i] = f.residual[0].0[k];
-            self.batch[k * self.m + 2 * i + 1] = f.residual[1].0[k];
-        }
-    }
-}
-
 crate::lanes::vectorized! {
-    /// Sums realizations `range` of `model` into a fresh accumulator with the engine `prepared`.
-    /// Realizations go in lane groups of [`LANES`] consecutive indices from `range.start`; each
-    /// lane keeps its own sums, added up in lane order at the end, and each group's residuals are
-    /// added as one batch.
-    pub fn accumulate_with(
+    /// Sums realizations `range` of `model` into `acc` (emptied first) with the engine
+    /// `prepared`; `rows` is scratch space. The realizations go in lane groups of [`LANES`]
+    /// consecutive indices from `range.start`, all advanced fix by fix: at each fix every lane
+    /// adds its realization into its own sums, and the lanes are added up in lane order when
+    /// every group has passed the fix. The residuals of the chunk are added in one pass, a batch
+    /// of [`LANES`] realizations after another.
+    pub fn accumulate_into(
         prepared: &Prepared,
         model: &Model,
         schedule: &FilterSchedule,
         seed: u64,
         range: std::ops::Range<u64>,
-    ) -> Accumulator => accumulate_lanes
+        acc: &mut Accumulator,
+        rows: &mut Vec<f64>,
+    ) -> () => accumulate_lanes
+}
+
+/// Sums realizations `range` of `model` into a fresh accumulator with the engine `prepared`
+/// (see [`accumulate_into`]).
+pub fn accumulate_with(
+    prepared: &Prepared,
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    range: std::ops::Range<u64>,
+) -> Accumulator {
+    let mut acc = Accumulator::new(&layout_of(model), model.residual_pair);
+    accumulate_into(
+        prepared,
+        model,
+        schedule,
+        seed,
+        range,
+        &mut acc,
+        &mut Vec::new(),
+    );
+    acc
 }
 
 #[inline(always)]
@@ -156,38 +165,57 @@ fn accumulate_lanes(
     schedule: &FilterSchedule,
     seed: u64,
     range: std::ops::Range<u64>,
-) -> Accumulator {
-    let m = 2 * model.timeline.fixes();
-    let mut acc = Accumulator::new(&layout_of(model), model.residual_pair);
-    let mut lanes = LaneSums::new(schedule);
-    let mut batch = vec![0.0; BATCH * m];
+    acc: &mut Accumulator,
+    rows: &mut Vec<f64>,
+) {
     let key = stream_key(seed, model.case());
-    let mut first = range.start;
-    while first < range.end {
+    let groups = (range.start..range.end).step_by(LANES).map(|first| {
         let active = (range.end - first).min(LANES as u64) as usize;
-        let mut on_fix = ChunkSink {
-            lanes: &mut lanes,
-            batch: &mut batch,
-            m,
-        };
-        match prepared {
-            Prepared::Sample => kernel::run_group(model, schedule, key, first, active, &mut on_fix),
-            Prepared::Epoch(plan) => epoch::run_group(
-                plan,
-                model,
-                schedule,
-                epoch::epoch_key(key),
-                first,
-                active,
-                &mut on_fix,
-            ),
+        (first, active)
+    });
+    match (prepared, model.truth()) {
+        (Prepared::Sample, TruthModel::Euler) => {
+            let g = groups.map(|(f, a)| SampleGroup::<true>::new(model, key, f, a));
+            sum_groups(g.collect(), schedule, acc, rows);
         }
-        acc.add_residual_batch(&mut batch, active);
-        first += LANES as u64;
+        (Prepared::Sample, TruthModel::Analytic) => {
+            let g = groups.map(|(f, a)| SampleGroup::<false>::new(model, key, f, a));
+            sum_groups(g.collect(), schedule, acc, rows);
+        }
+        (Prepared::Epoch(plan), _) => {
+            let key = epoch::epoch_key(key);
+            let g = groups.map(|(f, a)| EpochGroup::new(plan, model, key, f, a));
+            sum_groups(g.collect(), schedule, acc, rows);
+        }
     }
-    lanes.reduce_into(&mut acc);
     acc.count = range.end - range.start;
-    acc
+}
+
+#[inline(always)]
+fn sum_groups<G: LaneGroup>(
+    mut groups: Vec<G>,
+    schedule: &FilterSchedule,
+    acc: &mut Accumulator,
+    rows: &mut Vec<f64>,
+) {
+    let m = 2 * schedule.fixes.len();
+    acc.clear();
+    rows.clear();
+    rows.resize(groups.len() * LANES * m, 0.0);
+    let mut lanes = LaneSums::new(schedule);
+    for (i, fix) in schedule.fixes.iter().enumerate() {
+        for (g, group) in groups.iter_mut().enumerate() {
+            let f = group.next_fix(i, fix);
+            lanes.add(i, &f);
+            for k in 0..LANES {
+                let row = (g * LANES + k) * m;
+                rows[row + 2 * i] = f.residual[0].0[k];
+                rows[row + 2 * i + 1] = f.residual[1].0[k];
+            }
+        }
+        lanes.finish_fix(&mut acc.fixes[i]);
+    }
+    acc.add_residual_rows(rows);
 }
 
 /// Largest number of blocks an ensemble is folded in. Blocks are the unit of sharding.
@@ -304,16 +332,21 @@ pub fn run_blocks_with(
     let mut sums = Accumulator::new(&layout, model.residual_pair);
     let mut done = 0;
     let mut first = chunks.start;
+    // The chunk sums in flight and their scratch space, reused from window to window.
+    let mut slots: Vec<(Accumulator, Vec<f64>)> = Vec::new();
     while first < chunks.end {
         let last = (first + window).min(chunks.end);
-        let parts: Vec<Accumulator> = (first..last)
-            .into_par_iter()
-            .map(|c| {
-                let range = partition.chunk_realizations(c);
-                accumulate_with(&prepared, model, schedule, seed, range)
-            })
-            .collect();
-        for (c, part) in (first..last).zip(&parts) {
+        slots.resize_with((last - first) as usize, || {
+            (Accumulator::new(&layout, model.residual_pair), Vec::new())
+        });
+        slots
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(k, (acc, rows))| {
+                let range = partition.chunk_realizations(first + k as u64);
+                accumulate_into(&prepared, model, schedule, seed, range, acc, rows);
+            });
+        for (c, (part, _)) in (first..last).zip(&slots) {
             sums.merge(part);
             done += part.count;
             if c + 1 == partition.block_chunks(block).end {

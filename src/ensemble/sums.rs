@@ -116,38 +116,57 @@ impl Accumulator {
         }
     }
 
-    /// Adds Σ_q ρ_q·ρ_qᵀ over the stacked residual vectors of a batch (the first `filled` rows of
-    /// `batch`, each of length 2·fixes). Batching reads and writes the large packed triangle once
-    /// per [`BATCH`] realizations instead of once per realization.
+    /// Empties the sums, keeping their layout and storage.
+    pub fn clear(&mut self) {
+        self.count = 0;
+        self.fixes.fill(FixSums::default());
+        self.residual_products.fill(0.0);
+        self.pair_products = [0.0; 4];
+    }
+
+    /// Adds Σ_q ρ_q·ρ_qᵀ over the stacked residual vectors `rows` (each of length 2·fixes, a
+    /// whole number of batches of [`BATCH`]; rows of inactive realizations are zero). Each stored
+    /// product gets the batches' partial sums added in batch order. The rows of the triangle go in
+    /// tiles small enough to stay in cache while every batch passes over them, so the large
+    /// packed triangle is read and written once per call.
     #[inline(always)]
-    pub(super) fn add_residual_batch(&mut self, batch: &mut [f64], filled: usize) {
+    pub(super) fn add_residual_rows(&mut self, rows: &[f64]) {
         let m = 2 * self.fixes.len();
-        debug_assert_eq!(batch.len(), BATCH * m);
-        // Unused rows contribute nothing: zero them so the fixed-size inner loop stays exact.
-        batch[filled * m..].fill(0.0);
-        let rows: [&[f64]; BATCH] = std::array::from_fn(|q| &batch[q * m..(q + 1) * m]);
+        let batches = rows.len() / (BATCH * m);
+        debug_assert_eq!(rows.len(), batches * BATCH * m);
         let [pm, pi] = self.pair;
-        for row in rows.iter().take(filled) {
+        for row in rows.chunks_exact(m) {
             for (c, p) in self.pair_products.iter_mut().enumerate() {
                 *p += row[2 * pi + c / 2] * row[2 * pm + c % 2];
             }
         }
-        let mut start = 0;
-        for a in 0..m {
-            let first = self.layout.first_col(a);
-            let len = a + 1 - first;
-            let coef: [f64; BATCH] = std::array::from_fn(|q| rows[q][a]);
-            let dst = &mut self.residual_products[start..start + len];
-            let cols: [&[f64]; BATCH] = std::array::from_fn(|q| &rows[q][first..=a]);
-            // Row a += Σ_q ρ_q[a] · ρ_q[first..=a].
-            for (b, d) in dst.iter_mut().enumerate() {
-                let mut s = 0.0;
-                for q in 0..BATCH {
-                    s += coef[q] * cols[q][b];
+        const TILE: usize = 16;
+        let mut tile_start = 0;
+        for a0 in (0..m).step_by(TILE) {
+            let a1 = (a0 + TILE).min(m);
+            for batch in rows.chunks_exact(BATCH * m).take(batches) {
+                let rows: [&[f64]; BATCH] = std::array::from_fn(|q| &batch[q * m..(q + 1) * m]);
+                let mut start = tile_start;
+                for a in a0..a1 {
+                    let first = self.layout.first_col(a);
+                    let len = a + 1 - first;
+                    let coef: [f64; BATCH] = std::array::from_fn(|q| rows[q][a]);
+                    let dst = &mut self.residual_products[start..start + len];
+                    let cols: [&[f64]; BATCH] = std::array::from_fn(|q| &rows[q][first..=a]);
+                    // Row a += Σ_q ρ_q[a] · ρ_q[first..=a].
+                    for (b, d) in dst.iter_mut().enumerate() {
+                        let mut s = 0.0;
+                        for q in 0..BATCH {
+                            s += coef[q] * cols[q][b];
+                        }
+                        *d += s;
+                    }
+                    start += len;
                 }
-                *d += s;
             }
-            start += len;
+            tile_start += (a0..a1)
+                .map(|a| a + 1 - self.layout.first_col(a))
+                .sum::<usize>();
         }
     }
 }
