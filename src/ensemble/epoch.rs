@@ -97,6 +97,19 @@ impl EpochPlan {
     }
 }
 
+impl EpochPlan {
+    /// The same plan with the accelerometer noise's covariance over every interval multiplied by
+    /// `factor`: a deliberately wrong engine, to show that the two-sample comparison with the
+    /// per-sample engine can tell.
+    pub fn with_noise_scaled(&self, factor: f64) -> Self {
+        let mut p = self.clone();
+        for l in &mut p.chol {
+            *l = l.map(|v| v * factor.sqrt());
+        }
+        p
+    }
+}
+
 /// A key for the epoch engine's streams, distinct from the per-sample engine's `key`, so that
 /// the two engines' ensembles are independent samples.
 pub fn epoch_key(key: u64) -> u64 {
