@@ -172,8 +172,8 @@ fn sum_groups<G: LaneGroup>(
     rows: &mut Vec<f64>,
 ) {
     let m = 2 * schedule.fixes.len();
-    acc.clear();
-    rows.clear();
+    acc.clear_but_products();
+    // Every entry is written below: the rows need no clearing between chunks.
     rows.resize(groups.len() * LANES * m, 0.0);
     let mut lanes = LaneSums::new(schedule);
     for (i, fix) in schedule.fixes.iter().enumerate() {
@@ -188,5 +188,5 @@ fn sum_groups<G: LaneGroup>(
         }
         lanes.finish_fix(&mut acc.fixes[i]);
     }
-    acc.add_residual_rows(rows);
+    acc.set_residual_rows(rows);
 }

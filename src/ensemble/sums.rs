@@ -116,24 +116,26 @@ impl Accumulator {
         }
     }
 
-    /// Empties the sums, keeping their layout and storage.
-    pub fn clear(&mut self) {
+    /// Empties the per-fix sums, the count and the pair products, keeping the layout and the
+    /// storage; the residual products are left as they are for [`Self::set_residual_rows`] to
+    /// overwrite.
+    pub(super) fn clear_but_products(&mut self) {
         self.count = 0;
         self.fixes.fill(FixSums::default());
-        self.residual_products.fill(0.0);
         self.pair_products = [0.0; 4];
     }
 
-    /// Adds Σ_q ρ_q·ρ_qᵀ over the stacked residual vectors `rows` (each of length 2·fixes, a
-    /// whole number of batches of [`BATCH`]; rows of inactive realizations are zero). Each stored
-    /// product gets the batches' partial sums added in batch order. The rows of the triangle go in
+    /// Sets the residual products to Σ_q ρ_q·ρ_qᵀ over the stacked residual vectors `rows` (each
+    /// of length 2·fixes, a whole number ≥ 1 of batches of [`BATCH`]; rows of inactive
+    /// realizations are zero) and adds the pair products. Each stored product is the first
+    /// batch's partial sum, then the next batches' added in order. The rows of the triangle go in
     /// tiles small enough to stay in cache while every batch passes over them, so the large
-    /// packed triangle is read and written once per call.
+    /// packed triangle is written once per call.
     #[inline(always)]
-    pub(super) fn add_residual_rows(&mut self, rows: &[f64]) {
+    pub(super) fn set_residual_rows(&mut self, rows: &[f64]) {
         let m = 2 * self.fixes.len();
         let batches = rows.len() / (BATCH * m);
-        debug_assert_eq!(rows.len(), batches * BATCH * m);
+        debug_assert!(batches >= 1 && rows.len() == batches * BATCH * m);
         let [pm, pi] = self.pair;
         for row in rows.chunks_exact(m) {
             for (c, p) in self.pair_products.iter_mut().enumerate() {
@@ -144,7 +146,7 @@ impl Accumulator {
         let mut tile_start = 0;
         for a0 in (0..m).step_by(TILE) {
             let a1 = (a0 + TILE).min(m);
-            for batch in rows.chunks_exact(BATCH * m).take(batches) {
+            for (k, batch) in rows.chunks_exact(BATCH * m).enumerate() {
                 let rows: [&[f64]; BATCH] = std::array::from_fn(|q| &batch[q * m..(q + 1) * m]);
                 let mut start = tile_start;
                 for a in a0..a1 {
@@ -153,13 +155,11 @@ impl Accumulator {
                     let coef: [f64; BATCH] = std::array::from_fn(|q| rows[q][a]);
                     let dst = &mut self.residual_products[start..start + len];
                     let cols: [&[f64]; BATCH] = std::array::from_fn(|q| &rows[q][first..=a]);
-                    // Row a += Σ_q ρ_q[a] · ρ_q[first..=a].
-                    for (b, d) in dst.iter_mut().enumerate() {
-                        let mut s = 0.0;
-                        for q in 0..BATCH {
-                            s += coef[q] * cols[q][b];
-                        }
-                        *d += s;
+                    // Row a (+)= Σ_q ρ_q[a] · ρ_q[first..=a].
+                    if k == 0 {
+                        row_pass::<true>(dst, &coef, &cols);
+                    } else {
+                        row_pass::<false>(dst, &coef, &cols);
                     }
                     start += len;
                 }
@@ -167,6 +167,22 @@ impl Accumulator {
             tile_start += (a0..a1)
                 .map(|a| a + 1 - self.layout.first_col(a))
                 .sum::<usize>();
+        }
+    }
+}
+
+/// dst = (SET) or += Σ_q coef_q · cols_q, element by element.
+#[inline(always)]
+fn row_pass<const SET: bool>(dst: &mut [f64], coef: &[f64; BATCH], cols: &[&[f64]; BATCH]) {
+    for (b, d) in dst.iter_mut().enumerate() {
+        let mut s = 0.0;
+        for q in 0..BATCH {
+            s += coef[q] * cols[q][b];
+        }
+        if SET {
+            *d = s;
+        } else {
+            *d += s;
         }
     }
 }
