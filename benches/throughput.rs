@@ -1,28 +1,30 @@
 //! Ensemble throughput, in realizations per second, for the default configuration (200 Hz for
-//! 30 s, 150 GPS fixes, every statistic of the checks). Prints the median of repeated runs, with
-//! the minimum and maximum, and the same for the bare simulation kernel with no statistics, so
-//! the cost of the statistics shows as a ratio.
+//! 30 s, 150 GPS fixes, every statistic of the checks). Each figure is the median of repeated
+//! runs, with the minimum and maximum:
 //!
-//! Run with `cargo bench --bench throughput` (options: `-- --realizations N --repeats R`).
+//! - the random-number bound: only the 6 303 standard normal draws a realization needs
+//!   (3 initial values, 6 000 accelerometer noises, 2 per fix), in lane groups;
+//! - the bare per-sample kernel (simulation and filter, no statistics);
+//! - the full per-sample ensemble (`ensemble::run_with(Engine::Sample, …)`);
+//! - the full epoch ensemble (`Engine::Epoch`);
+//!
+//! and their ratios, so the remaining gap shows. `--numpy R` adds each figure's ratio to a numpy
+//! rate R measured in the same session (`python3 benches/numpy_reference.py`).
+//!
+//! Run with `cargo bench --bench throughput` (options: `-- --realizations N --repeats R
+//! --numpy R --truth analytic|euler`).
 
 use std::hint::black_box;
 use std::time::Instant;
 
 use accelcal::config::{Config, TruthModel};
-use accelcal::ensemble;
+use accelcal::ensemble::{self, Engine, kernel};
 use accelcal::filter::FilterSchedule;
+use accelcal::lanes::LANES;
 use accelcal::model::Model;
-use accelcal::simulation::{FixState, Observer, run_realization};
+use accelcal::random::normals_sum;
+use accelcal::simulation::stream_key;
 use rayon::prelude::*;
-
-/// Keeps nothing but what stops the optimizer from removing the work.
-struct Discard(f64);
-
-impl Observer for Discard {
-    fn fix(&mut self, f: &FixState) {
-        self.0 += f.post[2];
-    }
-}
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -34,7 +36,7 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-fn measure(label: &str, repeats: usize, n: u64, mut once: impl FnMut()) -> f64 {
+fn measure(label: &str, repeats: usize, n: u64, numpy: Option<f64>, mut once: impl FnMut()) -> f64 {
     once(); // warm-up
     let mut rates: Vec<f64> = (0..repeats)
         .map(|_| {
@@ -48,59 +50,103 @@ fn measure(label: &str, repeats: usize, n: u64, mut once: impl FnMut()) -> f64 {
         rates.iter().cloned().fold(0.0, f64::max),
     );
     let med = median(&mut rates);
+    let vs = numpy.map_or(String::new(), |r| format!("  {:>6.1}× numpy", med / r));
     println!(
-        "{label:<38} median {med:>9.0} realizations/s   (min {lo:.0}, max {hi:.0}, {repeats} runs of {n})"
+        "{label:<34} median {med:>9.0} realizations/s (min {lo:.0}, max {hi:.0}; {repeats} runs of {n}){vs}"
     );
     med
 }
 
-fn arg(name: &str, default: u64) -> u64 {
+fn arg(name: &str) -> Option<String> {
     let args: Vec<String> = std::env::args().collect();
     args.iter()
         .position(|a| a == name)
         .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
+        .cloned()
+}
+
+/// Lane groups covering realizations 0..n, in parallel.
+fn groups(n: u64) -> impl ParallelIterator<Item = (u64, usize)> {
+    (0..n.div_ceil(LANES as u64)).into_par_iter().map(move |g| {
+        (
+            g * LANES as u64,
+            (n - g * LANES as u64).min(LANES as u64) as usize,
+        )
+    })
 }
 
 fn main() {
-    let n = arg("--realizations", 10_000);
-    let repeats = arg("--repeats", 9) as usize;
-    println!("threads: {}", rayon::current_num_threads());
+    let n: u64 = arg("--realizations")
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(20_000);
+    let repeats: usize = arg("--repeats").and_then(|v| v.parse().ok()).unwrap_or(9);
+    let numpy: Option<f64> = arg("--numpy").and_then(|v| v.parse().ok());
+    let truth = match arg("--truth").as_deref() {
+        Some("euler") => TruthModel::Euler,
+        _ => TruthModel::Analytic,
+    };
+    println!("threads: {}, truth: {truth}", rayon::current_num_threads());
     let config = Config::default();
-    let base = Model::new(&config).expect("default configuration is valid");
+    let model = Model::new(&config)
+        .expect("default configuration is valid")
+        .with_truth(truth);
     let schedule =
-        FilterSchedule::new(&base.timeline, &base.filter_stats).expect("positive definite");
-    for truth in TruthModel::ALL {
-        let model = base.with_truth(truth);
-        let full = measure(
-            &format!("ensemble with statistics ({truth})"),
-            repeats,
+        FilterSchedule::new(&model.timeline, &model.filter_stats).expect("positive definite");
+    let key = stream_key(1, model.case());
+    let draws = 3 + model.timeline.steps + 2 * model.timeline.fixes();
+    let rng = measure(
+        &format!("random numbers only ({draws} normals)"),
+        repeats,
+        n,
+        numpy,
+        || {
+            let s: f64 = groups(n)
+                .map(|(first, _)| normals_sum(key, first, draws))
+                .sum();
+            black_box(s);
+        },
+    );
+    let bare = measure(
+        "per-sample kernel, no statistics",
+        repeats,
+        n,
+        numpy,
+        || {
+            let s: f64 = groups(n)
+                .map(|(first, active)| kernel::bare_group(&model, &schedule, key, first, active))
+                .sum();
+            black_box(s);
+        },
+    );
+    let full = measure("per-sample ensemble", repeats, n, numpy, || {
+        black_box(ensemble::run_with(
+            Engine::Sample,
+            &model,
+            &schedule,
+            1,
             n,
-            || {
-                black_box(ensemble::run(&model, &schedule, 1, n, |_| {}));
-            },
-        );
-        let bare = measure(
-            &format!("simulation kernel only ({truth})"),
-            repeats,
+            |_| {},
+        ));
+    });
+    let epoch = measure("epoch ensemble", repeats, n, numpy, || {
+        black_box(ensemble::run_with(
+            Engine::Epoch,
+            &model,
+            &schedule,
+            1,
             n,
-            || {
-                let s: f64 = (0..n)
-                    .into_par_iter()
-                    .map(|l| {
-                        let mut d = Discard(0.0);
-                        run_realization(&model, &schedule, 1, l, &mut d);
-                        d.0
-                    })
-                    .sum();
-                black_box(s);
-            },
-        );
-        println!(
-            "{:<38} {:.2}",
-            "ratio statistics / kernel only",
-            full / bare
-        );
-    }
+            |_| {},
+        ));
+    });
+    println!("{:<34} {:.2}", "ratio kernel / random numbers", bare / rng);
+    println!(
+        "{:<34} {:.2}",
+        "ratio per-sample ensemble / kernel",
+        full / bare
+    );
+    println!(
+        "{:<34} {:.2}",
+        "ratio epoch / per-sample ensemble",
+        epoch / full
+    );
 }

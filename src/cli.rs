@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::{ArgGroup, Args, Parser, Subcommand};
 
 use accelcal::config::{AccelerometerOutput, TruthModel};
+use accelcal::ensemble::Engine;
 
 /// Calibrates an accelerometer's bias with GPS through a Kalman filter, checks the filter with a
 /// Monte Carlo ensemble, and writes the study as a self-contained HTML report.
@@ -107,6 +108,11 @@ pub struct EnsembleArgs {
     /// Where a shard writes its partial sums (see `accelcal merge`).
     #[arg(long, value_name = "FILE", requires = "shard")]
     pub partial: Option<PathBuf>,
+    /// How realizations are simulated: `sample` draws and integrates every accelerometer
+    /// sample; `epoch` draws the noise's exact effect once per GPS interval (same distribution
+    /// at the fixes, several times faster).
+    #[arg(long, value_enum, default_value_t = Engine::Sample)]
+    pub engine: Engine,
 }
 
 #[derive(Debug, Args)]

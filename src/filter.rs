@@ -9,6 +9,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::error::FilterError;
+use crate::lanes::Real;
 use crate::model::{NoiseStats, Timeline};
 
 /// A 2-vector: a GPS measurement or residual (m, m/s).
@@ -223,6 +224,29 @@ pub struct FixCovariance {
     pub p_prior_inv: Matrix3,
     /// (P⁺)⁻¹, for the a posteriori normalized estimation error squared.
     pub p_post_inv: Matrix3,
+}
+
+impl FixCovariance {
+    /// The estimate through this fix, for one realization (`f64`) or a lane group: the a priori
+    /// estimate δx̂⁻ = Φ·δx̂⁺(previous), the residual r = δz − H·δx̂⁻ and the a posteriori estimate
+    /// δx̂⁺ = δx̂⁻ + K·r, returned as (prior, post, residual). Written once over [`Real`] so that
+    /// every engine performs the same operations in the same order.
+    #[inline(always)]
+    pub fn step<T: Real>(&self, estimate: &[T; 3], dz: &[T; 2]) -> ([T; 3], [T; 3], [T; 2]) {
+        let phi = &self.phi_from_previous;
+        let prior: [T; 3] = std::array::from_fn(|r| {
+            T::splat(phi[(r, 0)]) * estimate[0]
+                + T::splat(phi[(r, 1)]) * estimate[1]
+                + T::splat(phi[(r, 2)]) * estimate[2]
+        });
+        // H selects (δp, δv).
+        let residual = [dz[0] - prior[0], dz[1] - prior[1]];
+        let k = &self.gain;
+        let post = std::array::from_fn(|r| {
+            prior[r] + (T::splat(k[(r, 0)]) * residual[0] + T::splat(k[(r, 1)]) * residual[1])
+        });
+        (prior, post, residual)
+    }
 }
 
 /// Every covariance and gain of the filter over a time grid, computed once and shared.

@@ -5,34 +5,23 @@
 //! ("euler"); the GPS measures the truth plus white noise; the filter sees δz = z − (p_c, v_c),
 //! eq. (6). What a caller keeps of a realization is decided by its [`Observer`].
 
-use rand::RngExt;
-use rand_distr::StandardNormal;
-use rand_pcg::Pcg64Mcg;
-
 use crate::config::{Case, TruthModel};
 use crate::filter::{FilterSchedule, Vector2, Vector3};
 use crate::model::Model;
+pub use crate::random::Stream;
+use crate::random::splitmix64;
 
-/// The random generator of one realization: PCG-64 MCG (XSL-RR 128/64), a portable generator
-/// whose output is fixed by its seed on every platform.
-pub type Stream = Pcg64Mcg;
-
-/// SplitMix64 finalizer: a bijective 64-bit mixer.
-fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+/// The key of the random streams of `case` under `seed`: realization l draws from
+/// `Stream::new(key, l)`.
+pub fn stream_key(seed: u64, case: Case) -> u64 {
+    splitmix64(seed ^ splitmix64(0xC0DE_CA5E ^ case.stream_key()))
 }
 
 /// The random stream of realization `index` of `case` under `seed`. It depends on nothing else,
 /// so results do not depend on the thread count or on how the ensemble is split, and different
 /// cases draw independent numbers.
 pub fn stream(seed: u64, case: Case, index: u64) -> Stream {
-    let case_seed = splitmix64(seed ^ splitmix64(0xC0DE_CA5E ^ case.stream_key()));
-    let hi = splitmix64(splitmix64(case_seed) ^ index);
-    let lo = splitmix64(hi ^ 0x6A09_E667_F3BC_C909);
-    Pcg64Mcg::new((u128::from(hi) << 64) | u128::from(lo))
+    Stream::new(stream_key(seed, case), index)
 }
 
 /// Where a realization's standard normal numbers come from.
@@ -44,7 +33,7 @@ pub trait Noise {
 impl Noise for Stream {
     #[inline]
     fn normal(&mut self) -> f64 {
-        self.sample(StandardNormal)
+        Stream::normal(self)
     }
 }
 
@@ -235,8 +224,8 @@ fn run_with<N: Noise, O: Observer>(
             tv + eta_v_sigma * rng.normal(),
         );
         let dz = Vector2::new(z[0] - pc, z[1] - vc);
-        let prior = fix.phi_from_previous * estimate;
-        let (post, residual) = schedule.update(i, &prior, &dz);
+        let (prior, post, residual) = fix.step(&estimate.into(), &dz.into());
+        let (prior, post, residual) = (prior.into(), post.into(), Vector2::from(residual));
         estimate = post;
         observer.fix(&FixState {
             index: i,
@@ -259,7 +248,6 @@ fn run_with<N: Noise, O: Observer>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rand::Rng;
 
     #[test]
     fn streams_are_fixed_by_seed_and_index() {

@@ -63,9 +63,28 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
     let model = load_model(&args.model, &args.case, args.realizations)?;
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
     if let (Some(shard), Some(path)) = (&args.shard, &args.partial) {
-        return run_shard(&model, &schedule, shard, path, args.model.quiet);
+        return run_shard(
+            &model,
+            &schedule,
+            args.engine,
+            shard,
+            path,
+            args.model.quiet,
+        );
     }
-    let outcome = study::run_case(&model, &schedule, &mut Bar::new(args.model.quiet));
+    let outcome = match args.engine {
+        ensemble::Engine::Sample => {
+            study::run_case(&model, &schedule, &mut Bar::new(args.model.quiet))
+        }
+        engine => {
+            use accelcal::progress::Progress;
+            let mut bar = Bar::new(args.model.quiet);
+            bar.start(&model.case().id(), model.config.ensemble.realizations);
+            let run = ensemble::run_model_with(engine, &model, &schedule, |d| bar.advance(d));
+            bar.finish();
+            study::judge_case(&model, &schedule, run)
+        }
+    };
     let doc = export::ensemble_doc(&model.config, &schedule, &outcome);
     let json = export::ensemble_json(&model.config, &doc);
     match &args.json {
@@ -179,6 +198,7 @@ fn parse_shard(text: &str, partition: &Partition) -> Result<(u64, u64), ConfigEr
 fn run_shard(
     model: &Model,
     schedule: &FilterSchedule,
+    engine: ensemble::Engine,
     shard: &str,
     path: &Path,
     quiet: bool,
@@ -199,6 +219,7 @@ fn run_shard(
         max_lag: layout.max_lag(),
         pair: model.residual_pair,
         elapsed_s: 0.0,
+        engine,
     };
     let mut bar = Bar::new(quiet);
     bar.start(
@@ -210,7 +231,8 @@ fn run_shard(
     // The header carries the run time, so blocks wait in a second temporary until the run ends.
     let spool = tempfile_beside(path)?;
     let mut spool_w = std::io::BufWriter::new(std::fs::File::create(&spool)?);
-    ensemble::run_blocks(
+    ensemble::run_blocks_with(
+        engine,
         model,
         schedule,
         e.seed,
@@ -274,6 +296,7 @@ pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
     let run = EnsembleRun {
         stats: EnsembleStats::from_sums(&merged.sums, &schedule),
         elapsed_s: merged.elapsed_s,
+        engine: merged.engine,
     };
     let outcome = study::judge_case(&model, &schedule, run);
     let doc = export::ensemble_doc(&model.config, &schedule, &outcome);

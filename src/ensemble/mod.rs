@@ -5,6 +5,10 @@
 //! into the total in chunk order. The chunk boundaries depend on N alone, so the result is
 //! bit-for-bit the same on one thread or many.
 
+mod engine;
+pub mod epoch;
+pub mod kernel;
+mod lane_sums;
 mod layout;
 pub mod partial;
 mod stats;
@@ -16,10 +20,10 @@ use rayon::prelude::*;
 
 use crate::filter::FilterSchedule;
 use crate::model::Model;
-use crate::simulation::{FixState, Observer, run_realization};
+pub use engine::{Engine, Prepared, accumulate, accumulate_into, accumulate_with};
+pub use lane_sums::LaneFix;
 pub use layout::ResidualLayout;
 pub use stats::{EnsembleStats, FixStats, StageStats};
-use sums::BATCH;
 pub use sums::{Accumulator, FixSums, StageSums};
 
 /// Realizations summed sequentially into one accumulator before it is merged.
@@ -28,63 +32,9 @@ pub const CHUNK: u64 = 64;
 /// Memory the chunk accumulators in flight may take together, bytes.
 const WINDOW_BYTES: u64 = 256 << 20;
 
-/// Feeds one realization's fixes into an [`Accumulator`].
-struct Summer<'a> {
-    acc: &'a mut Accumulator,
-    schedule: &'a FilterSchedule,
-    /// This realization's residuals, stacked: (r_p(t_0), r_v(t_0), r_p(t_1), …).
-    stacked: &'a mut [f64],
-}
-
-impl Observer for Summer<'_> {
-    #[inline]
-    fn fix(&mut self, f: &FixState) {
-        let cov = &self.schedule.fixes[f.index];
-        let sums = &mut self.acc.fixes[f.index];
-        sums.prior
-            .add(&(f.delta_x - f.prior), &f.prior, &cov.p_prior_inv);
-        sums.post
-            .add(&(f.delta_x - f.post), &f.post, &cov.p_post_inv);
-        sums.nis += f.residual.dot(&(cov.s_inv * f.residual));
-        self.stacked[2 * f.index] = f.residual[0];
-        self.stacked[2 * f.index + 1] = f.residual[1];
-    }
-}
-
 /// The residual layout of `model`'s ensemble.
 pub fn layout_of(model: &Model) -> ResidualLayout {
     ResidualLayout::new(model.timeline.fixes(), model.residual_max_lag())
-}
-
-/// Sums realizations `range` of `model` into a fresh accumulator.
-pub fn accumulate(
-    model: &Model,
-    schedule: &FilterSchedule,
-    seed: u64,
-    range: std::ops::Range<u64>,
-) -> Accumulator {
-    let m = 2 * model.timeline.fixes();
-    let mut acc = Accumulator::new(&layout_of(model), model.residual_pair);
-    let mut batch = vec![0.0; BATCH * m];
-    let mut filled = 0;
-    for l in range {
-        let mut summer = Summer {
-            acc: &mut acc,
-            schedule,
-            stacked: &mut batch[filled * m..(filled + 1) * m],
-        };
-        run_realization(model, schedule, seed, l, &mut summer);
-        acc.count += 1;
-        filled += 1;
-        if filled == BATCH {
-            acc.add_residual_batch(&mut batch, filled);
-            filled = 0;
-        }
-    }
-    if filled > 0 {
-        acc.add_residual_batch(&mut batch, filled);
-    }
-    acc
 }
 
 /// Largest number of blocks an ensemble is folded in. Blocks are the unit of sharding.
@@ -155,6 +105,48 @@ pub fn run_blocks(
     seed: u64,
     n: u64,
     blocks: std::ops::Range<u64>,
+    progress: impl FnMut(u64),
+    on_block: impl FnMut(u64, Accumulator),
+) {
+    run_blocks_with(
+        Engine::Sample,
+        model,
+        schedule,
+        seed,
+        n,
+        blocks,
+        progress,
+        on_block,
+    );
+}
+
+/// [`run_blocks`] with the engine `engine`.
+#[allow(clippy::too_many_arguments)]
+pub fn run_blocks_with(
+    engine: Engine,
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    n: u64,
+    blocks: std::ops::Range<u64>,
+    progress: impl FnMut(u64),
+    on_block: impl FnMut(u64, Accumulator),
+) {
+    let prepared = Prepared::new(engine, model, schedule);
+    run_blocks_prepared(
+        &prepared, model, schedule, seed, n, blocks, progress, on_block,
+    );
+}
+
+/// [`run_blocks`] with the engine `prepared`.
+#[allow(clippy::too_many_arguments)]
+pub fn run_blocks_prepared(
+    prepared: &Prepared,
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    n: u64,
+    blocks: std::ops::Range<u64>,
     mut progress: impl FnMut(u64),
     mut on_block: impl FnMut(u64, Accumulator),
 ) {
@@ -176,13 +168,21 @@ pub fn run_blocks(
     let mut sums = Accumulator::new(&layout, model.residual_pair);
     let mut done = 0;
     let mut first = chunks.start;
+    // The chunk sums in flight and their scratch space, reused from window to window.
+    let mut slots: Vec<(Accumulator, Vec<f64>)> = Vec::new();
     while first < chunks.end {
         let last = (first + window).min(chunks.end);
-        let parts: Vec<Accumulator> = (first..last)
-            .into_par_iter()
-            .map(|c| accumulate(model, schedule, seed, partition.chunk_realizations(c)))
-            .collect();
-        for (c, part) in (first..last).zip(&parts) {
+        slots.resize_with((last - first) as usize, || {
+            (Accumulator::new(&layout, model.residual_pair), Vec::new())
+        });
+        slots
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(k, (acc, rows))| {
+                let range = partition.chunk_realizations(first + k as u64);
+                accumulate_into(prepared, model, schedule, seed, range, acc, rows);
+            });
+        for (c, (part, _)) in (first..last).zip(&slots) {
             sums.merge(part);
             done += part.count;
             if c + 1 == partition.block_chunks(block).end {
@@ -207,8 +207,34 @@ pub fn run(
     n: u64,
     progress: impl FnMut(u64),
 ) -> Accumulator {
+    run_with(Engine::Sample, model, schedule, seed, n, progress)
+}
+
+/// [`run`] with the engine `engine`.
+pub fn run_with(
+    engine: Engine,
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    n: u64,
+    progress: impl FnMut(u64),
+) -> Accumulator {
+    let prepared = Prepared::new(engine, model, schedule);
+    run_prepared(&prepared, model, schedule, seed, n, progress)
+}
+
+/// [`run`] with the engine `prepared`.
+pub fn run_prepared(
+    prepared: &Prepared,
+    model: &Model,
+    schedule: &FilterSchedule,
+    seed: u64,
+    n: u64,
+    progress: impl FnMut(u64),
+) -> Accumulator {
     let mut total = Accumulator::new(&layout_of(model), model.residual_pair);
-    run_blocks(
+    run_blocks_prepared(
+        prepared,
         model,
         schedule,
         seed,
@@ -227,6 +253,8 @@ pub struct EnsembleRun {
     pub stats: EnsembleStats,
     /// Wall-clock time of the realizations, s.
     pub elapsed_s: f64,
+    /// The engine that simulated the realizations.
+    pub engine: Engine,
 }
 
 impl EnsembleRun {
@@ -242,13 +270,24 @@ pub fn run_model(
     schedule: &FilterSchedule,
     progress: impl FnMut(u64),
 ) -> EnsembleRun {
+    run_model_with(Engine::Sample, model, schedule, progress)
+}
+
+/// [`run_model`] with the engine `engine`.
+pub fn run_model_with(
+    engine: Engine,
+    model: &Model,
+    schedule: &FilterSchedule,
+    progress: impl FnMut(u64),
+) -> EnsembleRun {
     let e = &model.config.ensemble;
     let start = Instant::now();
-    let acc = run(model, schedule, e.seed, e.realizations, progress);
+    let acc = run_with(engine, model, schedule, e.seed, e.realizations, progress);
     let elapsed_s = start.elapsed().as_secs_f64();
     EnsembleRun {
         stats: EnsembleStats::from_sums(&acc, schedule),
         elapsed_s,
+        engine,
     }
 }
 

@@ -10,6 +10,7 @@ use std::io::{Read, Write};
 
 use serde::{Deserialize, Serialize};
 
+use super::Engine;
 use super::layout::ResidualLayout;
 use super::sums::{Accumulator, FixSums, StageSums};
 use crate::config::Config;
@@ -38,6 +39,10 @@ pub struct PartialHeader {
     pub pair: [usize; 2],
     /// Wall-clock time of the shard's realizations, s.
     pub elapsed_s: f64,
+    /// The engine that simulated the realizations (files without it were written by the
+    /// per-sample engine).
+    #[serde(default)]
+    pub engine: Engine,
 }
 
 /// A partial file that cannot be read or does not belong with the others.
@@ -238,6 +243,8 @@ pub struct Merged {
     pub sums: Accumulator,
     /// The shards' run times added up, s.
     pub elapsed_s: f64,
+    /// The engine that simulated the realizations.
+    pub engine: Engine,
 }
 
 /// Reads the partial files `files` (name and reader, any order), checks that they are every
@@ -282,6 +289,15 @@ pub fn merge<R: std::io::BufRead>(files: Vec<(String, R)>) -> Result<Merged, Par
                 )
             };
             return Err(mismatch(name, format!("another ensemble: {what}")));
+        }
+        if h.engine != first.engine {
+            return Err(mismatch(
+                name,
+                format!(
+                    "simulated by the {} engine, {first_name} by the {} engine",
+                    h.engine, first.engine
+                ),
+            ));
         }
         if h.shards != first.shards {
             return Err(mismatch(
@@ -367,6 +383,7 @@ pub fn merge<R: std::io::BufRead>(files: Vec<(String, R)>) -> Result<Merged, Par
         config: first.config,
         sums,
         elapsed_s,
+        engine: first.engine,
     })
 }
 
@@ -396,6 +413,7 @@ mod tests {
             max_lag: Some(3),
             pair: m.residual_pair,
             elapsed_s: 0.5,
+            engine: Engine::Sample,
         };
         let mut bytes = Vec::new();
         write_header(&mut bytes, &header).unwrap();

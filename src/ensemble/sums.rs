@@ -25,22 +25,6 @@ pub struct StageSums {
 const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
 
 impl StageSums {
-    #[inline]
-    pub(super) fn add(&mut self, e: &Vector3, x: &Vector3, p_inv: &Matrix3) {
-        self.e += e;
-        let mut nees = 0.0;
-        for (s, &(r, c)) in self.ee.iter_mut().zip(&UPPER) {
-            let prod = e[r] * e[c];
-            *s += prod;
-            // eᵀP⁻¹e over the upper triangle: off-diagonal terms count twice.
-            nees += if r == c { 1.0 } else { 2.0 } * p_inv[(r, c)] * prod;
-        }
-        self.ex += e * x.transpose();
-        self.x += x;
-        self.xx += x.component_mul(x);
-        self.nees += nees;
-    }
-
     /// Σ e·eᵀ as a full matrix.
     pub fn ee_matrix(&self) -> Matrix3 {
         let mut m = Matrix3::zeros();
@@ -132,37 +116,73 @@ impl Accumulator {
         }
     }
 
-    /// Adds Σ_q ρ_q·ρ_qᵀ over the stacked residual vectors of a batch (the first `filled` rows of
-    /// `batch`, each of length 2·fixes). Batching reads and writes the large packed triangle once
-    /// per [`BATCH`] realizations instead of once per realization.
-    pub(super) fn add_residual_batch(&mut self, batch: &mut [f64], filled: usize) {
+    /// Empties the per-fix sums, the count and the pair products, keeping the layout and the
+    /// storage; the residual products are left as they are for [`Self::set_residual_rows`] to
+    /// overwrite.
+    pub(super) fn clear_but_products(&mut self) {
+        self.count = 0;
+        self.fixes.fill(FixSums::default());
+        self.pair_products = [0.0; 4];
+    }
+
+    /// Sets the residual products to Σ_q ρ_q·ρ_qᵀ over the stacked residual vectors `rows` (each
+    /// of length 2·fixes, a whole number ≥ 1 of batches of [`BATCH`]; rows of inactive
+    /// realizations are zero) and adds the pair products. Each stored product is the first
+    /// batch's partial sum, then the next batches' added in order. The rows of the triangle go in
+    /// tiles small enough to stay in cache while every batch passes over them, so the large
+    /// packed triangle is written once per call.
+    #[inline(always)]
+    pub(super) fn set_residual_rows(&mut self, rows: &[f64]) {
         let m = 2 * self.fixes.len();
-        debug_assert_eq!(batch.len(), BATCH * m);
-        // Unused rows contribute nothing: zero them so the fixed-size inner loop stays exact.
-        batch[filled * m..].fill(0.0);
-        let rows: [&[f64]; BATCH] = std::array::from_fn(|q| &batch[q * m..(q + 1) * m]);
+        let batches = rows.len() / (BATCH * m);
+        debug_assert!(batches >= 1 && rows.len() == batches * BATCH * m);
         let [pm, pi] = self.pair;
-        for row in rows.iter().take(filled) {
+        for row in rows.chunks_exact(m) {
             for (c, p) in self.pair_products.iter_mut().enumerate() {
                 *p += row[2 * pi + c / 2] * row[2 * pm + c % 2];
             }
         }
-        let mut start = 0;
-        for a in 0..m {
-            let first = self.layout.first_col(a);
-            let len = a + 1 - first;
-            let coef: [f64; BATCH] = std::array::from_fn(|q| rows[q][a]);
-            let dst = &mut self.residual_products[start..start + len];
-            let cols: [&[f64]; BATCH] = std::array::from_fn(|q| &rows[q][first..=a]);
-            // Row a += Σ_q ρ_q[a] · ρ_q[first..=a].
-            for (b, d) in dst.iter_mut().enumerate() {
-                let mut s = 0.0;
-                for q in 0..BATCH {
-                    s += coef[q] * cols[q][b];
+        const TILE: usize = 16;
+        let mut tile_start = 0;
+        for a0 in (0..m).step_by(TILE) {
+            let a1 = (a0 + TILE).min(m);
+            for (k, batch) in rows.chunks_exact(BATCH * m).enumerate() {
+                let rows: [&[f64]; BATCH] = std::array::from_fn(|q| &batch[q * m..(q + 1) * m]);
+                let mut start = tile_start;
+                for a in a0..a1 {
+                    let first = self.layout.first_col(a);
+                    let len = a + 1 - first;
+                    let coef: [f64; BATCH] = std::array::from_fn(|q| rows[q][a]);
+                    let dst = &mut self.residual_products[start..start + len];
+                    let cols: [&[f64]; BATCH] = std::array::from_fn(|q| &rows[q][first..=a]);
+                    // Row a (+)= Σ_q ρ_q[a] · ρ_q[first..=a].
+                    if k == 0 {
+                        row_pass::<true>(dst, &coef, &cols);
+                    } else {
+                        row_pass::<false>(dst, &coef, &cols);
+                    }
+                    start += len;
                 }
-                *d += s;
             }
-            start += len;
+            tile_start += (a0..a1)
+                .map(|a| a + 1 - self.layout.first_col(a))
+                .sum::<usize>();
+        }
+    }
+}
+
+/// dst = (SET) or += Σ_q coef_q · cols_q, element by element.
+#[inline(always)]
+fn row_pass<const SET: bool>(dst: &mut [f64], coef: &[f64; BATCH], cols: &[&[f64]; BATCH]) {
+    for (b, d) in dst.iter_mut().enumerate() {
+        let mut s = 0.0;
+        for q in 0..BATCH {
+            s += coef[q] * cols[q][b];
+        }
+        if SET {
+            *d = s;
+        } else {
+            *d += s;
         }
     }
 }

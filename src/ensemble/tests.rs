@@ -2,6 +2,7 @@ use super::*;
 
 use crate::config::Config;
 use crate::filter::Vector3;
+use crate::simulation::{FixState, Observer, run_realization};
 
 fn small() -> (Model, FilterSchedule) {
     let mut c = Config::default();

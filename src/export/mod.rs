@@ -114,6 +114,8 @@ pub struct Summary {
     pub realizations: u64,
     /// Seed of the random streams.
     pub seed: u64,
+    /// The engine that simulated the realizations: "sample" or "epoch".
+    pub engine: crate::ensemble::Engine,
     /// The filter's a posteriori σ at the last fix: the accuracy it claims.
     pub final_sigma: FinalSigma,
     /// The achieved RMS a posteriori error at the last fix, √(mean² + variance) over the
@@ -218,6 +220,7 @@ pub fn ensemble_doc<'a>(
             accelerometer_output: outcome.case.output,
             realizations: stats.realizations,
             seed: config.ensemble.seed,
+            engine: run.engine,
             final_sigma: FinalSigma::from(std::array::from_fn(|k| last.p_post[(k, k)].sqrt())),
             achieved_rms: FinalSigma::from(outcome.achieved_rms_final()),
             mean_error_prediction: PredictionSummary {

@@ -1,0 +1,184 @@
+//! The per-sample engine on lane groups: [`LANES`] consecutive realizations simulated side by side,
+//! each with its own random stream, performing exactly the operations of
+//! [`crate::simulation::run_realization`] in the same order, so that every lane reproduces its
+//! realization bit for bit (tested).
+
+use super::lane_sums::LaneFix;
+use crate::config::TruthModel;
+use crate::filter::{FilterSchedule, FixCovariance};
+use crate::lanes::{LANES, Lanes, Real};
+use crate::model::Model;
+use crate::random::LaneStreams;
+
+/// The lane mask of a group with `active` realizations: 1 for the active lanes, 0 for the rest.
+pub(super) fn lane_mask(active: usize) -> Lanes {
+    Lanes(std::array::from_fn(|k| if k < active { 1.0 } else { 0.0 }))
+}
+
+/// A lane group advanced fix by fix: [`LaneGroup::next_fix`] integrates up to the next fix and
+/// runs the filter through it.
+pub trait LaneGroup {
+    /// Advances to fix `i` (the fixes come in order) with the filter's `fix`.
+    fn next_fix(&mut self, i: usize, fix: &FixCovariance) -> LaneFix;
+}
+
+/// The per-sample simulation of realizations `first..first + LANES` (only the first `active`
+/// count; the others are zeroed at every fix). `EULER`: the truth is eq. (4), else eq. (1).
+pub struct SampleGroup<'a, const EULER: bool> {
+    model: &'a Model,
+    rng: LaneStreams,
+    mask: Lanes,
+    p0: Lanes,
+    v0: Lanes,
+    b: Lanes,
+    /// (p_c, v_c, p_E, v_E), eqs. (3) and (4).
+    state: [Lanes; 4],
+    estimate: [Lanes; 3],
+    /// The next sample to integrate.
+    j: usize,
+}
+
+impl<'a, const EULER: bool> SampleGroup<'a, EULER> {
+    /// The group of realizations `first..` of the streams `key`, its initial values drawn.
+    #[inline(always)]
+    pub fn new(model: &'a Model, key: u64, first: u64, active: usize) -> Self {
+        let cfg = &model.config;
+        let ts = &model.truth_stats;
+        let mut rng = LaneStreams::new(key, first);
+        let s = Lanes::splat;
+        // Draw order as in simulation::run_with: p(0), v(0), b.
+        let p0 = s(cfg.initial.position_mean_m) + s(ts.initial_position_sigma_m) * rng.normal();
+        let v0 = s(cfg.initial.velocity_mean_m_s) + s(ts.initial_velocity_sigma_m_s) * rng.normal();
+        let b = s(ts.bias_var_m2_s4.sqrt()) * rng.normal();
+        Self {
+            model,
+            rng,
+            mask: lane_mask(active),
+            p0,
+            v0,
+            b,
+            state: [
+                s(cfg.initial.position_mean_m),
+                s(cfg.initial.velocity_mean_m_s),
+                p0,
+                v0,
+            ],
+            estimate: [Lanes::default(); 3],
+            j: 0,
+        }
+    }
+}
+
+impl<const EULER: bool> LaneGroup for SampleGroup<'_, EULER> {
+    #[inline(always)]
+    fn next_fix(&mut self, i: usize, fix: &FixCovariance) -> LaneFix {
+        let model = self.model;
+        let ts = &model.truth_stats;
+        let s = Lanes::splat;
+        let tl = &model.timeline;
+        let dt = tl.dt_s;
+        let half_dt2 = 0.5 * dt * dt;
+        let w_sigma = s(ts.accel_noise_var_m2_s4.sqrt());
+        let b = self.b;
+        let jf = tl.fix_steps[i];
+        let [mut pc, mut vc, mut pe, mut ve] = self.state;
+        for &a in &model.accel_m_s2[self.j..jf] {
+            // eq. (2), then eq. (3); eq. (4) for the Euler truth.
+            let ac = (s(a) + b) + w_sigma * self.rng.normal();
+            pc += vc * s(dt) + ac * s(half_dt2);
+            vc += ac * s(dt);
+            if EULER {
+                pe += ve * s(dt) + s(a * half_dt2);
+                ve += s(a * dt);
+            }
+        }
+        self.state = [pc, vc, pe, ve];
+        self.j = jf;
+        let (tp, tv) = if EULER {
+            (pe, ve)
+        } else {
+            let [dp, dv] = model.analytic_offsets_at_fix[i];
+            (
+                self.p0 + self.v0 * s(tl.time_s(jf)) + s(dp),
+                self.v0 + s(dv),
+            )
+        };
+        let mask = self.mask;
+        let delta_x = [(tp - pc) * mask, (tv - vc) * mask, b * mask];
+        let z = [
+            tp + s(ts.gps_position_sigma_m) * self.rng.normal(),
+            tv + s(ts.gps_velocity_sigma_m_s) * self.rng.normal(),
+        ];
+        let dz = [(z[0] - pc) * mask, (z[1] - vc) * mask];
+        let (prior, post, residual) = fix.step(&self.estimate, &dz);
+        self.estimate = post;
+        LaneFix {
+            delta_x,
+            prior,
+            post,
+            residual,
+        }
+    }
+}
+
+/// Runs the realizations `first..first + LANES` of the streams `key` (only the first `active`
+/// count) and hands each fix to `on_fix`.
+#[inline(always)]
+pub fn run_group(
+    model: &Model,
+    schedule: &FilterSchedule,
+    key: u64,
+    first: u64,
+    active: usize,
+    on_fix: impl FnMut(usize, &LaneFix),
+) {
+    fn all<G: LaneGroup>(
+        mut g: G,
+        schedule: &FilterSchedule,
+        mut on_fix: impl FnMut(usize, &LaneFix),
+    ) {
+        for (i, fix) in schedule.fixes.iter().enumerate() {
+            let f = g.next_fix(i, fix);
+            on_fix(i, &f);
+        }
+    }
+    match model.truth() {
+        TruthModel::Euler => all(
+            SampleGroup::<true>::new(model, key, first, active),
+            schedule,
+            on_fix,
+        ),
+        TruthModel::Analytic => all(
+            SampleGroup::<false>::new(model, key, first, active),
+            schedule,
+            on_fix,
+        ),
+    }
+}
+
+#[inline(always)]
+fn bare_group_lanes(
+    model: &Model,
+    schedule: &FilterSchedule,
+    key: u64,
+    first: u64,
+    active: usize,
+) -> f64 {
+    let mut acc = Lanes::default();
+    run_group(model, schedule, key, first, active, |_, f| acc += f.post[2]);
+    acc.sum()
+}
+
+crate::lanes::vectorized! {
+    /// The bare kernel for benchmarks: one lane group without statistics; returns the sum of the
+    /// final bias estimates.
+    pub fn bare_group(
+        model: &Model,
+        schedule: &FilterSchedule,
+        key: u64,
+        first: u64,
+        active: usize,
+    ) -> f64 => bare_group_lanes
+}
+
+const _: () = assert!(LANES == super::sums::BATCH);

@@ -1,0 +1,146 @@
+//! The running sums of one fix of a chunk kept per lane: each lane of every lane group of the
+//! chunk adds its realization's fix into its own column, with no branch and no reduction, and the
+//! lanes are added up once, in lane order, when every group has passed the fix.
+// Lane loops index several arrays by the lane k; iterators would hide that.
+#![allow(clippy::needless_range_loop)]
+
+use super::sums::{FixSums, StageSums};
+use crate::filter::{FilterSchedule, Matrix3};
+use crate::lanes::Lanes;
+
+/// Upper-triangle index pairs of a symmetric 3×3 matrix, in [`StageSums::ee`] order.
+const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+/// What every engine hands over at one fix, for a lane group: the true error state, the
+/// estimates and the residual (inactive lanes all zero).
+#[derive(Clone, Copy, Debug)]
+pub struct LaneFix {
+    /// δx(t_i).
+    pub delta_x: [Lanes; 3],
+    /// δx̂(t_i⁻).
+    pub prior: [Lanes; 3],
+    /// δx̂(t_i⁺).
+    pub post: [Lanes; 3],
+    /// r(t_i).
+    pub residual: [Lanes; 2],
+}
+
+/// One stage's sums per lane; fields as in [`StageSums`].
+#[derive(Clone, Copy, Debug, Default)]
+struct LaneStage {
+    e: [Lanes; 3],
+    ee: [Lanes; 6],
+    /// Σ e·δx̂ᵀ, column-major like [`Matrix3`].
+    ex: [Lanes; 9],
+    x: [Lanes; 3],
+    xx: [Lanes; 3],
+    nees: Lanes,
+}
+
+impl LaneStage {
+    /// Adds e = δx − δx̂ for the estimate `x`; `w` holds the weights of eᵀP⁻¹e over the upper
+    /// triangle (off-diagonal terms doubled).
+    #[inline(always)]
+    fn add(&mut self, delta_x: &[Lanes; 3], x: &[Lanes; 3], w: &[f64; 6]) {
+        let e: [Lanes; 3] = std::array::from_fn(|k| delta_x[k] - x[k]);
+        let mut nees = Lanes::default();
+        for (s, (&(r, c), &wk)) in self.ee.iter_mut().zip(UPPER.iter().zip(w)) {
+            let prod = e[r] * e[c];
+            *s += prod;
+            nees += Lanes([wk; 8]) * prod;
+        }
+        self.nees += nees;
+        for c in 0..3 {
+            for r in 0..3 {
+                self.ex[3 * c + r] += e[r] * x[c];
+            }
+            self.e[c] += e[c];
+            self.x[c] += x[c];
+            self.xx[c] += x[c] * x[c];
+        }
+    }
+
+    /// The lanes added up into `s`.
+    fn reduce(&self, s: &mut StageSums) {
+        for k in 0..3 {
+            s.e[k] = self.e[k].sum();
+            s.x[k] = self.x[k].sum();
+            s.xx[k] = self.xx[k].sum();
+        }
+        for k in 0..6 {
+            s.ee[k] = self.ee[k].sum();
+        }
+        s.ex = Matrix3::from_fn(|r, c| self.ex[3 * c + r].sum());
+        s.nees = self.nees.sum();
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct LaneFixSums {
+    prior: LaneStage,
+    post: LaneStage,
+    nis: Lanes,
+}
+
+/// The weights of the quadratic forms at one fix.
+#[derive(Clone, Copy, Debug)]
+struct Weights {
+    prior: [f64; 6],
+    post: [f64; 6],
+    /// S⁻¹ as (00, 2·01, 11).
+    s: [f64; 3],
+}
+
+/// The per-lane sums of the fix being summed, and the weights of every fix's quadratic forms.
+#[derive(Clone, Debug)]
+pub struct LaneSums {
+    current: LaneFixSums,
+    weights: Vec<Weights>,
+}
+
+impl LaneSums {
+    /// Empty sums for the fixes of `schedule`.
+    pub fn new(schedule: &FilterSchedule) -> Self {
+        let upper = |m: &Matrix3| {
+            std::array::from_fn(|k| {
+                let (r, c) = UPPER[k];
+                if r == c { m[(r, c)] } else { 2.0 * m[(r, c)] }
+            })
+        };
+        Self {
+            current: LaneFixSums::default(),
+            weights: schedule
+                .fixes
+                .iter()
+                .map(|f| Weights {
+                    prior: upper(&f.p_prior_inv),
+                    post: upper(&f.p_post_inv),
+                    s: [f.s_inv[(0, 0)], 2.0 * f.s_inv[(0, 1)], f.s_inv[(1, 1)]],
+                })
+                .collect(),
+        }
+    }
+
+    /// Adds a lane group's fix `i`.
+    #[inline(always)]
+    pub fn add(&mut self, i: usize, f: &LaneFix) {
+        let w = &self.weights[i];
+        let sums = &mut self.current;
+        sums.prior.add(&f.delta_x, &f.prior, &w.prior);
+        sums.post.add(&f.delta_x, &f.post, &w.post);
+        let [r0, r1] = f.residual;
+        sums.nis += Lanes([w.s[0]; 8]) * r0 * r0
+            + Lanes([w.s[1]; 8]) * r0 * r1
+            + Lanes([w.s[2]; 8]) * r1 * r1;
+    }
+
+    /// Writes the lanes' totals of the fix into `out` (replacing it) and starts the next fix.
+    #[inline(always)]
+    pub fn finish_fix(&mut self, out: &mut FixSums) {
+        let c = &self.current;
+        c.prior.reduce(&mut out.prior);
+        c.post.reduce(&mut out.post);
+        out.nis = c.nis.sum();
+        self.current = LaneFixSums::default();
+    }
+}
