@@ -143,6 +143,9 @@ pub struct SensitivityArgs {
     /// (0: no prediction), overriding sensitivity.draws.
     #[arg(long, value_name = "D")]
     pub draws: Option<u64>,
+    /// How the Monte Carlo ensembles simulate their realizations (see `ensemble --engine`).
+    #[arg(long, value_enum, default_value_t = Engine::Epoch)]
+    pub engine: Engine,
     /// Write the JSON here instead of to standard output.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,

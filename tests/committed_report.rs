@@ -62,7 +62,6 @@ fn without_timing(html: &str) -> String {
 }
 
 #[test]
-#[ignore = "the speed branch changed the random streams; regenerate report/ with `cargo run --release` after the merge, then remove this"]
 fn committed_page_matches_the_code() {
     let committed =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/report/index.html"))
@@ -106,7 +105,6 @@ fn timing_cells_are_masked_and_nothing_else() {
 }
 
 #[test]
-#[ignore = "the speed branch changed the random streams; regenerate report/ with `cargo run --release` after the merge, then remove this"]
 fn committed_data_matches_the_code() {
     let committed: Value = serde_json::from_str(
         &std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/report/data.json"))

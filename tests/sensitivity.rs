@@ -6,7 +6,7 @@ mod common;
 
 use accelcal::checks::CheckId;
 use accelcal::config::{Config, TruthModel};
-use accelcal::ensemble::{self, EnsembleStats};
+use accelcal::ensemble::{self, Engine, EnsembleStats};
 use accelcal::sensitivity::{self, AssumedStatistic, Plan, actual_covariance};
 use accelcal::stats::clopper_pearson;
 use accelcal::study::Silent;
@@ -239,6 +239,8 @@ fn predicted_detection_agrees_with_the_measured_by_a_two_sample_test() {
                 realizations: 300,
                 ensembles: k,
                 draws: d,
+                // The per-sample engine: the measurement owes nothing to fix-level shortcuts.
+                engine: Engine::Sample,
             };
             sensitivity::run(&base, &plan, &mut Silent).unwrap().cases[0].clone()
         })
@@ -298,6 +300,7 @@ fn half_the_accelerometer_noise_is_detected_at_10000_realizations() {
         realizations: 10_000,
         ensembles: 60,
         draws: 1000,
+        engine: Engine::Epoch,
     };
     let s = sensitivity::run(&base, &plan, &mut Silent).unwrap();
     let c = &s.cases[0];
@@ -345,6 +348,7 @@ fn a_case_gives_the_same_numbers_in_any_plan() {
         realizations: 100,
         ensembles: 2,
         draws: 20,
+        engine: Engine::Epoch,
     };
     let alone = sensitivity::run(
         &base,
@@ -375,6 +379,7 @@ fn the_same_seed_gives_the_same_numbers_on_any_thread_count() {
         realizations: 200,
         ensembles: 3,
         draws: 50,
+        engine: Engine::Epoch,
     };
     let on = |threads: usize| {
         rayon::ThreadPoolBuilder::new()

@@ -162,6 +162,7 @@ fn sensitivity_plan(args: &SensitivityArgs, config: &Config) -> Result<Plan, Con
         realizations: config.ensemble.realizations,
         ensembles,
         draws,
+        engine: args.engine,
     })
 }
 

@@ -46,6 +46,8 @@ pub struct MonteCarloRecord {
     pub realizations: u64,
     /// Independent ensembles.
     pub ensembles: u64,
+    /// The engine that simulated them: "sample" or "epoch".
+    pub engine: &'static str,
     /// Fraction of the ensembles in which each check failed; null when none ran.
     pub detected: Option<BTreeMap<&'static str, f64>>,
 }
@@ -102,6 +104,7 @@ pub fn record(s: &Sensitivity) -> SensitivityRecord {
                 monte_carlo: MonteCarloRecord {
                     realizations: s.plan.realizations,
                     ensembles: c.ensembles,
+                    engine: s.plan.engine.name(),
                     detected: c.detected.as_ref().map(|d| {
                         CheckId::ALL
                             .iter()

@@ -6,6 +6,7 @@ use super::figures::{Numbering, figure};
 use super::prose::and_list;
 use super::view::{DetectionCell, DetectionRow, SensitivityView};
 use crate::checks::CheckId;
+use crate::ensemble::Engine;
 use crate::format::{count, fixed, short, sig};
 use crate::plot::{self, SensitivitySeries};
 use crate::sensitivity::{AssumedStatistic, Sensitivity, SensitivityCase};
@@ -195,6 +196,11 @@ pub fn view(s: &Sensitivity, numbers: &mut Numbering) -> Result<SensitivityView,
         realizations: count(s.plan.realizations),
         ensembles: count(s.plan.ensembles),
         draws: count(s.cases.first().map_or(0, |c| c.draws)),
+        engine_words: match s.plan.engine {
+            Engine::Sample => "per-sample engine (every accelerometer sample drawn and integrated)",
+            Engine::Epoch => "epoch engine (one exact draw of the accelerometer noise's effect per GPS interval, the same distribution at the fixes as sample by sample)",
+        }
+        .to_string(),
         ensembles_words: match s.plan.ensembles {
             0 => "no Monte Carlo ensemble".to_string(),
             1 => "one independent Monte Carlo ensemble".to_string(),

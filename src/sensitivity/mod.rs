@@ -15,7 +15,7 @@ pub mod sampler;
 
 use crate::checks::{self, Budget, CheckId, Verdict};
 use crate::config::{Case, Config};
-use crate::ensemble::{self, EnsembleStats};
+use crate::ensemble::{self, Engine, EnsembleStats};
 use crate::error::{ConfigError, FilterError};
 use crate::filter::FilterSchedule;
 use crate::model::Model;
@@ -125,11 +125,14 @@ pub struct Plan {
     /// Draws of the ensemble's sums per case that predict the detection probabilities; 0 skips
     /// the prediction.
     pub draws: u64,
+    /// The engine of the Monte Carlo ensembles.
+    pub engine: Engine,
 }
 
 impl Plan {
     /// The plan of `config`: every assumed statistic, `sensitivity.factors`,
-    /// `sensitivity.ensembles` ensembles of `ensemble.realizations`, `sensitivity.draws` draws.
+    /// `sensitivity.ensembles` ensembles of `ensemble.realizations` by the epoch engine,
+    /// `sensitivity.draws` draws.
     pub fn of(config: &Config) -> Self {
         Self {
             parameters: AssumedStatistic::ALL.to_vec(),
@@ -137,6 +140,7 @@ impl Plan {
             realizations: config.ensemble.realizations,
             ensembles: config.sensitivity.ensembles,
             draws: config.sensitivity.draws,
+            engine: Engine::Epoch,
         }
     }
 }
@@ -372,12 +376,18 @@ pub fn run(
         let mut done = 0;
         for case in &mut cases {
             let (model, schedule) = mistuned(&world, case.parameter, case.factor)?;
+            let prepared = ensemble::Prepared::new(plan.engine, &model, &schedule);
             let mut failures = [0u64; 7];
             for k in 0..plan.ensembles {
                 let seed = mix(case_seed(seed, ENSEMBLES, case.parameter, case.factor), k);
-                let acc = ensemble::run(&model, &schedule, seed, plan.realizations, |d| {
-                    progress.advance(done + d)
-                });
+                let acc = ensemble::run_prepared(
+                    &prepared,
+                    &model,
+                    &schedule,
+                    seed,
+                    plan.realizations,
+                    |d| progress.advance(done + d),
+                );
                 done += plan.realizations;
                 let stats = EnsembleStats::from_sums(&acc, &schedule);
                 let v = checks::evaluate(&stats, &budget);
