@@ -1,4 +1,4 @@
-//! The per-sample engine on lane groups: [`LANES`] consecutive realizations simulated side by side,
+//! The per-sample engine on lane groups: [`LANES`](crate::lanes::LANES) consecutive realizations simulated side by side,
 //! each with its own random stream, performing exactly the operations of
 //! [`crate::simulation::run_realization`] in the same order, so that every lane reproduces its
 //! realization bit for bit (tested).
@@ -6,7 +6,7 @@
 use super::lane_sums::LaneFix;
 use crate::config::TruthModel;
 use crate::filter::{FilterSchedule, FixCovariance};
-use crate::lanes::{LANES, Lanes, Real};
+use crate::lanes::{Lanes, Real};
 use crate::model::Model;
 use crate::random::LaneStreams;
 
@@ -180,5 +180,3 @@ crate::lanes::vectorized! {
         active: usize,
     ) -> f64 => bare_group_lanes
 }
-
-const _: () = assert!(LANES == super::sums::BATCH);
