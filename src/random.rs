@@ -249,6 +249,19 @@ impl LaneStreams {
         }
     }
 
+    /// The next normal numbers of every lane, at most `max` of them and at least one: a run of
+    /// [`Self::normal`]'s results, handed over at once.
+    #[inline(always)]
+    pub fn normals(&mut self, max: usize) -> &[Lanes] {
+        if self.pos == BLOCK {
+            refill(self);
+        }
+        let start = self.pos;
+        let end = (start + max).min(BLOCK);
+        self.pos = end;
+        &self.buf[start..end]
+    }
+
     /// The next standard normal number of every lane, each the number its scalar stream draws.
     #[inline(always)]
     pub fn normal(&mut self) -> Lanes {
