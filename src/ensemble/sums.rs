@@ -182,12 +182,9 @@ pub(super) const PANEL: usize = 8;
 #[inline(always)]
 fn tile_products<const OFF: usize>(rows: &[f64], cols: &[f64], count: usize) -> [[f64; PANEL]; 4] {
     let mut acc = [[0.0; PANEL]; 4];
-    for (row, col) in rows
-        .chunks_exact(PANEL)
-        .zip(cols.chunks_exact(PANEL))
-        .take(count)
-    {
-        let col: &[f64; PANEL] = col.try_into().expect("a panel row");
+    let (rows, _) = rows[..count * PANEL].as_chunks::<PANEL>();
+    let (cols, _) = cols[..count * PANEL].as_chunks::<PANEL>();
+    for (row, col) in rows.iter().zip(cols) {
         let x: [f64; 4] = std::array::from_fn(|r| row[OFF + r]);
         for r in 0..4 {
             for c in 0..PANEL {
