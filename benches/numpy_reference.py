@@ -78,7 +78,10 @@ def ensemble(n, sched, rng):
         # Every sample's output a_c = a + b + w, integrated by eq. (3) over the interval at once:
         # p_c gains v_c·τ + Σ_k a_c,k·(Δt²/2 + (n − 1 − k)·Δt²), v_c gains Σ_k a_c,k·Δt.
         steps = jf - j
-        ac = ACCEL[j:jf, None] + b + sw * rng.standard_normal((steps, n))
+        ac = rng.standard_normal((steps, n))
+        ac *= sw
+        ac += b
+        ac += ACCEL[j:jf, None]
         coef_p = half + (steps - 1 - np.arange(steps)) * DT * DT
         pc += vc * (steps * DT) + coef_p @ ac
         vc += DT * ac.sum(0)
@@ -96,8 +99,8 @@ def ensemble(n, sched, rng):
         for x, pinv in ((prior, p_prior_inv), (post, p_post_inv)):
             e = dx - x
             fix.append((e.sum(1), e @ e.T, e @ x.T, x.sum(1), (x * x).sum(1),
-                        np.einsum("in,ij,jn->", e, pinv, e)))
-        fix.append(np.einsum("in,ij,jn->", r, s_inv, r))
+                        ((pinv @ e) * e).sum()))
+        fix.append(((s_inv @ r) * r).sum())
         sums.append(fix)
         resid[:, 2 * i] = r[0]
         resid[:, 2 * i + 1] = r[1]

@@ -33,9 +33,43 @@ pub const BLOCK: usize = 32;
 /// its standard normal numbers drawn [`BLOCK`] at a time.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Stream {
-    s: [u64; 4],
+    core: Core,
     buf: [f64; BLOCK],
     pos: usize,
+}
+
+/// The xoshiro256++ state and its uniform numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Core([u64; 4]);
+
+impl Core {
+    /// The next 64 random bits.
+    #[inline]
+    fn next_u64(&mut self) -> u64 {
+        let [s0, s1, s2, s3] = self.0;
+        let out = s0.wrapping_add(s3).rotate_left(23).wrapping_add(s0);
+        let t = s1 << 17;
+        let s2 = s2 ^ s0;
+        let s3 = s3 ^ s1;
+        let s1 = s1 ^ s2;
+        let s0 = s0 ^ s3;
+        let s2 = s2 ^ t;
+        let s3 = s3.rotate_left(45);
+        self.0 = [s0, s1, s2, s3];
+        out
+    }
+
+    /// A uniform number in (0, 1], from the top 53 bits.
+    #[inline]
+    fn open_closed01(&mut self) -> f64 {
+        ((self.next_u64() >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    /// A uniform number in [0, 1), from the top 53 bits.
+    #[inline]
+    fn closed_open01(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
 }
 
 impl Stream {
@@ -53,7 +87,7 @@ impl Stream {
             s[0] = 1;
         }
         Self {
-            s,
+            core: Core(s),
             buf: [0.0; BLOCK],
             pos: BLOCK,
         }
@@ -62,29 +96,7 @@ impl Stream {
     /// The next 64 random bits.
     #[inline]
     pub fn next_u64(&mut self) -> u64 {
-        let [s0, s1, s2, s3] = self.s;
-        let out = s0.wrapping_add(s3).rotate_left(23).wrapping_add(s0);
-        let t = s1 << 17;
-        let s2 = s2 ^ s0;
-        let s3 = s3 ^ s1;
-        let s1 = s1 ^ s2;
-        let s0 = s0 ^ s3;
-        let s2 = s2 ^ t;
-        let s3 = s3.rotate_left(45);
-        self.s = [s0, s1, s2, s3];
-        out
-    }
-
-    /// A uniform number in (0, 1], from the top 53 bits.
-    #[inline]
-    fn open_closed01(&mut self) -> f64 {
-        ((self.next_u64() >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-
-    /// A uniform number in [0, 1), from the top 53 bits.
-    #[inline]
-    fn closed_open01(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+        self.core.next_u64()
     }
 
     /// The next standard normal number (ziggurat).
@@ -104,12 +116,12 @@ impl Stream {
         let mut bits = [0; BLOCK];
         let mut ok = [true; BLOCK];
         for t in 0..BLOCK {
-            bits[t] = self.next_u64();
+            bits[t] = self.core.next_u64();
             (self.buf[t], ok[t]) = z.fast(bits[t]);
         }
         for t in 0..BLOCK {
             if !ok[t] {
-                self.buf[t] = z.slow(bits[t], self.buf[t], self);
+                self.buf[t] = z.slow(bits[t], self.buf[t], &mut self.core);
             }
         }
         self.pos = 0;
@@ -194,7 +206,7 @@ impl Ziggurat {
     /// tail beyond R for the base layer, else the wedge test; a rejected point starts over.
     #[cold]
     #[inline(never)]
-    fn slow(&self, mut bits: u64, mut x: f64, rng: &mut Stream) -> f64 {
+    fn slow(&self, mut bits: u64, mut x: f64, rng: &mut Core) -> f64 {
         loop {
             let i = (bits as usize) & (LAYERS - 1);
             if i == 0 {
@@ -229,6 +241,8 @@ impl Ziggurat {
 pub struct LaneStreams {
     s: [[u64; LANES]; 4],
     buf: [Lanes; BLOCK],
+    /// The generators' outputs of the last refill, kept for the draws outside the fast path.
+    bits: [[u64; LANES]; BLOCK],
     pos: usize,
 }
 
@@ -239,14 +253,28 @@ impl LaneStreams {
         for k in 0..LANES {
             let one = Stream::new(key, first + k as u64);
             for (w, row) in s.iter_mut().enumerate() {
-                row[k] = one.s[w];
+                row[k] = one.core.0[w];
             }
         }
         Self {
             s,
             buf: [Lanes::default(); BLOCK],
+            bits: [[0; LANES]; BLOCK],
             pos: BLOCK,
         }
+    }
+
+    /// The next normal numbers of every lane, at most `max` of them and at least one: a run of
+    /// [`Self::normal`]'s results, handed over at once.
+    #[inline(always)]
+    pub fn normals(&mut self, max: usize) -> &[Lanes] {
+        if self.pos == BLOCK {
+            refill(self);
+        }
+        let start = self.pos;
+        let end = (start + max).min(BLOCK);
+        self.pos = end;
+        &self.buf[start..end]
     }
 
     /// The next standard normal number of every lane, each the number its scalar stream draws.
@@ -265,7 +293,6 @@ impl LaneStreams {
 fn refill_lanes(r: &mut LaneStreams) {
     let z = ziggurat();
     let [mut s0, mut s1, mut s2, mut s3] = r.s;
-    let mut bits = [[0u64; LANES]; BLOCK];
     // Bit t of fail[k]: lane k's draw t fell outside the fast path.
     let mut fail = [0u64; LANES];
     for t in 0..BLOCK {
@@ -280,7 +307,7 @@ fn refill_lanes(r: &mut LaneStreams) {
             s0[k] ^= s3[k];
             s2[k] ^= u;
             s3[k] = s3[k].rotate_left(45);
-            bits[t][k] = out;
+            r.bits[t][k] = out;
             let (x, ok) = z.fast(out);
             r.buf[t].0[k] = x;
             fail[k] |= u64::from(!ok) << t;
@@ -289,7 +316,7 @@ fn refill_lanes(r: &mut LaneStreams) {
     r.s = [s0, s1, s2, s3];
     r.pos = 0;
     if fail.iter().fold(0, |a, &f| a | f) != 0 {
-        finish(r, &bits, &fail);
+        finish(r, &fail);
     }
 }
 
@@ -301,21 +328,21 @@ crate::lanes::vectorized! {
 /// scalar code.
 #[cold]
 #[inline(never)]
-fn finish(r: &mut LaneStreams, bits: &[[u64; LANES]; BLOCK], fail: &[u64; LANES]) {
+fn finish(r: &mut LaneStreams, fail: &[u64; LANES]) {
     let z = ziggurat();
     for k in 0..LANES {
-        if fail[k] == 0 {
+        let mut left = fail[k];
+        if left == 0 {
             continue;
         }
-        let mut one = Stream::new(0, 0);
-        one.s = std::array::from_fn(|w| r.s[w][k]);
-        for t in 0..BLOCK {
-            if fail[k] >> t & 1 == 1 {
-                r.buf[t].0[k] = z.slow(bits[t][k], r.buf[t].0[k], &mut one);
-            }
+        let mut one = Core(std::array::from_fn(|w| r.s[w][k]));
+        while left != 0 {
+            let t = left.trailing_zeros() as usize;
+            left &= left - 1;
+            r.buf[t].0[k] = z.slow(r.bits[t][k], r.buf[t].0[k], &mut one);
         }
         for w in 0..4 {
-            r.s[w][k] = one.s[w];
+            r.s[w][k] = one.0[w];
         }
     }
 }
@@ -344,7 +371,7 @@ mod tests {
     fn xoshiro_matches_the_reference_output() {
         // xoshiro256++ from state (1, 2, 3, 4): the reference implementation's first outputs.
         let mut r = Stream::new(0, 0);
-        r.s = [1, 2, 3, 4];
+        r.core = Core([1, 2, 3, 4]);
         let first: Vec<u64> = (0..3).map(|_| r.next_u64()).collect();
         assert_eq!(first, [41943041, 58720359, 3588806011781223]);
     }

@@ -5,7 +5,7 @@ use super::epoch::{self, EpochGroup, EpochPlan};
 use super::kernel::{LaneGroup, SampleGroup};
 use super::lane_sums::LaneSums;
 use super::layout::ResidualLayout;
-use super::sums::Accumulator;
+use super::sums::{Accumulator, PANEL};
 use crate::config::TruthModel;
 use crate::filter::FilterSchedule;
 use crate::lanes::LANES;
@@ -93,8 +93,8 @@ crate::lanes::vectorized! {
     /// `prepared`; `rows` is scratch space. The realizations go in lane groups of [`LANES`]
     /// consecutive indices from `range.start`, all advanced fix by fix: at each fix every lane
     /// adds its realization into its own sums, and the lanes are added up in lane order when
-    /// every group has passed the fix. The residuals of the chunk are added in one pass, a batch
-    /// of [`LANES`] realizations after another.
+    /// every group has passed the fix. The residual products of the chunk are summed in one
+    /// pass over its stacked residuals.
     pub fn accumulate_into(
         prepared: &Prepared,
         model: &Model,
@@ -173,20 +173,30 @@ fn sum_groups<G: LaneGroup>(
 ) {
     let m = 2 * schedule.fixes.len();
     acc.clear_but_products();
-    // Every entry is written below: the rows need no clearing between chunks.
-    rows.resize(groups.len() * LANES * m, 0.0);
+    let count = groups.len() * LANES;
+    let width = PANEL * count;
+    // Every entry is written below but the padding beyond component m − 1, zeroed here.
+    rows.resize(m.div_ceil(PANEL) * width, 0.0);
+    if !m.is_multiple_of(PANEL) {
+        let last = &mut rows[(m / PANEL) * width..];
+        for q in 0..count {
+            last[q * PANEL + m % PANEL..(q + 1) * PANEL].fill(0.0);
+        }
+    }
     let mut lanes = LaneSums::new(schedule);
     for (i, fix) in schedule.fixes.iter().enumerate() {
         for (g, group) in groups.iter_mut().enumerate() {
             let f = group.next_fix(i, fix);
             lanes.add(i, &f);
-            for k in 0..LANES {
-                let row = (g * LANES + k) * m;
-                rows[row + 2 * i] = f.residual[0].0[k];
-                rows[row + 2 * i + 1] = f.residual[1].0[k];
+            // Components 2i and 2i + 1 of realization q = g·LANES + k, in panel layout.
+            for (c, r) in [2 * i, 2 * i + 1].into_iter().zip(&f.residual) {
+                let base = (c / PANEL) * width + g * LANES * PANEL + c % PANEL;
+                for k in 0..LANES {
+                    rows[base + k * PANEL] = r.0[k];
+                }
             }
         }
         lanes.finish_fix(&mut acc.fixes[i]);
     }
-    acc.set_residual_rows(rows);
+    acc.set_residual_products(rows, count);
 }

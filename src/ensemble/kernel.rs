@@ -1,4 +1,4 @@
-//! The per-sample engine on lane groups: [`LANES`] consecutive realizations simulated side by side,
+//! The per-sample engine on lane groups: [`LANES`](crate::lanes::LANES) consecutive realizations simulated side by side,
 //! each with its own random stream, performing exactly the operations of
 //! [`crate::simulation::run_realization`] in the same order, so that every lane reproduces its
 //! realization bit for bit (tested).
@@ -6,7 +6,7 @@
 use super::lane_sums::LaneFix;
 use crate::config::TruthModel;
 use crate::filter::{FilterSchedule, FixCovariance};
-use crate::lanes::{LANES, Lanes, Real};
+use crate::lanes::{Lanes, Real};
 use crate::model::Model;
 use crate::random::LaneStreams;
 
@@ -82,15 +82,22 @@ impl<const EULER: bool> LaneGroup for SampleGroup<'_, EULER> {
         let b = self.b;
         let jf = tl.fix_steps[i];
         let [mut pc, mut vc, mut pe, mut ve] = self.state;
-        for &a in &model.accel_m_s2[self.j..jf] {
-            // eq. (2), then eq. (3); eq. (4) for the Euler truth.
-            let ac = (s(a) + b) + w_sigma * self.rng.normal();
-            pc += vc * s(dt) + ac * s(half_dt2);
-            vc += ac * s(dt);
-            if EULER {
-                pe += ve * s(dt) + s(a * half_dt2);
-                ve += s(a * dt);
+        let mut j = self.j;
+        while j < jf {
+            // The interval's noises in runs of the generator's buffer: the same numbers, in the
+            // same order, as one `normal()` per sample.
+            let w = self.rng.normals(jf - j);
+            for (&a, &w) in model.accel_m_s2[j..].iter().zip(w) {
+                // eq. (2), then eq. (3); eq. (4) for the Euler truth.
+                let ac = (s(a) + b) + w_sigma * w;
+                pc += vc * s(dt) + ac * s(half_dt2);
+                vc += ac * s(dt);
+                if EULER {
+                    pe += ve * s(dt) + s(a * half_dt2);
+                    ve += s(a * dt);
+                }
             }
+            j += w.len();
         }
         self.state = [pc, vc, pe, ve];
         self.j = jf;
@@ -180,5 +187,3 @@ crate::lanes::vectorized! {
         active: usize,
     ) -> f64 => bare_group_lanes
 }
-
-const _: () = assert!(LANES == super::sums::BATCH);

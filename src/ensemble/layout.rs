@@ -62,6 +62,12 @@ impl ResidualLayout {
         self.len() == 0
     }
 
+    /// Where row a's first kept column is stored.
+    #[inline]
+    pub fn row_start(&self, a: usize) -> usize {
+        self.row_start[a]
+    }
+
     /// Where the product of components a and b is stored, if it is.
     #[inline]
     pub fn index(&self, a: usize, b: usize) -> Option<usize> {
