@@ -369,34 +369,38 @@ fn sensitivity_refuses_bad_parameters_and_factors() {
     sensitivity_refuses(&["--draws", "1000001"], "--draws");
 }
 
-#[test]
-fn sensitivity_writes_the_cases_of_the_data_contract() {
+/// Runs `sensitivity` on a 2 s run of 200 realizations with `extra` arguments and returns its JSON.
+fn sensitivity_doc(extra: &[&str]) -> serde_json::Value {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(
         dir.path().join("c.toml"),
         "[profile]\nduration_s = 2.0\n[ensemble]\nrealizations = 200\n",
     )
     .unwrap();
-    let o = run(
-        &[
-            "sensitivity",
-            "--config",
-            "c.toml",
-            "--parameters",
-            "accel_noise_var_m2_s4,bias_var_m2_s4",
-            "--factors",
-            "0.5,2",
-            "--ensembles",
-            "2",
-            "--json",
-            "s.json",
-            "--quiet",
-        ],
-        dir.path(),
-    );
+    let mut args = vec![
+        "sensitivity",
+        "--config",
+        "c.toml",
+        "--json",
+        "s.json",
+        "--quiet",
+    ];
+    args.extend_from_slice(extra);
+    let o = run(&args, dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
-    let doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.json")).unwrap()).unwrap();
+    serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn sensitivity_writes_the_cases_of_the_data_contract() {
+    let doc = sensitivity_doc(&[
+        "--parameters",
+        "accel_noise_var_m2_s4,bias_var_m2_s4",
+        "--factors",
+        "0.5,2",
+        "--ensembles",
+        "2",
+    ]);
     let cases = doc["cases"].as_array().unwrap();
     assert_eq!(cases.len(), 4);
     for c in cases {
@@ -425,34 +429,16 @@ fn sensitivity_writes_the_cases_of_the_data_contract() {
 
 #[test]
 fn sensitivity_without_ensembles_writes_null_measurements() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("c.toml"),
-        "[profile]\nduration_s = 2.0\n[ensemble]\nrealizations = 200\n",
-    )
-    .unwrap();
-    let o = run(
-        &[
-            "sensitivity",
-            "--config",
-            "c.toml",
-            "--parameters",
-            "gps_position_sigma_m",
-            "--factors",
-            "0.5",
-            "--ensembles",
-            "0",
-            "--draws",
-            "50",
-            "--json",
-            "s.json",
-            "--quiet",
-        ],
-        dir.path(),
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
-    let doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.json")).unwrap()).unwrap();
+    let doc = sensitivity_doc(&[
+        "--parameters",
+        "gps_position_sigma_m",
+        "--factors",
+        "0.5",
+        "--ensembles",
+        "0",
+        "--draws",
+        "50",
+    ]);
     let c = &doc["cases"][0];
     assert!(c["monte_carlo"]["detected"].is_null(), "{c}");
     assert_eq!(c["monte_carlo"]["ensembles"], 0);

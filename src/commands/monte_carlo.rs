@@ -5,7 +5,7 @@ use std::path::Path;
 
 use super::{Bar, load_model, verdict_lines, write};
 use crate::cli::{CaseArgs, EnsembleArgs, MergeArgs, ReportArgs, SensitivityArgs};
-use accelcal::config::Config;
+use accelcal::config::{Config, SensitivityConfig};
 use accelcal::ensemble::{self, EnsembleRun, EnsembleStats, Partition, partial};
 use accelcal::error::ConfigError;
 use accelcal::filter::FilterSchedule;
@@ -100,27 +100,15 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
 
 /// The sensitivity plan of `args` on `config`, or the option that is out of range.
 fn sensitivity_plan(args: &SensitivityArgs, config: &Config) -> Result<Plan, ConfigError> {
-    let factors = args
-        .factors
-        .clone()
-        .unwrap_or_else(|| config.sensitivity.factors.clone());
-    if factors.is_empty() {
-        return Err(ConfigError::invalid(
-            "--factors",
-            "(empty)",
-            "must list at least one factor",
-        ));
-    }
-    if let Some(f) = factors
-        .iter()
-        .find(|f| !(f.is_finite() && **f > 0.0 && **f <= 1e3))
-    {
-        return Err(ConfigError::invalid(
-            "--factors",
-            f,
-            "every factor must be a finite number in (0, 1000]",
-        ));
-    }
+    let sizes = SensitivityConfig {
+        factors: args
+            .factors
+            .clone()
+            .unwrap_or_else(|| config.sensitivity.factors.clone()),
+        ensembles: args.ensembles.unwrap_or(config.sensitivity.ensembles),
+        draws: args.draws.unwrap_or(config.sensitivity.draws),
+    };
+    sizes.check(["--factors", "--ensembles", "--draws"])?;
     let parameters = if args.parameters.is_empty() {
         AssumedStatistic::ALL.to_vec()
     } else {
@@ -140,28 +128,12 @@ fn sensitivity_plan(args: &SensitivityArgs, config: &Config) -> Result<Plan, Con
             })
             .collect::<Result<_, _>>()?
     };
-    let ensembles = args.ensembles.unwrap_or(config.sensitivity.ensembles);
-    if ensembles > 10_000 {
-        return Err(ConfigError::invalid(
-            "--ensembles",
-            ensembles,
-            "must be a whole number in [0, 10000]",
-        ));
-    }
-    let draws = args.draws.unwrap_or(config.sensitivity.draws);
-    if draws > 1_000_000 {
-        return Err(ConfigError::invalid(
-            "--draws",
-            draws,
-            "must be a whole number in [0, 1000000]",
-        ));
-    }
     Ok(Plan {
         parameters,
-        factors,
+        factors: sizes.factors,
         realizations: config.ensemble.realizations,
-        ensembles,
-        draws,
+        ensembles: sizes.ensembles,
+        draws: sizes.draws,
         engine: args.engine,
     })
 }

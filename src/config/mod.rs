@@ -5,6 +5,7 @@
 //! and names the offending field with its accepted range.
 
 mod case;
+mod sensitivity;
 mod source;
 
 use std::f64::consts::PI;
@@ -14,6 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{ConfigError, Position};
 pub use case::{AccelerometerOutput, Case, TruthModel};
+pub use sensitivity::SensitivityConfig;
 pub use source::ConfigText;
 
 /// Every parameter of the study.
@@ -208,28 +210,6 @@ impl Default for ChecksConfig {
             false_alarm_rate: 0.01,
             residual_pair_s: None,
             residual_max_lag: None,
-        }
-    }
-}
-
-/// The sensitivity study: each statistic the filter assumes, scaled.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SensitivityConfig {
-    /// Factors on the assumed standard deviations (a variance is scaled by the square).
-    pub factors: Vec<f64>,
-    /// Independent Monte Carlo ensembles of `ensemble.realizations` per statistic and factor.
-    pub ensembles: u64,
-    /// Sampled ensembles per statistic and factor that predict the detection probabilities.
-    pub draws: u64,
-}
-
-impl Default for SensitivityConfig {
-    fn default() -> Self {
-        Self {
-            factors: vec![0.25, 0.5, 2.0, 4.0],
-            ensembles: 1,
-            draws: 1000,
         }
     }
 }

@@ -4,7 +4,6 @@
 use super::epoch::{self, EpochGroup, EpochPlan};
 use super::kernel::{LaneGroup, SampleGroup};
 use super::lane_sums::LaneSums;
-use super::layout::ResidualLayout;
 use super::sums::{Accumulator, PANEL};
 use crate::config::TruthModel;
 use crate::filter::FilterSchedule;
@@ -115,10 +114,7 @@ pub fn accumulate_with(
     seed: u64,
     range: std::ops::Range<u64>,
 ) -> Accumulator {
-    let mut acc = Accumulator::new(
-        &ResidualLayout::new(model.timeline.fixes(), model.residual_max_lag()),
-        model.residual_pair,
-    );
+    let mut acc = Accumulator::new(&super::layout_of(model), model.residual_pair);
     accumulate_into(
         prepared,
         model,

@@ -96,31 +96,9 @@ impl Partition {
     }
 }
 
-/// Runs blocks `blocks` of the `n` realizations of `model` under `seed` in parallel, and hands
-/// each block's sums to `on_block` as it is finished, in block order. `progress` is called with
-/// the number of realizations of these blocks finished so far.
-pub fn run_blocks(
-    model: &Model,
-    schedule: &FilterSchedule,
-    seed: u64,
-    n: u64,
-    blocks: std::ops::Range<u64>,
-    progress: impl FnMut(u64),
-    on_block: impl FnMut(u64, Accumulator),
-) {
-    run_blocks_with(
-        Engine::Sample,
-        model,
-        schedule,
-        seed,
-        n,
-        blocks,
-        progress,
-        on_block,
-    );
-}
-
-/// [`run_blocks`] with the engine `engine`.
+/// Runs blocks `blocks` of the `n` realizations of `model` under `seed` in parallel with the
+/// engine `engine`, and hands each block's sums to `on_block` as it is finished, in block order.
+/// `progress` is called with the number of realizations of these blocks finished so far.
 #[allow(clippy::too_many_arguments)]
 pub fn run_blocks_with(
     engine: Engine,
@@ -138,7 +116,7 @@ pub fn run_blocks_with(
     );
 }
 
-/// [`run_blocks`] with the engine `prepared`.
+/// [`run_blocks_with`] with the engine `prepared`.
 #[allow(clippy::too_many_arguments)]
 pub fn run_blocks_prepared(
     prepared: &Prepared,

@@ -191,39 +191,11 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
         ));
     }
 
-    let sens = &c.sensitivity;
-    if sens.factors.is_empty() {
-        return Err(ConfigError::invalid(
-            "sensitivity.factors",
-            "[]",
-            "must list at least one factor",
-        ));
-    }
-    if let Some(f) = sens
-        .factors
-        .iter()
-        .find(|f| !(f.is_finite() && **f > 0.0 && **f <= 1e3))
-    {
-        return Err(ConfigError::invalid(
-            "sensitivity.factors",
-            show(*f),
-            "every factor must be a finite number in (0, 1000]",
-        ));
-    }
-    if sens.ensembles > 10_000 {
-        return Err(ConfigError::invalid(
-            "sensitivity.ensembles",
-            sens.ensembles,
-            "must be a whole number in [0, 10000]",
-        ));
-    }
-    if sens.draws > 1_000_000 {
-        return Err(ConfigError::invalid(
-            "sensitivity.draws",
-            sens.draws,
-            "must be a whole number in [0, 1000000]",
-        ));
-    }
+    c.sensitivity.check([
+        "sensitivity.factors",
+        "sensitivity.ensembles",
+        "sensitivity.draws",
+    ])?;
 
     let k = &c.checks;
     finite_in(

@@ -5,8 +5,8 @@ use plotters::style::{Color, RGBColor};
 
 use super::axis::{Axis, y_label_area};
 use super::geometry::{extent, time_span};
-use super::legend::{Entry, Swatch, draw_legend, legend_height};
-use super::panel::{Layout, Panel, columns, render, rows};
+use super::legend::{Entry, Swatch, render_state_rows};
+use super::panel::{Layout, Panel, columns};
 use super::{
     BLACK, BLUE, PlotResult, REDDISH_PURPLE, REFERENCE, VERMILLION, capitalized, state_name,
 };
@@ -58,25 +58,19 @@ fn per_state(
     let y_area_px = y_label_area(&axes.iter().collect::<Vec<_>>());
     let mut entries = legend(cases);
     entries.extend(extra_legend);
-    let legend_px = legend_height(&entries);
-    let last_row_px = ROW_PX + 24;
-    render(legend_px + 2 * ROW_PX + last_row_px + 6, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
-        draw_legend(&parts[0], &entries)?;
-        for k in 0..3 {
-            let p = Panel::new(
-                &parts[k + 1],
-                &title(k),
-                time.clone(),
-                axes[k].clone(),
-                Layout {
-                    y_area_px,
-                    x_title: k == 2,
-                    title: true,
-                },
-            )?;
-            draw(&p, k)?;
-        }
+    render_state_rows(ROW_PX, &entries, |area, k| {
+        let p = Panel::new(
+            area,
+            &title(k),
+            time.clone(),
+            axes[k].clone(),
+            Layout {
+                y_area_px,
+                x_title: k == 2,
+                title: true,
+            },
+        )?;
+        draw(&p, k)?;
         Ok(())
     })
 }
@@ -121,48 +115,42 @@ pub fn accuracy_ratio(cases: &[CaseSeries<'_>]) -> PlotResult {
         "1: the filter's claim",
     ));
     entries.push(Entry::new(Swatch::Line(REFERENCE.stroke_width(1)), "±5 %"));
-    let legend_px = legend_height(&entries);
-    let last_row_px = ROW_PX + 24;
-    render(legend_px + 2 * ROW_PX + last_row_px + 6, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
-        draw_legend(&parts[0], &entries)?;
-        for k in 0..3 {
-            let cols = columns(&parts[k + 1], &[FULL_COLUMN_PX]);
-            let name = capitalized(state_name(k));
-            for (col, axis, area, title) in [
-                (
-                    &cols[0],
-                    &full_axes[k],
-                    full_area,
-                    format!("{name}: achieved RMS error over the filter's σ"),
-                ),
-                (
-                    &cols[1],
-                    &near_axes[k],
-                    near_area,
-                    format!("{name}: around 1, enlarged"),
-                ),
-            ] {
-                let p = Panel::new(
-                    col,
-                    &title,
-                    time.clone(),
-                    axis.clone(),
-                    Layout {
-                        y_area_px: area,
-                        x_title: k == 2,
-                        title: true,
-                    },
+    render_state_rows(ROW_PX, &entries, |area, k| {
+        let cols = columns(area, &[FULL_COLUMN_PX]);
+        let name = capitalized(state_name(k));
+        for (col, axis, area, title) in [
+            (
+                &cols[0],
+                &full_axes[k],
+                full_area,
+                format!("{name}: achieved RMS error over the filter's σ"),
+            ),
+            (
+                &cols[1],
+                &near_axes[k],
+                near_area,
+                format!("{name}: around 1, enlarged"),
+            ),
+        ] {
+            let p = Panel::new(
+                col,
+                &title,
+                time.clone(),
+                axis.clone(),
+                Layout {
+                    y_area_px: area,
+                    x_title: k == 2,
+                    title: true,
+                },
+            )?;
+            p.hline(1.0, BLACK.stroke_width(1))?;
+            p.hline(1.05, REFERENCE.stroke_width(1))?;
+            p.hline(0.95, REFERENCE.stroke_width(1))?;
+            for (j, c) in cases.iter().enumerate() {
+                p.line(
+                    (0..c.stats.fixes.len()).map(|i| (c.stats.fixes[i].time_s, ratio(c, i, k))),
+                    color(j).stroke_width(2),
                 )?;
-                p.hline(1.0, BLACK.stroke_width(1))?;
-                p.hline(1.05, REFERENCE.stroke_width(1))?;
-                p.hline(0.95, REFERENCE.stroke_width(1))?;
-                for (j, c) in cases.iter().enumerate() {
-                    p.line(
-                        (0..c.stats.fixes.len()).map(|i| (c.stats.fixes[i].time_s, ratio(c, i, k))),
-                        color(j).stroke_width(2),
-                    )?;
-                }
             }
         }
         Ok(())

@@ -4,8 +4,8 @@ use plotters::style::Color;
 
 use super::axis::{Axis, y_label_area};
 use super::geometry::{extent, padded, time_span};
-use super::legend::{Entry, Swatch, draw_legend, legend_height};
-use super::panel::{Layout, Panel, columns, render, rows};
+use super::legend::{Entry, Swatch, render_state_rows};
+use super::panel::{Layout, Panel, columns};
 use super::{
     BLACK, BLUE, ORANGE, PlotResult, REFERENCE, SKY_BLUE, VERMILLION, WIDTH_PX, capitalized,
     state_name, state_unit,
@@ -83,67 +83,60 @@ pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
             ),
         ),
     ];
-    let legend_px = legend_height(&legend);
-    let last_row_px = ROW_PX + 24;
-
-    render(legend_px + 2 * ROW_PX + last_row_px + 6, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
-        draw_legend(&parts[0], &legend)?;
-        for k in 0..3 {
-            let cols = columns(&parts[k + 1], &[WIDTH_PX / 2]);
-            let layout = |y_area_px| Layout {
-                y_area_px,
-                x_title: k == 2,
-                title: true,
+    render_state_rows(ROW_PX, &legend, |area, k| {
+        let cols = columns(area, &[WIDTH_PX / 2]);
+        let layout = |y_area_px| Layout {
+            y_area_px,
+            x_title: k == 2,
+            title: true,
+        };
+        let name = state_name(k);
+        let p = Panel::new(
+            &cols[0],
+            &format!("{}: ensemble and filter variance", capitalized(name)),
+            time.clone(),
+            var_axes[k].clone(),
+            layout(var_area),
+        )?;
+        for (stage, wide, thin) in [
+            (false, ORANGE.mix(0.5), VERMILLION.mix(1.0)),
+            (true, SKY_BLUE.mix(0.6), BLUE.mix(1.0)),
+        ] {
+            let pick = |f: &FixStats| {
+                if stage {
+                    var(&f.post, k)
+                } else {
+                    var(&f.prior, k)
+                }
             };
-            let name = state_name(k);
-            let p = Panel::new(
-                &cols[0],
-                &format!("{}: ensemble and filter variance", capitalized(name)),
-                time.clone(),
-                var_axes[k].clone(),
-                layout(var_area),
+            p.line(
+                fixes.iter().map(|f| (f.time_s, pick(f).1)),
+                wide.stroke_width(5),
             )?;
-            for (stage, wide, thin) in [
-                (false, ORANGE.mix(0.5), VERMILLION.mix(1.0)),
-                (true, SKY_BLUE.mix(0.6), BLUE.mix(1.0)),
-            ] {
-                let pick = |f: &FixStats| {
-                    if stage {
-                        var(&f.post, k)
-                    } else {
-                        var(&f.prior, k)
-                    }
-                };
-                p.line(
-                    fixes.iter().map(|f| (f.time_s, pick(f).1)),
-                    wide.stroke_width(5),
-                )?;
-                p.line(
-                    fixes.iter().map(|f| (f.time_s, pick(f).0)),
-                    thin.stroke_width(1),
-                )?;
-            }
-
-            let q = Panel::new(
-                &cols[1],
-                &format!("{}: variance ratio P^{{ave}} / P", capitalized(name)),
-                time.clone(),
-                ratio_axes[k].clone(),
-                layout(ratio_area),
-            )?;
-            q.hline(1.0, REFERENCE.stroke_width(1))?;
-            q.hline(check.lower, BLACK.stroke_width(1))?;
-            q.hline(check.upper, BLACK.stroke_width(1))?;
-            q.line(
-                fixes.iter().map(|f| (f.time_s, ratio(&f.prior, k))),
-                VERMILLION.stroke_width(2),
-            )?;
-            q.line(
-                fixes.iter().map(|f| (f.time_s, ratio(&f.post, k))),
-                BLUE.stroke_width(2),
+            p.line(
+                fixes.iter().map(|f| (f.time_s, pick(f).0)),
+                thin.stroke_width(1),
             )?;
         }
+
+        let q = Panel::new(
+            &cols[1],
+            &format!("{}: variance ratio P^{{ave}} / P", capitalized(name)),
+            time.clone(),
+            ratio_axes[k].clone(),
+            layout(ratio_area),
+        )?;
+        q.hline(1.0, REFERENCE.stroke_width(1))?;
+        q.hline(check.lower, BLACK.stroke_width(1))?;
+        q.hline(check.upper, BLACK.stroke_width(1))?;
+        q.line(
+            fixes.iter().map(|f| (f.time_s, ratio(&f.prior, k))),
+            VERMILLION.stroke_width(2),
+        )?;
+        q.line(
+            fixes.iter().map(|f| (f.time_s, ratio(&f.post, k))),
+            BLUE.stroke_width(2),
+        )?;
         Ok(())
     })
 }

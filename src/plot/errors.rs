@@ -4,8 +4,8 @@ use plotters::style::Color;
 
 use super::axis::{Axis, y_label_area};
 use super::geometry::{before, clipped_until, extent, max_abs, padded, settled_from, time_span};
-use super::legend::{Entry, Swatch, draw_legend, legend_height};
-use super::panel::{Layout, Panel, columns, render, rows};
+use super::legend::{Entry, Swatch, render_state_rows};
+use super::panel::{Layout, Panel, columns};
 use super::{BLACK, BLUE, ORANGE, PlotResult, REFERENCE, capitalized, state_name, state_unit};
 use crate::realization::Realization;
 
@@ -55,66 +55,58 @@ pub fn realization_errors(r: &Realization) -> PlotResult {
         Entry::new(Swatch::Marker(BLACK.stroke_width(2)), "σ before GPS update"),
         Entry::new(Swatch::Marker(BLACK.filled()), "σ after update"),
     ];
-    let legend_px = legend_height(&legend);
-    let last_row_px = ROW_PX + 24;
-    let height = legend_px + 2 * ROW_PX + last_row_px + 6;
+    render_state_rows(ROW_PX, &legend, |area, k| {
+        let last = k == 2;
+        let cols = columns(area, &[FULL_COLUMN_PX]);
+        let name = state_name(k);
 
-    render(height, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
-        draw_legend(&parts[0], &legend)?;
-        for k in 0..3 {
-            let last = k == 2;
-            let cols = columns(&parts[k + 1], &[FULL_COLUMN_PX]);
-            let name = state_name(k);
-
-            let full = Panel::new(
-                &cols[0],
-                &full_run_title(r, k, &error_axes[k]),
-                time.clone(),
-                error_axes[k].clone(),
-                full_layout(last),
-            )?;
-            let sigma: Vec<f64> = r.samples.iter().map(|s| s.sigma[k]).collect();
-            let lower: Vec<f64> = sigma.iter().map(|s| -s).collect();
-            full.band(&t, &lower, &sigma, ORANGE.mix(0.35))?;
-            full.hline(0.0, REFERENCE.stroke_width(1))?;
-            full.line(
-                r.samples
-                    .iter()
-                    .map(|s| (s.t_s, s.delta_x[k] - s.estimate[k])),
-                BLUE.stroke_width(1),
-            )?;
-
-            let detail = Panel::new(
-                &cols[1],
-                &format!(
-                    "{} σ between fixes, {}–{} s",
-                    capitalized(name),
-                    zoom.0,
-                    zoom.1
-                ),
-                zoom_time.clone(),
-                sigma_axes[k].clone(),
-                zoom_layout(last),
-            )?;
-            detail.line(
-                r.samples
-                    .iter()
-                    .filter(|s| s.t_s >= zoom.0 && s.t_s <= zoom.1)
-                    .map(|s| (s.t_s, s.sigma[k])),
-                ORANGE.stroke_width(2),
-            )?;
-            let fixes = r
-                .fixes
+        let full = Panel::new(
+            &cols[0],
+            &full_run_title(r, k, &error_axes[k]),
+            time.clone(),
+            error_axes[k].clone(),
+            full_layout(last),
+        )?;
+        let sigma: Vec<f64> = r.samples.iter().map(|s| s.sigma[k]).collect();
+        let lower: Vec<f64> = sigma.iter().map(|s| -s).collect();
+        full.band(&t, &lower, &sigma, ORANGE.mix(0.35))?;
+        full.hline(0.0, REFERENCE.stroke_width(1))?;
+        full.line(
+            r.samples
                 .iter()
-                .filter(|f| f.t_s >= zoom.0 && f.t_s <= zoom.1);
-            detail.dots(
-                fixes.clone().map(|f| (f.t_s, f.sigma_prior[k])),
-                4,
-                BLACK.stroke_width(2),
-            )?;
-            detail.dots(fixes.map(|f| (f.t_s, f.sigma_post[k])), 4, BLACK.filled())?;
-        }
+                .map(|s| (s.t_s, s.delta_x[k] - s.estimate[k])),
+            BLUE.stroke_width(1),
+        )?;
+
+        let detail = Panel::new(
+            &cols[1],
+            &format!(
+                "{} σ between fixes, {}–{} s",
+                capitalized(name),
+                zoom.0,
+                zoom.1
+            ),
+            zoom_time.clone(),
+            sigma_axes[k].clone(),
+            zoom_layout(last),
+        )?;
+        detail.line(
+            r.samples
+                .iter()
+                .filter(|s| s.t_s >= zoom.0 && s.t_s <= zoom.1)
+                .map(|s| (s.t_s, s.sigma[k])),
+            ORANGE.stroke_width(2),
+        )?;
+        let fixes = r
+            .fixes
+            .iter()
+            .filter(|f| f.t_s >= zoom.0 && f.t_s <= zoom.1);
+        detail.dots(
+            fixes.clone().map(|f| (f.t_s, f.sigma_prior[k])),
+            4,
+            BLACK.stroke_width(2),
+        )?;
+        detail.dots(fixes.map(|f| (f.t_s, f.sigma_post[k])), 4, BLACK.filled())?;
         Ok(())
     })
 }

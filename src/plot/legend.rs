@@ -4,8 +4,8 @@
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::panel::Area;
-use super::{LEGEND_PX, PlotError, WIDTH_PX};
+use super::panel::{Area, render, rows};
+use super::{LEGEND_PX, PlotError, PlotResult, WIDTH_PX};
 use super::{font, text_width};
 
 /// Height of one legend row, px.
@@ -106,4 +106,24 @@ fn draw_swatch(area: &Area<'_>, swatch: Swatch, x: i32, y: i32) -> Result<(), Pl
         }
     }
     Ok(())
+}
+
+/// A figure of the legend `legend` over one row per state (position, velocity, bias), each
+/// `row_px` high but the last, which is taller to hold the time axis's title; `draw` fills row
+/// k's area.
+pub(crate) fn render_state_rows(
+    row_px: u32,
+    legend: &[Entry],
+    mut draw: impl FnMut(&Area<'_>, usize) -> Result<(), PlotError>,
+) -> PlotResult {
+    let legend_px = legend_height(legend);
+    let last_row_px = row_px + 24;
+    render(legend_px + 2 * row_px + last_row_px + 6, |root| {
+        let parts = rows(root, &[legend_px, row_px, row_px, last_row_px]);
+        draw_legend(&parts[0], legend)?;
+        for (k, area) in parts[1..4].iter().enumerate() {
+            draw(area, k)?;
+        }
+        Ok(())
+    })
 }

@@ -4,8 +4,8 @@ use plotters::style::Color;
 
 use super::axis::{Axis, y_label_area};
 use super::geometry::{max_abs, settled_from, time_span};
-use super::legend::{Entry, Swatch, draw_legend, legend_height};
-use super::panel::{Layout, Panel, columns, render, rows};
+use super::legend::{Entry, Swatch, render_state_rows};
+use super::panel::{Layout, Panel, columns};
 use super::{
     BLACK, BLUE, ORANGE, PlotError, PlotResult, REFERENCE, capitalized, state_name, state_unit,
 };
@@ -80,40 +80,33 @@ pub fn mean_error(stats: &EnsembleStats, check: &Check, predicted: &[[[f64; 3]; 
             "predicted, a priori",
         ),
     ];
-    let legend_px = legend_height(&legend);
-    let last_row_px = ROW_PX + 24;
-
-    render(legend_px + 2 * ROW_PX + last_row_px + 6, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
-        draw_legend(&parts[0], &legend)?;
-        for k in 0..3 {
-            let cols = columns(&parts[k + 1], &[FULL_COLUMN_PX]);
-            let name = capitalized(state_name(k));
-            let layout = |y_area_px| Layout {
-                y_area_px,
-                x_title: k == 2,
-                title: true,
-            };
-            let full = Panel::new(
-                &cols[0],
-                &format!(
-                    "{name}: ensemble mean error, N = {}",
-                    crate::format::count(stats.realizations)
-                ),
-                full_time.clone(),
-                full_axes[k].clone(),
-                layout(full_area),
-            )?;
-            draw(&full, fixes, predicted, k, &band)?;
-            let late = Panel::new(
-                &cols[1],
-                &format!("{name}: second half, enlarged"),
-                half_time.clone(),
-                half_axes[k].clone(),
-                layout(half_area),
-            )?;
-            draw(&late, fixes, predicted, k, &band)?;
-        }
+    render_state_rows(ROW_PX, &legend, |area, k| {
+        let cols = columns(area, &[FULL_COLUMN_PX]);
+        let name = capitalized(state_name(k));
+        let layout = |y_area_px| Layout {
+            y_area_px,
+            x_title: k == 2,
+            title: true,
+        };
+        let full = Panel::new(
+            &cols[0],
+            &format!(
+                "{name}: ensemble mean error, N = {}",
+                crate::format::count(stats.realizations)
+            ),
+            full_time.clone(),
+            full_axes[k].clone(),
+            layout(full_area),
+        )?;
+        draw(&full, fixes, predicted, k, &band)?;
+        let late = Panel::new(
+            &cols[1],
+            &format!("{name}: second half, enlarged"),
+            half_time.clone(),
+            half_axes[k].clone(),
+            layout(half_area),
+        )?;
+        draw(&late, fixes, predicted, k, &band)?;
         Ok(())
     })
 }

@@ -4,8 +4,8 @@ use plotters::style::Color;
 
 use super::axis::{Axis, y_label_area};
 use super::geometry::{max_abs, time_span};
-use super::legend::{Entry, Swatch, draw_legend, legend_height};
-use super::panel::{Layout, Panel, columns, render, rows};
+use super::legend::{Entry, Swatch, render_state_rows};
+use super::panel::{Layout, Panel, columns};
 use super::{
     BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotResult, REFERENCE, WIDTH_PX, capitalized, state_name,
 };
@@ -49,42 +49,35 @@ pub fn orthogonality(stats: &EnsembleStats, check: &Check) -> PlotResult {
         Swatch::Line(BLACK.stroke_width(1)),
         format!("±{:.2} bound", check.upper),
     ));
-    let legend_px = legend_height(&legend);
-    let last_row_px = ROW_PX + 24;
-
-    render(legend_px + 2 * ROW_PX + last_row_px + 6, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
-        draw_legend(&parts[0], &legend)?;
-        for j in 0..3 {
-            let cols = columns(&parts[j + 1], &[WIDTH_PX / 2]);
-            for (c, prior) in [(0, true), (1, false)] {
-                let p = Panel::new(
-                    &cols[c],
-                    &format!(
-                        "{} error vs the estimates, {}",
-                        capitalized(state_name(j)),
-                        if prior { "a priori" } else { "a posteriori" }
-                    ),
-                    time.clone(),
-                    y.clone(),
-                    Layout {
-                        y_area_px,
-                        x_title: j == 2,
-                        title: true,
-                    },
+    render_state_rows(ROW_PX, &legend, |area, j| {
+        let cols = columns(area, &[WIDTH_PX / 2]);
+        for (c, prior) in [(0, true), (1, false)] {
+            let p = Panel::new(
+                &cols[c],
+                &format!(
+                    "{} error vs the estimates, {}",
+                    capitalized(state_name(j)),
+                    if prior { "a priori" } else { "a posteriori" }
+                ),
+                time.clone(),
+                y.clone(),
+                Layout {
+                    y_area_px,
+                    x_title: j == 2,
+                    title: true,
+                },
+            )?;
+            p.hline(0.0, REFERENCE.stroke_width(1))?;
+            p.hline(check.upper, BLACK.stroke_width(1))?;
+            p.hline(-check.upper, BLACK.stroke_width(1))?;
+            for (k, color) in COLORS.iter().enumerate() {
+                p.line(
+                    fixes.iter().map(|f| {
+                        let s = if prior { &f.prior } else { &f.post };
+                        (f.time_s, z(s, j, k))
+                    }),
+                    color.stroke_width(1),
                 )?;
-                p.hline(0.0, REFERENCE.stroke_width(1))?;
-                p.hline(check.upper, BLACK.stroke_width(1))?;
-                p.hline(-check.upper, BLACK.stroke_width(1))?;
-                for (k, color) in COLORS.iter().enumerate() {
-                    p.line(
-                        fixes.iter().map(|f| {
-                            let s = if prior { &f.prior } else { &f.post };
-                            (f.time_s, z(s, j, k))
-                        }),
-                        color.stroke_width(1),
-                    )?;
-                }
             }
         }
         Ok(())

@@ -5,8 +5,8 @@ use plotters::style::{Color, RGBColor};
 
 use super::axis::{Axis, y_label_area};
 use super::geometry::extent;
-use super::legend::{Entry, Swatch, draw_legend, legend_height};
-use super::panel::{Layout, Panel, render, rows};
+use super::legend::{Entry, Swatch, render_state_rows};
+use super::panel::{Layout, Panel};
 use super::{
     BLACK, BLUE, BLUISH_GREEN, GREY, ORANGE, PlotResult, REDDISH_PURPLE, VERMILLION, capitalized,
     state_name,
@@ -67,35 +67,29 @@ pub fn sigma_ratio(series: &[SensitivitySeries]) -> PlotResult {
         Swatch::Line(GREY.stroke_width(1)),
         "1: the claim is right",
     ));
-    let legend_px = legend_height(&legend);
-    let last_row_px = ROW_PX + 24;
-    render(legend_px + 2 * ROW_PX + last_row_px + 6, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
-        draw_legend(&parts[0], &legend)?;
-        for k in 0..3 {
-            let p = Panel::new(
-                &parts[k + 1],
-                &format!(
-                    "{}: actual σ over claimed σ at the last fix",
-                    capitalized(state_name(k))
-                ),
-                x.clone(),
-                axes[k].clone(),
-                Layout {
-                    y_area_px,
-                    x_title: k == 2,
-                    title: true,
-                },
+    render_state_rows(ROW_PX, &legend, |area, k| {
+        let p = Panel::new(
+            area,
+            &format!(
+                "{}: actual σ over claimed σ at the last fix",
+                capitalized(state_name(k))
+            ),
+            x.clone(),
+            axes[k].clone(),
+            Layout {
+                y_area_px,
+                x_title: k == 2,
+                title: true,
+            },
+        )?;
+        p.hline(1.0, GREY.stroke_width(1))?;
+        for (i, s) in series.iter().enumerate() {
+            let color = COLORS[i % COLORS.len()];
+            p.line(
+                s.points.iter().map(|q| (q.0, q.1[k])),
+                color.stroke_width(2),
             )?;
-            p.hline(1.0, GREY.stroke_width(1))?;
-            for (i, s) in series.iter().enumerate() {
-                let color = COLORS[i % COLORS.len()];
-                p.line(
-                    s.points.iter().map(|q| (q.0, q.1[k])),
-                    color.stroke_width(2),
-                )?;
-                p.dots(s.points.iter().map(|q| (q.0, q.1[k])), 3, color.filled())?;
-            }
+            p.dots(s.points.iter().map(|q| (q.0, q.1[k])), 3, color.filled())?;
         }
         Ok(())
     })

@@ -375,6 +375,8 @@ pub fn run(
         progress.start("sensitivity", total);
         let mut done = 0;
         for case in &mut cases {
+            // Built again rather than kept from the first pass: one covariance pass, against
+            // memory that would grow with cases × fixes.
             let (model, schedule) = mistuned(&world, case.parameter, case.factor)?;
             let prepared = ensemble::Prepared::new(plan.engine, &model, &schedule);
             let mut failures = [0u64; 7];

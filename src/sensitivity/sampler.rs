@@ -94,7 +94,7 @@ impl Sampler {
                 f.fixed_view_mut::<3, 3>(0, 0).copy_from(&phi);
                 f.fixed_view_mut::<3, 3>(3, 3).copy_from(&phi);
                 let mut g = SMatrix::<f64, 6, 3>::zeros();
-                g.fixed_view_mut::<3, 3>(0, 0).copy_from(&root(&q));
+                g.fixed_view_mut::<3, 3>(0, 0).copy_from(&psd_cholesky(&q));
                 let k = fix.gain;
                 let kh = k * h;
                 let mut update = SMatrix::<f64, 6, 8>::zeros();
@@ -125,8 +125,8 @@ impl Sampler {
             .collect::<Vec<_>>();
         Self {
             realizations,
-            p0_root: root(&world.p0),
-            r_root: root(&world.r),
+            p0_root: psd_cholesky(&world.p0),
+            r_root: psd_cholesky(&world.r),
             layout: ResidualLayout::new(steps.len(), Some(0)),
             steps,
             pair,
@@ -322,11 +322,6 @@ fn psd_cholesky<const D: usize>(s: &SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
         }
     }
     l
-}
-
-/// A square root of a small covariance (zero rows and columns allowed).
-fn root<const D: usize>(s: &SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
-    psd_cholesky(s)
 }
 
 fn symmetric<const D: usize>(m: SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
