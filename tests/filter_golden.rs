@@ -5,32 +5,8 @@ mod common;
 
 use accelcal::config::Config;
 use approx::assert_relative_eq;
+use common::plain::{M3, mul, transpose};
 
-type M3 = [[f64; 3]; 3];
-
-fn mul(a: &M3, b: &M3) -> M3 {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            for k in 0..3 {
-                c[i][j] += a[i][k] * b[k][j];
-            }
-        }
-    }
-    c
-}
-
-fn transpose(a: &M3) -> M3 {
-    let mut t = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            t[i][j] = a[j][i];
-        }
-    }
-    t
-}
-
-/// (P⁻, P⁺) at every fix for the default problem: Δt = 5 ms, fixes every 40 samples.
 fn reference(fix_count: usize) -> Vec<(M3, M3)> {
     let dt: f64 = 0.005;
     let w = 0.0004;

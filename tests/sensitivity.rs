@@ -10,18 +10,10 @@ use accelcal::ensemble::{self, Engine, EnsembleStats};
 use accelcal::sensitivity::{self, AssumedStatistic, Plan, actual_covariance};
 use accelcal::stats::clopper_pearson;
 use accelcal::study::Silent;
+use common::plain::{M3, mul, transpose};
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
-type M3 = [[f64; 3]; 3];
 type M3x = accelcal::filter::Matrix3;
-
-fn mul(a: &M3, b: &M3) -> M3 {
-    std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
-}
-
-fn t(a: &M3) -> M3 {
-    std::array::from_fn(|i| std::array::from_fn(|j| a[j][i]))
-}
 
 fn add(a: &M3, b: &M3) -> M3 {
     std::array::from_fn(|i| std::array::from_fn(|j| a[i][j] + b[i][j]))
@@ -47,8 +39,8 @@ fn textbook(dt: f64, fix_every: usize, fixes: usize, assumed: [f64; 6], truth: [
     let (mut p, mut pa) = (p0(assumed), p0(truth));
     for _ in 0..fixes {
         for _ in 0..fix_every {
-            p = add(&mul(&mul(&phi, &p), &t(&phi)), &qf);
-            pa = add(&mul(&mul(&phi, &pa), &t(&phi)), &qt);
+            p = add(&mul(&mul(&phi, &p), &transpose(&phi)), &qf);
+            pa = add(&mul(&mul(&phi, &pa), &transpose(&phi)), &qt);
         }
         // S = H P Hᵀ + R with H = [I₂ 0]: the upper-left 2×2 block.
         let s = [
@@ -73,11 +65,11 @@ fn textbook(dt: f64, fix_every: usize, fixes: usize, assumed: [f64; 6], truth: [
             })
         };
         p = add(
-            &mul(&mul(&i_kh, &p), &t(&i_kh)),
+            &mul(&mul(&i_kh, &p), &transpose(&i_kh)),
             &krk([assumed[2].powi(2), assumed[3].powi(2)]),
         );
         pa = add(
-            &mul(&mul(&i_kh, &pa), &t(&i_kh)),
+            &mul(&mul(&i_kh, &pa), &transpose(&i_kh)),
             &krk([truth[2].powi(2), truth[3].powi(2)]),
         );
     }

@@ -1,6 +1,8 @@
 //! Shared helpers of the integration tests.
 #![allow(dead_code)]
 
+pub mod plain;
+
 use accelcal::checks::Verdicts;
 use accelcal::config::{Config, TruthModel};
 use accelcal::filter::FilterSchedule;

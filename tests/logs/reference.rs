@@ -6,7 +6,8 @@
 // Matrix formulas read best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
-pub type M3 = [[f64; 3]; 3];
+pub use super::common::plain::M3;
+use super::common::plain::{mul, transpose};
 /// An accelerometer log: (t, a_c).
 pub type AccelLog = Vec<(f64, f64)>;
 /// A GPS log: (t, z_p, z_v).
@@ -49,28 +50,6 @@ pub struct Processed {
     pub p: Vec<M3>,
     pub xs: Vec<[f64; 3]>,
     pub ps: Vec<M3>,
-}
-
-fn mul(a: &M3, b: &M3) -> M3 {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            for k in 0..3 {
-                c[i][j] += a[i][k] * b[k][j];
-            }
-        }
-    }
-    c
-}
-
-fn transpose(a: &M3) -> M3 {
-    let mut t = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            t[i][j] = a[j][i];
-        }
-    }
-    t
 }
 
 fn mul_v(a: &M3, v: &[f64; 3]) -> [f64; 3] {
