@@ -261,28 +261,35 @@ fn sigma(p: &crate::filter::Matrix3) -> [f64; 3] {
     std::array::from_fn(|k| p[(k, k)].sqrt())
 }
 
+/// The model and filter schedule of `config`, whose filter assumes `parameter` × `factor` (named
+/// in errors).
+fn filter_of(
+    config: &Config,
+    parameter: &'static str,
+    factor: f64,
+) -> Result<(Model, FilterSchedule), SensitivityError> {
+    let model = Model::new(config).map_err(|source| SensitivityError::Config {
+        parameter,
+        factor,
+        source,
+    })?;
+    let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats).map_err(|source| {
+        SensitivityError::Filter {
+            parameter,
+            factor,
+            source,
+        }
+    })?;
+    Ok((model, schedule))
+}
+
 /// The filter of `parameter` × `factor` in `world`, with its schedule.
 fn mistuned(
     world: &Config,
     parameter: AssumedStatistic,
     factor: f64,
 ) -> Result<(Model, FilterSchedule), SensitivityError> {
-    let name = parameter.name();
-    let model = Model::new(&parameter.scaled(world, factor)).map_err(|source| {
-        SensitivityError::Config {
-            parameter: name,
-            factor,
-            source,
-        }
-    })?;
-    let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats).map_err(|source| {
-        SensitivityError::Filter {
-            parameter: name,
-            factor,
-            source,
-        }
-    })?;
-    Ok((model, schedule))
+    filter_of(&parameter.scaled(world, factor), parameter.name(), factor)
 }
 
 /// Runs `plan` on `base` (its statistics are the truth's; its `[filter]` the starting point).
@@ -299,19 +306,7 @@ pub fn run(
 ) -> Result<Sensitivity, SensitivityError> {
     let world = world(base, plan.realizations);
     let budget = Budget::study(base.checks.false_alarm_rate);
-    let tuned = Model::new(&world).map_err(|source| SensitivityError::Config {
-        parameter: "configured",
-        factor: 1.0,
-        source,
-    })?;
-    let tuned_schedule =
-        FilterSchedule::new(&tuned.timeline, &tuned.filter_stats).map_err(|source| {
-            SensitivityError::Filter {
-                parameter: "configured",
-                factor: 1.0,
-                source,
-            }
-        })?;
+    let (_, tuned_schedule) = filter_of(&world, "configured", 1.0)?;
     let grid: Vec<(AssumedStatistic, f64)> = plan
         .parameters
         .iter()
