@@ -234,17 +234,21 @@ impl FixCovariance {
     #[inline(always)]
     pub fn step<T: Real>(&self, estimate: &[T; 3], dz: &[T; 2]) -> ([T; 3], [T; 3], [T; 2]) {
         let phi = &self.phi_from_previous;
-        let prior: [T; 3] = std::array::from_fn(|r| {
+        // Written out row by row (no closures), so that every operation is inlined into the
+        // vectorized callers.
+        let row = |r: usize| {
             T::splat(phi[(r, 0)]) * estimate[0]
                 + T::splat(phi[(r, 1)]) * estimate[1]
                 + T::splat(phi[(r, 2)]) * estimate[2]
-        });
+        };
+        let prior: [T; 3] = [row(0), row(1), row(2)];
         // H selects (δp, δv).
         let residual = [dz[0] - prior[0], dz[1] - prior[1]];
         let k = &self.gain;
-        let post = std::array::from_fn(|r| {
+        let gain = |r: usize| {
             prior[r] + (T::splat(k[(r, 0)]) * residual[0] + T::splat(k[(r, 1)]) * residual[1])
-        });
+        };
+        let post = [gain(0), gain(1), gain(2)];
         (prior, post, residual)
     }
 }

@@ -2,7 +2,7 @@
 //! nothing of terminals.
 
 /// Receives the progress of a long run. The command line draws a bar; tests pass [`Silent`].
-pub trait Progress {
+pub trait Progress: Send {
     /// A run of `total` realizations, called `label`, starts.
     fn start(&mut self, _label: &str, _total: u64) {}
     /// A run of `total` steps counted in `unit` (plural, e.g. "ensemble draws") starts.

@@ -1,10 +1,12 @@
 //! The engines and the sums of one chunk: its lane groups advanced fix by fix, their lane sums
 //! reduced per fix, its residual rows added to the packed triangle at the end.
 
+use super::CHUNK;
 use super::epoch::{self, EpochGroup, EpochPlan};
 use super::kernel::{LaneGroup, SampleGroup};
 use super::lane_sums::LaneSums;
-use super::sums::{Accumulator, PANEL};
+use super::sums::Accumulator;
+use super::tiles;
 use crate::config::TruthModel;
 use crate::filter::FilterSchedule;
 use crate::lanes::LANES;
@@ -87,13 +89,21 @@ pub fn accumulate(
     accumulate_with(&Prepared::Sample, model, schedule, seed, range)
 }
 
+/// Scratch space of [`accumulate_into`], reused from call to call: the residual-product tiles of
+/// the sums being made and the panels of a chunk's stacked residuals.
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    tiles: Vec<f64>,
+    panels: Vec<f64>,
+}
+
 crate::lanes::vectorized! {
     /// Sums realizations `range` of `model` into `acc` (emptied first) with the engine
-    /// `prepared`; `rows` is scratch space. The realizations go in lane groups of [`LANES`]
-    /// consecutive indices from `range.start`, all advanced fix by fix: at each fix every lane
-    /// adds its realization into its own sums, and the lanes are added up in lane order when
-    /// every group has passed the fix. The residual products of the chunk are summed in one
-    /// pass over its stacked residuals.
+    /// `prepared`, in chunks of [`CHUNK`] consecutive indices from `range.start`, in order.
+    /// A chunk's realizations go in lane groups of [`LANES`], all advanced fix by fix: at each
+    /// fix every lane adds its realization into its own sums, and the lanes are added up in lane
+    /// order, onto the sums so far, when every group has passed the fix. The chunk's residual
+    /// products are then added in one pass over its stacked residuals (see [`tiles`]).
     pub fn accumulate_into(
         prepared: &Prepared,
         model: &Model,
@@ -101,7 +111,7 @@ crate::lanes::vectorized! {
         seed: u64,
         range: std::ops::Range<u64>,
         acc: &mut Accumulator,
-        rows: &mut Vec<f64>,
+        scratch: &mut Scratch,
     ) -> () => accumulate_lanes
 }
 
@@ -122,7 +132,7 @@ pub fn accumulate_with(
         seed,
         range,
         &mut acc,
-        &mut Vec::new(),
+        &mut Scratch::default(),
     );
     acc
 }
@@ -135,64 +145,71 @@ fn accumulate_lanes(
     seed: u64,
     range: std::ops::Range<u64>,
     acc: &mut Accumulator,
-    rows: &mut Vec<f64>,
+    scratch: &mut Scratch,
 ) {
+    acc.clear_but_products();
+    scratch.tiles.clear();
+    scratch.tiles.resize(tiles::tiles_len(&acc.layout), 0.0);
     let key = stream_key(seed, model.case());
-    let groups = (range.start..range.end).step_by(LANES).map(|first| {
-        let active = (range.end - first).min(LANES as u64) as usize;
-        (first, active)
-    });
-    match (prepared, model.truth()) {
-        (Prepared::Sample, TruthModel::Euler) => {
-            let g = groups.map(|(f, a)| SampleGroup::<true>::new(model, key, f, a));
-            sum_groups(g.collect(), schedule, acc, rows);
-        }
-        (Prepared::Sample, TruthModel::Analytic) => {
-            let g = groups.map(|(f, a)| SampleGroup::<false>::new(model, key, f, a));
-            sum_groups(g.collect(), schedule, acc, rows);
-        }
-        (Prepared::Epoch(plan), _) => {
-            let key = epoch::epoch_key(key);
-            let g = groups.map(|(f, a)| EpochGroup::new(plan, model, key, f, a));
-            sum_groups(g.collect(), schedule, acc, rows);
+    for start in range.clone().step_by(CHUNK as usize) {
+        let chunk = start..(start + CHUNK).min(range.end);
+        let groups = chunk.clone().step_by(LANES).map(|first| {
+            let active = (chunk.end - first).min(LANES as u64) as usize;
+            (first, active)
+        });
+        match (prepared, model.truth()) {
+            (Prepared::Sample, TruthModel::Euler) => {
+                let g = groups.map(|(f, a)| SampleGroup::<true>::new(model, key, f, a));
+                sum_groups(g.collect(), schedule, acc, scratch);
+            }
+            (Prepared::Sample, TruthModel::Analytic) => {
+                let g = groups.map(|(f, a)| SampleGroup::<false>::new(model, key, f, a));
+                sum_groups(g.collect(), schedule, acc, scratch);
+            }
+            (Prepared::Epoch(plan), _) => {
+                let key = epoch::epoch_key(key);
+                let g = groups.map(|(f, a)| EpochGroup::new(plan, model, key, f, a));
+                sum_groups(g.collect(), schedule, acc, scratch);
+            }
         }
     }
     acc.count = range.end - range.start;
+    tiles::unpack(&acc.layout, &scratch.tiles, &mut acc.residual_products);
 }
 
+/// Adds one chunk, the lane groups `groups`, to `acc` and to the residual-product tiles.
 #[inline(always)]
 fn sum_groups<G: LaneGroup>(
     mut groups: Vec<G>,
     schedule: &FilterSchedule,
     acc: &mut Accumulator,
-    rows: &mut Vec<f64>,
+    scratch: &mut Scratch,
 ) {
     let m = 2 * schedule.fixes.len();
-    acc.clear_but_products();
     let count = groups.len() * LANES;
-    let width = PANEL * count;
+    let panels = &mut scratch.panels;
     // Every entry is written below but the padding beyond component m − 1, zeroed here.
-    rows.resize(m.div_ceil(PANEL) * width, 0.0);
-    if !m.is_multiple_of(PANEL) {
-        let last = &mut rows[(m / PANEL) * width..];
-        for q in 0..count {
-            last[q * PANEL + m % PANEL..(q + 1) * PANEL].fill(0.0);
-        }
-    }
+    panels.clear();
+    panels.resize(tiles::panels_len(m, count), 0.0);
     let mut lanes = LaneSums::new(schedule);
     for (i, fix) in schedule.fixes.iter().enumerate() {
         for (g, group) in groups.iter_mut().enumerate() {
             let f = group.next_fix(i, fix);
             lanes.add(i, &f);
-            // Components 2i and 2i + 1 of realization q = g·LANES + k, in panel layout.
             for (c, r) in [2 * i, 2 * i + 1].into_iter().zip(&f.residual) {
-                let base = (c / PANEL) * width + g * LANES * PANEL + c % PANEL;
                 for k in 0..LANES {
-                    rows[base + k * PANEL] = r.0[k];
+                    panels[tiles::panel_index(c, g * LANES + k, count)] = r.0[k];
                 }
             }
         }
         lanes.finish_fix(&mut acc.fixes[i]);
     }
-    acc.set_residual_products(rows, count);
+    let [pm, pi] = acc.pair;
+    for q in 0..count {
+        let at = |c: usize| panels[tiles::panel_index(c, q, count)];
+        for (c, p) in acc.pair_products.iter_mut().enumerate() {
+            *p += at(2 * pi + c / 2) * at(2 * pm + c % 2);
+        }
+    }
+    tiles::add_products(&acc.layout, &mut scratch.tiles, panels, count);
 }

@@ -42,7 +42,7 @@ impl LaneStage {
     /// triangle (off-diagonal terms doubled).
     #[inline(always)]
     fn add(&mut self, delta_x: &[Lanes; 3], x: &[Lanes; 3], w: &[f64; 6]) {
-        let e: [Lanes; 3] = std::array::from_fn(|k| delta_x[k] - x[k]);
+        let e = [delta_x[0] - x[0], delta_x[1] - x[1], delta_x[2] - x[2]];
         let mut nees = Lanes::default();
         for (s, (&(r, c), &wk)) in self.ee.iter_mut().zip(UPPER.iter().zip(w)) {
             let prod = e[r] * e[c];
@@ -60,18 +60,18 @@ impl LaneStage {
         }
     }
 
-    /// The lanes added up into `s`.
-    fn reduce(&self, s: &mut StageSums) {
+    /// Adds the lanes' totals, each summed in lane order, to `s`.
+    fn reduce_into(&self, s: &mut StageSums) {
         for k in 0..3 {
-            s.e[k] = self.e[k].sum();
-            s.x[k] = self.x[k].sum();
-            s.xx[k] = self.xx[k].sum();
+            s.e[k] += self.e[k].sum();
+            s.x[k] += self.x[k].sum();
+            s.xx[k] += self.xx[k].sum();
         }
         for k in 0..6 {
-            s.ee[k] = self.ee[k].sum();
+            s.ee[k] += self.ee[k].sum();
         }
-        s.ex = Matrix3::from_fn(|r, c| self.ex[3 * c + r].sum());
-        s.nees = self.nees.sum();
+        s.ex += Matrix3::from_fn(|r, c| self.ex[3 * c + r].sum());
+        s.nees += self.nees.sum();
     }
 }
 
@@ -134,13 +134,13 @@ impl LaneSums {
             + Lanes([w.s[2]; 8]) * r1 * r1;
     }
 
-    /// Writes the lanes' totals of the fix into `out` (replacing it) and starts the next fix.
+    /// Adds the lanes' totals of the fix to `out` and starts the next fix.
     #[inline(always)]
     pub fn finish_fix(&mut self, out: &mut FixSums) {
         let c = &self.current;
-        c.prior.reduce(&mut out.prior);
-        c.post.reduce(&mut out.post);
-        out.nis = c.nis.sum();
+        c.prior.reduce_into(&mut out.prior);
+        c.post.reduce_into(&mut out.post);
+        out.nis += c.nis.sum();
         self.current = LaneFixSums::default();
     }
 }

@@ -13,14 +13,13 @@ mod layout;
 pub mod partial;
 mod stats;
 mod sums;
+mod tiles;
 
 use std::time::Instant;
 
-use rayon::prelude::*;
-
 use crate::filter::FilterSchedule;
 use crate::model::Model;
-pub use engine::{Engine, Prepared, accumulate, accumulate_into, accumulate_with};
+pub use engine::{Engine, Prepared, Scratch, accumulate, accumulate_into, accumulate_with};
 pub use lane_sums::LaneFix;
 pub use layout::ResidualLayout;
 pub use stats::{EnsembleStats, FixStats, StageStats};
@@ -107,8 +106,8 @@ pub fn run_blocks_with(
     seed: u64,
     n: u64,
     blocks: std::ops::Range<u64>,
-    progress: impl FnMut(u64),
-    on_block: impl FnMut(u64, Accumulator),
+    progress: impl FnMut(u64) + Send,
+    on_block: impl FnMut(u64, Accumulator) + Send,
 ) {
     let prepared = Prepared::new(engine, model, schedule);
     run_blocks_prepared(
@@ -116,7 +115,23 @@ pub fn run_blocks_with(
     );
 }
 
+/// Finished blocks waiting for their turn, and the callbacks that take them in block order.
+struct Emitter<P, B> {
+    /// The next block to hand over.
+    next: u64,
+    waiting: std::collections::BTreeMap<u64, Accumulator>,
+    done: u64,
+    progress: P,
+    on_block: B,
+}
+
 /// [`run_blocks_with`] with the engine `prepared`.
+///
+/// Each block is summed by one thread, chunk after chunk (see [`accumulate_into`]): its sums
+/// depend on the block's realizations alone, never on the thread count. One worker per thread
+/// takes the next block as it finishes one; finished blocks are handed over in block order, and
+/// a worker waits rather than run more than a window of blocks ahead of the oldest unfinished
+/// one, so that at most about WINDOW_BYTES of sums are alive at once.
 #[allow(clippy::too_many_arguments)]
 pub fn run_blocks_prepared(
     prepared: &Prepared,
@@ -125,54 +140,76 @@ pub fn run_blocks_prepared(
     seed: u64,
     n: u64,
     blocks: std::ops::Range<u64>,
-    mut progress: impl FnMut(u64),
-    mut on_block: impl FnMut(u64, Accumulator),
+    progress: impl FnMut(u64) + Send,
+    on_block: impl FnMut(u64, Accumulator) + Send,
 ) {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    use std::sync::{Condvar, Mutex};
+
     let partition = Partition::new(n);
     let layout = layout_of(model);
-    // A window of chunks in flight at once; only its size depends on the thread count, never the
-    // chunk boundaries nor the merge order. At most WINDOW_BYTES of accumulators are alive.
-    let acc_bytes = 8 * (layout.len() + 51 * layout.fixes()).max(1) as u64;
+    let acc_bytes = 8 * (2 * layout.len() + 51 * layout.fixes()).max(1) as u64;
     let threads = rayon::current_num_threads() as u64;
-    let window = (4 * threads)
+    let window = (2 * threads)
         .min((WINDOW_BYTES / acc_bytes).max(threads))
         .max(1);
-    if blocks.is_empty() {
-        return;
-    }
-    let chunks =
-        partition.block_chunks(blocks.start).start..partition.block_chunks(blocks.end - 1).end;
-    let mut block = blocks.start;
-    let mut sums = Accumulator::new(&layout, model.residual_pair);
-    let mut done = 0;
-    let mut first = chunks.start;
-    // The chunk sums in flight and their scratch space, reused from window to window.
-    let mut slots: Vec<(Accumulator, Vec<f64>)> = Vec::new();
-    while first < chunks.end {
-        let last = (first + window).min(chunks.end);
-        slots.resize_with((last - first) as usize, || {
-            (Accumulator::new(&layout, model.residual_pair), Vec::new())
-        });
-        slots
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(k, (acc, rows))| {
-                let range = partition.chunk_realizations(first + k as u64);
-                accumulate_into(prepared, model, schedule, seed, range, acc, rows);
-            });
-        for (c, (part, _)) in (first..last).zip(&slots) {
-            sums.merge(part);
-            done += part.count;
-            if c + 1 == partition.block_chunks(block).end {
-                let finished =
-                    std::mem::replace(&mut sums, Accumulator::new(&layout, model.residual_pair));
-                on_block(block, finished);
-                block += 1;
+    let claimed = AtomicU64::new(blocks.start);
+    let emitter = Mutex::new(Emitter {
+        next: blocks.start,
+        waiting: Default::default(),
+        done: 0,
+        progress,
+        on_block,
+    });
+    let turn = Condvar::new();
+    let lock = || emitter.lock().unwrap_or_else(|e| e.into_inner());
+    let worker = || {
+        let mut scratch = Scratch::default();
+        loop {
+            let b = claimed.fetch_add(1, Ordering::Relaxed);
+            if b >= blocks.end {
+                return;
+            }
+            // Every block before b is claimed by a running worker, so the wait ends.
+            drop(
+                turn.wait_while(lock(), |e| b >= e.next + window)
+                    .unwrap_or_else(|e| e.into_inner()),
+            );
+            let chunks = partition.block_chunks(b);
+            let range = partition.chunk_realizations(chunks.start).start
+                ..partition.chunk_realizations(chunks.end - 1).end;
+            let mut acc = Accumulator::new(&layout, model.residual_pair);
+            accumulate_into(
+                prepared,
+                model,
+                schedule,
+                seed,
+                range,
+                &mut acc,
+                &mut scratch,
+            );
+            let mut e = lock();
+            e.waiting.insert(b, acc);
+            let mut advanced = false;
+            loop {
+                let next = e.next;
+                let Some(acc) = e.waiting.remove(&next) else {
+                    break;
+                };
+                e.done += acc.count;
+                (e.on_block)(next, acc);
+                e.next += 1;
+                advanced = true;
+            }
+            if advanced {
+                let done = e.done;
+                (e.progress)(done);
+                drop(e);
+                turn.notify_all();
             }
         }
-        progress(done);
-        first = last;
-    }
+    };
+    rayon::broadcast(|_| worker());
 }
 
 /// Runs `n` realizations of `model` under `seed` in parallel and returns their sums, the fold
@@ -183,7 +220,7 @@ pub fn run(
     schedule: &FilterSchedule,
     seed: u64,
     n: u64,
-    progress: impl FnMut(u64),
+    progress: impl FnMut(u64) + Send,
 ) -> Accumulator {
     run_with(Engine::Sample, model, schedule, seed, n, progress)
 }
@@ -195,7 +232,7 @@ pub fn run_with(
     schedule: &FilterSchedule,
     seed: u64,
     n: u64,
-    progress: impl FnMut(u64),
+    progress: impl FnMut(u64) + Send,
 ) -> Accumulator {
     let prepared = Prepared::new(engine, model, schedule);
     run_prepared(&prepared, model, schedule, seed, n, progress)
@@ -208,7 +245,7 @@ pub fn run_prepared(
     schedule: &FilterSchedule,
     seed: u64,
     n: u64,
-    progress: impl FnMut(u64),
+    progress: impl FnMut(u64) + Send,
 ) -> Accumulator {
     let mut total = Accumulator::new(&layout_of(model), model.residual_pair);
     run_blocks_prepared(
@@ -246,7 +283,7 @@ impl EnsembleRun {
 pub fn run_model(
     model: &Model,
     schedule: &FilterSchedule,
-    progress: impl FnMut(u64),
+    progress: impl FnMut(u64) + Send,
 ) -> EnsembleRun {
     run_model_with(Engine::Sample, model, schedule, progress)
 }
@@ -256,7 +293,7 @@ pub fn run_model_with(
     engine: Engine,
     model: &Model,
     schedule: &FilterSchedule,
-    progress: impl FnMut(u64),
+    progress: impl FnMut(u64) + Send,
 ) -> EnsembleRun {
     let e = &model.config.ensemble;
     let start = Instant::now();

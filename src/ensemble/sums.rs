@@ -117,80 +117,10 @@ impl Accumulator {
     }
 
     /// Empties the per-fix sums, the count and the pair products, keeping the layout and the
-    /// storage; the residual products are left as they are for
-    /// [`Self::set_residual_products`] to overwrite.
+    /// storage; the residual products are left for the engine to overwrite, every one of them.
     pub(super) fn clear_but_products(&mut self) {
         self.count = 0;
         self.fixes.fill(FixSums::default());
         self.pair_products = [0.0; 4];
     }
-
-    /// Sets the residual products to Σ_q ρ_q·ρ_qᵀ over the `count` stacked residual vectors ρ_q
-    /// held in `panels` (see [`PANEL`]; rows of inactive realizations are zero), and adds the
-    /// pair products. Each kept product is one sum over q in order, kept in a register: the
-    /// triangle goes in tiles of 4 rows × [`PANEL`] columns, each the product of a 4-row slice
-    /// and a column panel of the stacked residuals, so the large packed triangle is written once
-    /// per chunk and read never.
-    #[inline(always)]
-    pub(super) fn set_residual_products(&mut self, panels: &[f64], count: usize) {
-        let m = 2 * self.fixes.len();
-        let width = PANEL * count;
-        debug_assert_eq!(panels.len(), m.div_ceil(PANEL) * width);
-        let at = |c: usize, q: usize| panels[(c / PANEL) * width + q * PANEL + c % PANEL];
-        let [pm, pi] = self.pair;
-        for q in 0..count {
-            for (c, p) in self.pair_products.iter_mut().enumerate() {
-                *p += at(2 * pi + c / 2, q) * at(2 * pm + c % 2, q);
-            }
-        }
-        for a0 in (0..m).step_by(4) {
-            let rows = &panels[(a0 / PANEL) * width..(a0 / PANEL + 1) * width];
-            let last = (a0 + 3).min(m - 1);
-            for pb in self.layout.first_col(a0) / PANEL..=last / PANEL {
-                let cols = &panels[pb * width..(pb + 1) * width];
-                let tile = if a0 % PANEL == 0 {
-                    tile_products::<0>(rows, cols, count)
-                } else {
-                    tile_products::<4>(rows, cols, count)
-                };
-                for (r, row) in tile.iter().enumerate() {
-                    let a = a0 + r;
-                    if a >= m {
-                        break;
-                    }
-                    let first = self.layout.first_col(a);
-                    let start = self.layout.row_start(a);
-                    for (c, &v) in row.iter().enumerate() {
-                        let b = pb * PANEL + c;
-                        if b >= first && b <= a {
-                            self.residual_products[start + b - first] = v;
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// Columns of a panel of stacked residuals: panel p holds components p·PANEL.. of every
-/// realization q of a chunk, realization after realization (PANEL numbers each), the components
-/// beyond the last zero.
-pub(super) const PANEL: usize = 8;
-
-/// Σ_q rows_q[OFF + r] · cols_q[c] for r < 4, c < PANEL, summed over q in order: 8 vector
-/// accumulators that stay in registers while the two panels stream by.
-#[inline(always)]
-fn tile_products<const OFF: usize>(rows: &[f64], cols: &[f64], count: usize) -> [[f64; PANEL]; 4] {
-    let mut acc = [[0.0; PANEL]; 4];
-    let (rows, _) = rows[..count * PANEL].as_chunks::<PANEL>();
-    let (cols, _) = cols[..count * PANEL].as_chunks::<PANEL>();
-    for (row, col) in rows.iter().zip(cols) {
-        let x: [f64; 4] = std::array::from_fn(|r| row[OFF + r]);
-        for r in 0..4 {
-            for c in 0..PANEL {
-                acc[r][c] += x[r] * col[c];
-            }
-        }
-    }
-    acc
 }
