@@ -9,7 +9,7 @@ use super::sums::Accumulator;
 use super::tiles;
 use crate::config::TruthModel;
 use crate::filter::FilterSchedule;
-use crate::lanes::LANES;
+use crate::lanes::{LANES, Lanes};
 use crate::model::Model;
 use crate::simulation::stream_key;
 
@@ -90,11 +90,14 @@ pub fn accumulate(
 }
 
 /// Scratch space of [`accumulate_into`], reused from call to call: the residual-product tiles of
-/// the sums being made and the panels of a chunk's stacked residuals.
+/// the sums being made, the panels of a chunk's stacked residuals and the lane sums.
 #[derive(Clone, Debug, Default)]
 pub struct Scratch {
     tiles: Vec<f64>,
-    panels: Vec<f64>,
+    panels: Vec<f32>,
+    lanes: Option<LaneSums>,
+    /// Per lane group, the residuals at the earlier and the later fix of the single pair.
+    pair: Vec<[[Lanes; 2]; 2]>,
 }
 
 crate::lanes::vectorized! {
@@ -148,11 +151,27 @@ fn accumulate_lanes(
     scratch: &mut Scratch,
 ) {
     acc.clear_but_products();
-    scratch.tiles.clear();
-    scratch.tiles.resize(tiles::tiles_len(&acc.layout), 0.0);
+    let Scratch {
+        tiles,
+        panels,
+        lanes,
+        pair,
+    } = scratch;
+    tiles.clear();
+    tiles.resize(tiles::tiles_len(&acc.layout), 0.0);
+    let lanes = match lanes {
+        Some(l) if l.fixes() == schedule.fixes.len() => l,
+        _ => lanes.insert(LaneSums::new(schedule)),
+    };
+    lanes.set_weights(schedule);
+    let m = 2 * schedule.fixes.len();
     let key = stream_key(seed, model.case());
     for start in range.clone().step_by(CHUNK as usize) {
         let chunk = start..(start + CHUNK).min(range.end);
+        let count = (chunk.end - chunk.start).div_ceil(LANES as u64) as usize * LANES;
+        // Every entry is written below but the padding beyond component m − 1, zeroed here.
+        panels.clear();
+        panels.resize(tiles::panels_len(m, count), 0.0);
         let groups = chunk.clone().step_by(LANES).map(|first| {
             let active = (chunk.end - first).min(LANES as u64) as usize;
             (first, active)
@@ -160,56 +179,60 @@ fn accumulate_lanes(
         match (prepared, model.truth()) {
             (Prepared::Sample, TruthModel::Euler) => {
                 let g = groups.map(|(f, a)| SampleGroup::<true>::new(model, key, f, a));
-                sum_groups(g.collect(), schedule, acc, scratch);
+                sum_groups(g.collect(), schedule, acc, lanes, panels, pair);
             }
             (Prepared::Sample, TruthModel::Analytic) => {
                 let g = groups.map(|(f, a)| SampleGroup::<false>::new(model, key, f, a));
-                sum_groups(g.collect(), schedule, acc, scratch);
+                sum_groups(g.collect(), schedule, acc, lanes, panels, pair);
             }
             (Prepared::Epoch(plan), _) => {
                 let key = epoch::epoch_key(key);
                 let g = groups.map(|(f, a)| EpochGroup::new(plan, model, key, f, a));
-                sum_groups(g.collect(), schedule, acc, scratch);
+                sum_groups(g.collect(), schedule, acc, lanes, panels, pair);
             }
         }
+        tiles::add_products(&acc.layout, tiles, panels, count);
     }
     acc.count = range.end - range.start;
-    tiles::unpack(&acc.layout, &scratch.tiles, &mut acc.residual_products);
+    tiles::unpack(&acc.layout, tiles, &mut acc.residual_products);
 }
 
-/// Adds one chunk, the lane groups `groups`, to `acc` and to the residual-product tiles.
+/// Adds one chunk, the lane groups `groups`, to the per-fix sums of `acc` and to its single
+/// residual pair's products, and writes its residuals into `panels`, in single precision.
 #[inline(always)]
 fn sum_groups<G: LaneGroup>(
     mut groups: Vec<G>,
     schedule: &FilterSchedule,
     acc: &mut Accumulator,
-    scratch: &mut Scratch,
+    lanes: &mut LaneSums,
+    panels: &mut [f32],
+    pair: &mut Vec<[[Lanes; 2]; 2]>,
 ) {
-    let m = 2 * schedule.fixes.len();
     let count = groups.len() * LANES;
-    let panels = &mut scratch.panels;
-    // Every entry is written below but the padding beyond component m − 1, zeroed here.
-    panels.clear();
-    panels.resize(tiles::panels_len(m, count), 0.0);
-    let mut lanes = LaneSums::new(schedule);
+    pair.resize(groups.len(), Default::default());
+    let [pm, pi] = acc.pair;
     for (i, fix) in schedule.fixes.iter().enumerate() {
         for (g, group) in groups.iter_mut().enumerate() {
             let f = group.next_fix(i, fix);
             lanes.add(i, &f);
             for (c, r) in [2 * i, 2 * i + 1].into_iter().zip(&f.residual) {
                 for k in 0..LANES {
-                    panels[tiles::panel_index(c, g * LANES + k, count)] = r.0[k];
+                    panels[tiles::panel_index(c, g * LANES + k, count)] = r.0[k] as f32;
+                }
+            }
+            // The residuals of the statement's single pair, kept in double precision.
+            for (slot, fix_index) in [pi, pm].into_iter().enumerate() {
+                if i == fix_index {
+                    pair[g][slot] = f.residual;
                 }
             }
         }
         lanes.finish_fix(&mut acc.fixes[i]);
     }
-    let [pm, pi] = acc.pair;
     for q in 0..count {
-        let at = |c: usize| panels[tiles::panel_index(c, q, count)];
+        let [earlier, later] = &pair[q / LANES];
         for (c, p) in acc.pair_products.iter_mut().enumerate() {
-            *p += at(2 * pi + c / 2) * at(2 * pm + c % 2);
+            *p += earlier[c / 2].0[q % LANES] * later[c % 2].0[q % LANES];
         }
     }
-    tiles::add_products(&acc.layout, &mut scratch.tiles, panels, count);
 }

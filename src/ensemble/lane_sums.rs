@@ -101,24 +101,34 @@ pub struct LaneSums {
 impl LaneSums {
     /// Empty sums for the fixes of `schedule`.
     pub fn new(schedule: &FilterSchedule) -> Self {
+        let mut s = Self {
+            current: LaneFixSums::default(),
+            weights: Vec::new(),
+        };
+        s.set_weights(schedule);
+        s
+    }
+
+    /// Number of fixes.
+    pub fn fixes(&self) -> usize {
+        self.weights.len()
+    }
+
+    /// Takes the weights of the quadratic forms from `schedule`, with empty sums.
+    pub fn set_weights(&mut self, schedule: &FilterSchedule) {
         let upper = |m: &Matrix3| {
             std::array::from_fn(|k| {
                 let (r, c) = UPPER[k];
                 if r == c { m[(r, c)] } else { 2.0 * m[(r, c)] }
             })
         };
-        Self {
-            current: LaneFixSums::default(),
-            weights: schedule
-                .fixes
-                .iter()
-                .map(|f| Weights {
-                    prior: upper(&f.p_prior_inv),
-                    post: upper(&f.p_post_inv),
-                    s: [f.s_inv[(0, 0)], 2.0 * f.s_inv[(0, 1)], f.s_inv[(1, 1)]],
-                })
-                .collect(),
-        }
+        self.current = LaneFixSums::default();
+        self.weights.clear();
+        self.weights.extend(schedule.fixes.iter().map(|f| Weights {
+            prior: upper(&f.p_prior_inv),
+            post: upper(&f.p_post_inv),
+            s: [f.s_inv[(0, 0)], 2.0 * f.s_inv[(0, 1)], f.s_inv[(1, 1)]],
+        }));
     }
 
     /// Adds a lane group's fix `i`.

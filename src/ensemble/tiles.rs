@@ -1,27 +1,42 @@
 //! The residual products Σ ρ·ρᵀ of a block, summed in register tiles.
 //!
-//! A chunk's stacked residual vectors ρ_q are held in column panels (see [`PANEL`]). The kept part
-//! of the lower triangle is covered by tiles of [`ROWS`] rows × [`PANEL`] columns, stored tile
-//! after tile, each tile's products row-major. A chunk adds to a tile in one pass: the tile's
-//! running sums are loaded into registers, every realization of the chunk is added in order, and
-//! the sums are stored back. So every product of a block is one running sum over the block's
-//! realizations in order, and the packed triangle is written once, when the block is finished.
+//! A chunk's stacked residual vectors ρ_q are held in column panels (see [`PANEL`]), in single
+//! precision. The kept part of the lower triangle is covered by tiles of [`ROWS`] rows ×
+//! [`PANEL`] columns, stored tile after tile, each tile's sums row-major in double precision. A
+//! chunk adds to a tile in one pass: the products of the chunk's realizations are summed in
+//! order in single-precision registers, and that sum is added to the tile's double-precision
+//! running sum. So every product of a block is a double-precision sum over the block's chunks in
+//! order of single-precision sums over a chunk's realizations in order, and the packed triangle
+//! is written once, when the block is finished.
+//!
+//! Single precision within a chunk doubles the products per instruction. Its rounding is far
+//! below the sampling noise of the sums: a chunk's sum of K = 64 products carries a relative
+//! error of about √K·2⁻²⁴ ≈ 5·10⁻⁷ (at most K·2⁻²⁴ ≈ 4·10⁻⁶), and these errors are independent
+//! from chunk to chunk, so a correlation estimated from N realizations moves by about
+//! 5·10⁻⁷/√K of its own standard error, whatever N (measured in the tests below and in
+//! docs/SPEED.md).
 
 use super::layout::ResidualLayout;
 
 /// Columns of a panel of stacked residuals: panel p holds components p·PANEL.. of every
-/// realization q of a chunk, realization after realization (PANEL numbers each), the components
-/// beyond the last zero.
-pub(super) const PANEL: usize = 8;
+/// realization q of a chunk, realization after realization (PANEL numbers each, one cache line),
+/// the components beyond the last zero.
+pub(super) const PANEL: usize = 16;
 
 /// Rows of a tile.
 const ROWS: usize = 4;
 
+/// The largest error of a residual product sum Σ_q ρ_a·ρ_b relative to √(Σ_q ρ_a²·Σ_q ρ_b²):
+/// (K + 2)·2⁻²⁴ with K = [`CHUNK`](super::CHUNK) products summed in single precision (K − 1
+/// sums, the product and the two inputs rounded), to first order, by Cauchy–Schwarz on the usual
+/// bound γ·Σ|ρ_a·ρ_b| of a running sum.
+pub const PRODUCT_RELATIVE_ERROR: f64 = (super::CHUNK as f64 + 2.0) / (1u64 << 24) as f64;
+
 /// Numbers in a tile.
 const TILE: usize = ROWS * PANEL;
 
-/// Calls `f(t, a0, pb)` for every tile t in storage order: rows a0..a0 + ROWS of column panel pb.
-#[inline(always)]
+/// Calls `f(t, a0, pb)` for every tile t in storage order: rows a0..a0 + ROWS of column panel pb
+/// (the loops of [`add_products_with`]).
 fn for_each_tile(layout: &ResidualLayout, mut f: impl FnMut(usize, usize, usize)) {
     let m = 2 * layout.fixes();
     let mut t = 0;
@@ -54,54 +69,147 @@ pub(super) fn panel_index(c: usize, q: usize, count: usize) -> usize {
 }
 
 /// Adds Σ_q ρ_q·ρ_qᵀ over the `count` stacked residual vectors ρ_q held in `panels` (rows of
-/// inactive realizations zero) to the tiles `sums` of `layout`.
-#[inline(always)]
+/// inactive realizations zero) to the tiles `sums` of `layout`. Runs the AVX2 tile kernel when
+/// the processor has one and the plain one otherwise: the same operations in the same order, so
+/// the same results.
 pub(super) fn add_products(
     layout: &ResidualLayout,
     sums: &mut [f64],
-    panels: &[f64],
+    panels: &[f32],
     count: usize,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the processor supports AVX2, checked just above.
+        unsafe { avx2::add_products(layout, sums, panels, count) };
+        return;
+    }
+    add_products_with(
+        layout,
+        sums,
+        panels,
+        count,
+        tile_add::<0>,
+        tile_add::<4>,
+        tile_add::<8>,
+        tile_add::<12>,
+    );
+}
+
+/// A tile kernel: adds Σ_q rows_q[OFF + r]·cols_q[c] for r < ROWS, c < PANEL to the tile, summed
+/// over q in order in single precision, then added to the tile's double-precision sums.
+type Kernel = fn(&mut [f64; TILE], &[f32], &[f32]);
+
+/// The tiles of `layout` in storage order, each given to the kernel for its row offset.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn add_products_with(
+    layout: &ResidualLayout,
+    sums: &mut [f64],
+    panels: &[f32],
+    count: usize,
+    k0: Kernel,
+    k4: Kernel,
+    k8: Kernel,
+    k12: Kernel,
 ) {
     let width = PANEL * count;
     let m = 2 * layout.fixes();
     let mut tiles = sums.as_chunks_mut::<TILE>().0.iter_mut();
-    // The loops of `for_each_tile`, written out: a closure would not be compiled into the
-    // vectorized caller.
     for a0 in (0..m).step_by(ROWS) {
         let last = (a0 + ROWS - 1).min(m - 1);
         let rows = &panels[(a0 / PANEL) * width..][..width];
+        let kernel = match a0 % PANEL {
+            0 => k0,
+            4 => k4,
+            8 => k8,
+            _ => k12,
+        };
         for pb in layout.first_col(a0) / PANEL..=last / PANEL {
             let cols = &panels[pb * width..][..width];
-            let tile = tiles.next().expect("a tile for every (a0, pb)");
-            if a0 % PANEL == 0 {
-                tile_add::<0>(tile, rows, cols);
-            } else {
-                tile_add::<ROWS>(tile, rows, cols);
-            }
+            kernel(tiles.next().expect("a tile for every (a0, pb)"), rows, cols);
         }
     }
 }
 
-/// Adds Σ_q rows_q[OFF + r] · cols_q[c] for r < ROWS, c < PANEL to `tile`, over q in order:
-/// 8 vector accumulators that stay in registers while the two panels stream by.
-#[inline(always)]
-fn tile_add<const OFF: usize>(tile: &mut [f64; TILE], rows: &[f64], cols: &[f64]) {
-    let mut acc = [[0.0; PANEL]; ROWS];
-    for (r, a) in acc.iter_mut().enumerate() {
-        a.copy_from_slice(&tile[r * PANEL..(r + 1) * PANEL]);
-    }
+/// The plain tile kernel (see [`Kernel`]).
+fn tile_add<const OFF: usize>(tile: &mut [f64; TILE], rows: &[f32], cols: &[f32]) {
+    let mut acc = [[0.0f32; PANEL]; ROWS];
     let (rows, _) = rows.as_chunks::<PANEL>();
     let (cols, _) = cols.as_chunks::<PANEL>();
     for (row, col) in rows.iter().zip(cols) {
-        let x = [row[OFF], row[OFF + 1], row[OFF + 2], row[OFF + 3]];
         for r in 0..ROWS {
             for c in 0..PANEL {
-                acc[r][c] += x[r] * col[c];
+                acc[r][c] += row[OFF + r] * col[c];
             }
         }
     }
     for (r, a) in acc.iter().enumerate() {
-        tile[r * PANEL..(r + 1) * PANEL].copy_from_slice(a);
+        for (t, &v) in tile[r * PANEL..(r + 1) * PANEL].iter_mut().zip(a) {
+            *t += f64::from(v);
+        }
+    }
+}
+
+/// The AVX2 tile kernel: eight 256-bit accumulators (two per row) stay in registers while the
+/// two panels stream by, 64 products per four broadcasts and two loads.
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::{PANEL, ROWS, ResidualLayout, TILE};
+    use std::arch::x86_64::*;
+
+    #[target_feature(enable = "avx2")]
+    pub(super) fn add_products(
+        layout: &ResidualLayout,
+        sums: &mut [f64],
+        panels: &[f32],
+        count: usize,
+    ) {
+        super::add_products_with(
+            layout,
+            sums,
+            panels,
+            count,
+            |t, r, c| tile_add::<0>(t, r, c),
+            |t, r, c| tile_add::<4>(t, r, c),
+            |t, r, c| tile_add::<8>(t, r, c),
+            |t, r, c| tile_add::<12>(t, r, c),
+        );
+    }
+
+    /// The AVX2 variant of [`super::tile_add`]: the same products and sums in the same order.
+    #[target_feature(enable = "avx2")]
+    fn tile_add<const OFF: usize>(tile: &mut [f64; TILE], rows: &[f32], cols: &[f32]) {
+        let n = rows.len().min(cols.len()) / PANEL;
+        let mut acc = [_mm256_setzero_ps(); 2 * ROWS];
+        for q in 0..n {
+            let row = &rows[q * PANEL..(q + 1) * PANEL];
+            let col = &cols[q * PANEL..(q + 1) * PANEL];
+            // SAFETY: `col` holds PANEL = 16 numbers, read as two runs of 8.
+            let (c0, c1) = unsafe {
+                (
+                    _mm256_loadu_ps(col.as_ptr()),
+                    _mm256_loadu_ps(col.as_ptr().add(8)),
+                )
+            };
+            for r in 0..ROWS {
+                let x = _mm256_set1_ps(row[OFF + r]);
+                acc[2 * r] = _mm256_add_ps(acc[2 * r], _mm256_mul_ps(x, c0));
+                acc[2 * r + 1] = _mm256_add_ps(acc[2 * r + 1], _mm256_mul_ps(x, c1));
+            }
+        }
+        for (k, a) in acc.iter().enumerate() {
+            let mut v = [0.0f32; 8];
+            // SAFETY: `v` holds 8 numbers.
+            unsafe { _mm256_storeu_ps(v.as_mut_ptr(), *a) };
+            let (r, h) = (k / 2, k % 2);
+            for (t, x) in tile[r * PANEL + 8 * h..r * PANEL + 8 * h + 8]
+                .iter_mut()
+                .zip(v)
+            {
+                *t += f64::from(x);
+            }
+        }
     }
 }
 
@@ -137,7 +245,7 @@ mod tests {
             let layout = ResidualLayout::new(fixes, lag);
             let m = 2 * fixes;
             let count = 5;
-            let mut panels = vec![0.0; panels_len(m, count)];
+            let mut panels = vec![0.0f32; panels_len(m, count)];
             let rho: Vec<Vec<f64>> = (0..count)
                 .map(|q| {
                     (0..m)
@@ -147,7 +255,7 @@ mod tests {
                 .collect();
             for (q, r) in rho.iter().enumerate() {
                 for (c, &v) in r.iter().enumerate() {
-                    panels[panel_index(c, q, count)] = v;
+                    panels[panel_index(c, q, count)] = v as f32;
                 }
             }
             let mut sums = vec![0.0; tiles_len(&layout)];
