@@ -170,8 +170,8 @@ fn accumulate_lanes(
         let chunk = start..(start + CHUNK).min(range.end);
         let count = (chunk.end - chunk.start).div_ceil(LANES as u64) as usize * LANES;
         // Every entry is written below but the padding beyond component m − 1, zeroed here.
-        panels.clear();
         panels.resize(tiles::panels_len(m, count), 0.0);
+        tiles::zero_padding(panels, m, count);
         let groups = chunk.clone().step_by(LANES).map(|first| {
             let active = (chunk.end - first).min(LANES as u64) as usize;
             (first, active)
@@ -214,7 +214,11 @@ fn sum_groups<G: LaneGroup>(
     for (i, fix) in schedule.fixes.iter().enumerate() {
         for (g, group) in groups.iter_mut().enumerate() {
             let f = group.next_fix(i, fix);
-            lanes.add(i, &f);
+            if g == 0 {
+                lanes.add::<true>(i, &f);
+            } else {
+                lanes.add::<false>(i, &f);
+            }
             for (c, r) in [2 * i, 2 * i + 1].into_iter().zip(&f.residual) {
                 for k in 0..LANES {
                     panels[tiles::panel_index(c, g * LANES + k, count)] = r.0[k] as f32;
@@ -227,7 +231,7 @@ fn sum_groups<G: LaneGroup>(
                 }
             }
         }
-        lanes.finish_fix(&mut acc.fixes[i]);
+        lanes.finish_fix(i, &mut acc.fixes[i]);
     }
     for q in 0..count {
         let [earlier, later] = &pair[q / LANES];

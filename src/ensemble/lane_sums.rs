@@ -25,7 +25,9 @@ pub struct LaneFix {
     pub residual: [Lanes; 2],
 }
 
-/// One stage's sums per lane; fields as in [`StageSums`].
+/// One stage's sums per lane; fields as in [`StageSums`]. The normalized estimation error
+/// squared is not summed per lane: Σ eᵀP⁻¹e = Σ_k w_k·(Σ e·eᵀ)_k, with one P per fix, so it is
+/// formed from the lanes' Σ e·eᵀ when they are added up.
 #[derive(Clone, Copy, Debug, Default)]
 struct LaneStage {
     e: [Lanes; 3],
@@ -34,44 +36,54 @@ struct LaneStage {
     ex: [Lanes; 9],
     x: [Lanes; 3],
     xx: [Lanes; 3],
-    nees: Lanes,
+}
+
+/// `*s = v` for the first lane group of a fix (`FIRST`), `*s += v` for the others: the sums of
+/// a fix start from the first group's values, with no zeroing.
+#[inline(always)]
+fn put<const FIRST: bool>(s: &mut Lanes, v: Lanes) {
+    if FIRST {
+        *s = v;
+    } else {
+        *s += v;
+    }
 }
 
 impl LaneStage {
-    /// Adds e = δx − δx̂ for the estimate `x`; `w` holds the weights of eᵀP⁻¹e over the upper
-    /// triangle (off-diagonal terms doubled).
+    /// Adds e = δx − δx̂ for the estimate `x` (see [`put`] for `FIRST`).
     #[inline(always)]
-    fn add(&mut self, delta_x: &[Lanes; 3], x: &[Lanes; 3], w: &[f64; 6]) {
+    fn add<const FIRST: bool>(&mut self, delta_x: &[Lanes; 3], x: &[Lanes; 3]) {
         let e = [delta_x[0] - x[0], delta_x[1] - x[1], delta_x[2] - x[2]];
-        let mut nees = Lanes::default();
-        for (s, (&(r, c), &wk)) in self.ee.iter_mut().zip(UPPER.iter().zip(w)) {
-            let prod = e[r] * e[c];
-            *s += prod;
-            nees += Lanes([wk; 8]) * prod;
+        for (s, &(r, c)) in self.ee.iter_mut().zip(UPPER.iter()) {
+            put::<FIRST>(s, e[r] * e[c]);
         }
-        self.nees += nees;
         for c in 0..3 {
             for r in 0..3 {
-                self.ex[3 * c + r] += e[r] * x[c];
+                put::<FIRST>(&mut self.ex[3 * c + r], e[r] * x[c]);
             }
-            self.e[c] += e[c];
-            self.x[c] += x[c];
-            self.xx[c] += x[c] * x[c];
+            put::<FIRST>(&mut self.e[c], e[c]);
+            put::<FIRST>(&mut self.x[c], x[c]);
+            put::<FIRST>(&mut self.xx[c], x[c] * x[c]);
         }
     }
 
-    /// Adds the lanes' totals, each summed in lane order, to `s`.
-    fn reduce_into(&self, s: &mut StageSums) {
+    /// Adds the lanes' totals, each summed in lane order, to `s`, and Σ eᵀP⁻¹e formed from them
+    /// with the weights `w` of eᵀP⁻¹e over the upper triangle (off-diagonal terms doubled).
+    #[inline(always)]
+    fn reduce_into(&self, s: &mut StageSums, w: &[f64; 6]) {
         for k in 0..3 {
             s.e[k] += self.e[k].sum();
             s.x[k] += self.x[k].sum();
             s.xx[k] += self.xx[k].sum();
         }
+        let mut nees = 0.0;
         for k in 0..6 {
-            s.ee[k] += self.ee[k].sum();
+            let ee = self.ee[k].sum();
+            s.ee[k] += ee;
+            nees += w[k] * ee;
         }
+        s.nees += nees;
         s.ex += Matrix3::from_fn(|r, c| self.ex[3 * c + r].sum());
-        s.nees += self.nees.sum();
     }
 }
 
@@ -131,26 +143,26 @@ impl LaneSums {
         }));
     }
 
-    /// Adds a lane group's fix `i`.
+    /// Adds a lane group's fix `i`; `FIRST` for the first group of the fix (see [`put`]).
     #[inline(always)]
-    pub fn add(&mut self, i: usize, f: &LaneFix) {
+    pub fn add<const FIRST: bool>(&mut self, i: usize, f: &LaneFix) {
         let w = &self.weights[i];
         let sums = &mut self.current;
-        sums.prior.add(&f.delta_x, &f.prior, &w.prior);
-        sums.post.add(&f.delta_x, &f.post, &w.post);
+        sums.prior.add::<FIRST>(&f.delta_x, &f.prior);
+        sums.post.add::<FIRST>(&f.delta_x, &f.post);
         let [r0, r1] = f.residual;
-        sums.nis += Lanes([w.s[0]; 8]) * r0 * r0
+        let nis = Lanes([w.s[0]; 8]) * r0 * r0
             + Lanes([w.s[1]; 8]) * r0 * r1
             + Lanes([w.s[2]; 8]) * r1 * r1;
+        put::<FIRST>(&mut sums.nis, nis);
     }
 
-    /// Adds the lanes' totals of the fix to `out` and starts the next fix.
+    /// Adds the lanes' totals of fix `i` to `out`; the next fix starts with its first group.
     #[inline(always)]
-    pub fn finish_fix(&mut self, out: &mut FixSums) {
-        let c = &self.current;
-        c.prior.reduce_into(&mut out.prior);
-        c.post.reduce_into(&mut out.post);
+    pub fn finish_fix(&mut self, i: usize, out: &mut FixSums) {
+        let (c, w) = (&self.current, &self.weights[i]);
+        c.prior.reduce_into(&mut out.prior, &w.prior);
+        c.post.reduce_into(&mut out.post, &w.post);
         out.nis += c.nis.sum();
-        self.current = LaneFixSums::default();
     }
 }

@@ -62,6 +62,17 @@ pub(super) fn panels_len(m: usize, count: usize) -> usize {
     m.div_ceil(PANEL) * PANEL * count
 }
 
+/// Zeroes the components from m on, up to the end of the last panel, of every realization of
+/// a chunk of `count`.
+pub(super) fn zero_padding(panels: &mut [f32], m: usize, count: usize) {
+    if !m.is_multiple_of(PANEL) {
+        for q in 0..count {
+            let first = panel_index(m, q, count);
+            panels[first..first + PANEL - m % PANEL].fill(0.0);
+        }
+    }
+}
+
 /// Where component c of realization q of a chunk of `count` goes in the panels.
 #[inline(always)]
 pub(super) fn panel_index(c: usize, q: usize, count: usize) -> usize {
