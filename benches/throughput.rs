@@ -6,13 +6,14 @@
 //!   (3 initial values, 6 000 accelerometer noises, 2 per fix), in lane groups;
 //! - the bare per-sample kernel (simulation and filter, no statistics);
 //! - the full per-sample ensemble (`ensemble::run_with(Engine::Sample, …)`);
-//! - the full epoch ensemble (`Engine::Epoch`);
+//! - the full epoch ensemble (`Engine::Epoch`), and its own random-number bound (603 normals:
+//!   3 initial values, 2 per GPS interval, 2 per fix);
 //!
 //! and their ratios, so the remaining gap shows. `--numpy R` adds each figure's ratio to a numpy
 //! rate R measured in the same session (`python3 benches/numpy_reference.py`).
 //!
 //! Run with `cargo bench --bench throughput` (options: `-- --realizations N --repeats R
-//! --numpy R --truth analytic|euler`).
+//! --numpy R --truth analytic|euler`; defaults N = 100 000, R = 9).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -78,7 +79,7 @@ fn groups(n: u64) -> impl ParallelIterator<Item = (u64, usize)> {
 fn main() {
     let n: u64 = arg("--realizations")
         .and_then(|v| v.parse().ok())
-        .unwrap_or(20_000);
+        .unwrap_or(100_000);
     let repeats: usize = arg("--repeats").and_then(|v| v.parse().ok()).unwrap_or(9);
     let numpy: Option<f64> = arg("--numpy").and_then(|v| v.parse().ok());
     let truth = match arg("--truth").as_deref() {
@@ -128,6 +129,19 @@ fn main() {
             |_| {},
         ));
     });
+    let epoch_draws = 3 + 4 * model.timeline.fixes();
+    let epoch_rng = measure(
+        &format!("random numbers only ({epoch_draws} normals)"),
+        repeats,
+        n,
+        numpy,
+        || {
+            let s: f64 = groups(n)
+                .map(|(first, _)| normals_sum(key, first, epoch_draws))
+                .sum();
+            black_box(s);
+        },
+    );
     let epoch = measure("epoch ensemble", repeats, n, numpy, || {
         black_box(ensemble::run_with(
             Engine::Epoch,
@@ -148,5 +162,10 @@ fn main() {
         "{:<34} {:.2}",
         "ratio epoch / per-sample ensemble",
         epoch / full
+    );
+    println!(
+        "{:<34} {:.2}",
+        "ratio epoch / its random numbers",
+        epoch / epoch_rng
     );
 }

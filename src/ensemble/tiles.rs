@@ -286,4 +286,106 @@ mod tests {
             }
         }
     }
+
+    /// Random panels of a chunk of 64 (some realizations inactive, so zero), with components of
+    /// very different scales, like position and velocity residuals.
+    fn random_panels(
+        m: usize,
+        count: usize,
+        active: usize,
+        seed: u64,
+    ) -> (Vec<f32>, Vec<Vec<f64>>) {
+        let mut rng = crate::random::Stream::new(seed, 0);
+        let rho: Vec<Vec<f64>> = (0..count)
+            .map(|q| {
+                (0..m)
+                    .map(|c| {
+                        let scale = if c % 2 == 0 { 3.0 } else { 0.05 };
+                        if q < active {
+                            scale * rng.normal()
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut panels = vec![0.0f32; panels_len(m, count)];
+        zero_padding(&mut panels, m, count);
+        for (q, r) in rho.iter().enumerate() {
+            for (c, &v) in r.iter().enumerate() {
+                panels[panel_index(c, q, count)] = v as f32;
+            }
+        }
+        (panels, rho)
+    }
+
+    /// Single precision within a chunk stays inside its stated bound: every product sum of 40
+    /// chunks of random residuals is within PRODUCT_RELATIVE_ERROR·√(Σρ_a²·Σρ_b²) of the exact
+    /// double-precision sum, and is not exact (the bound is not vacuous: the errors are of the
+    /// size single precision gives, far above double precision's).
+    #[test]
+    fn single_precision_sums_stay_within_their_bound() {
+        let layout = ResidualLayout::new(150, None);
+        let (m, count) = (300, super::super::CHUNK as usize);
+        let mut sums = vec![0.0; tiles_len(&layout)];
+        let mut exact = vec![0.0; layout.len()];
+        for chunk in 0..40 {
+            let (panels, rho) = random_panels(m, count, if chunk == 7 { 21 } else { count }, chunk);
+            add_products(&layout, &mut sums, &panels, count);
+            for r in &rho {
+                for a in 0..m {
+                    for b in 0..=a {
+                        exact[layout.index(a, b).unwrap()] += r[a] * r[b];
+                    }
+                }
+            }
+        }
+        let mut out = vec![f64::NAN; layout.len()];
+        unpack(&layout, &sums, &mut out);
+        let (mut worst, mut largest) = (0.0f64, 0.0f64);
+        for a in 0..m {
+            for b in 0..=a {
+                let i = layout.index(a, b).unwrap();
+                let diagonal = |c: usize| exact[layout.index(c, c).unwrap()];
+                let scale = (diagonal(a) * diagonal(b)).sqrt();
+                let err = (out[i] - exact[i]).abs() / scale;
+                worst = worst.max(err);
+                largest = largest.max(err / PRODUCT_RELATIVE_ERROR);
+            }
+        }
+        assert!(
+            largest <= 1.0,
+            "error {worst:e} beyond the bound {PRODUCT_RELATIVE_ERROR:e}"
+        );
+        assert!(worst > 1e-9, "errors of {worst:e}: not single precision");
+    }
+
+    /// The AVX2 kernel and the plain one give the same bits.
+    #[test]
+    fn both_tile_kernels_give_the_same_sums() {
+        let layout = ResidualLayout::new(37, Some(9));
+        let (m, count) = (74, 24);
+        let (panels, _) = random_panels(m, count, 19, 3);
+        let mut plain = vec![0.5; tiles_len(&layout)];
+        let mut fast = plain.clone();
+        add_products_with(
+            &layout,
+            &mut plain,
+            &panels,
+            count,
+            tile_add::<0>,
+            tile_add::<4>,
+            tile_add::<8>,
+            tile_add::<12>,
+        );
+        add_products(&layout, &mut fast, &panels, count);
+        assert!(
+            plain
+                .iter()
+                .zip(&fast)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        );
+        assert!(plain.iter().any(|&v| v != 0.5));
+    }
 }
