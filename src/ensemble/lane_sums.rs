@@ -1,6 +1,6 @@
 //! The running sums of one fix of a chunk kept per lane: each lane of every lane group of the
 //! chunk adds its realization's fix into its own column, with no branch and no reduction, and the
-//! lanes are added up once, in lane order, when every group has passed the fix.
+//! lanes are added up once (see [`Lanes::sum`]), when every group has passed the fix.
 // Lane loops index several arrays by the lane k; iterators would hide that.
 #![allow(clippy::needless_range_loop)]
 
@@ -67,7 +67,7 @@ impl LaneStage {
         }
     }
 
-    /// Adds the lanes' totals, each summed in lane order, to `s`, and Σ eᵀP⁻¹e formed from them
+    /// Adds the lanes' totals (see [`Lanes::sum`]) to `s`, and Σ eᵀP⁻¹e formed from them
     /// with the weights `w` of eᵀP⁻¹e over the upper triangle (off-diagonal terms doubled).
     #[inline(always)]
     fn reduce_into(&self, s: &mut StageSums, w: &[f64; 6]) {
@@ -83,7 +83,10 @@ impl LaneStage {
             nees += w[k] * ee;
         }
         s.nees += nees;
-        s.ex += Matrix3::from_fn(|r, c| self.ex[3 * c + r].sum());
+        // Column-major, like the lane layout; no closure, so that it is compiled into the caller.
+        for (k, v) in self.ex.iter().enumerate() {
+            s.ex[(k % 3, k / 3)] += v.sum();
+        }
     }
 }
 

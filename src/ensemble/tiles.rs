@@ -27,8 +27,8 @@ pub(super) const PANEL: usize = 16;
 const ROWS: usize = 4;
 
 /// The largest error of a residual product sum Σ_q ρ_a·ρ_b relative to √(Σ_q ρ_a²·Σ_q ρ_b²):
-/// (K + 2)·2⁻²⁴ with K = [`CHUNK`](super::CHUNK) products summed in single precision (K − 1
-/// sums, the product and the two inputs rounded), to first order, by Cauchy–Schwarz on the usual
+/// (K + 2)·2⁻²⁴ with K = [`CHUNK`](super::CHUNK) products summed in single precision (K
+/// fused multiply-adds, the two inputs rounded), to first order, by Cauchy–Schwarz on the usual
 /// bound γ·Σ|ρ_a·ρ_b| of a running sum.
 pub const PRODUCT_RELATIVE_ERROR: f64 = (super::CHUNK as f64 + 2.0) / (1u64 << 24) as f64;
 
@@ -81,8 +81,8 @@ pub(super) fn panel_index(c: usize, q: usize, count: usize) -> usize {
 
 /// Adds Σ_q ρ_q·ρ_qᵀ over the `count` stacked residual vectors ρ_q held in `panels` (rows of
 /// inactive realizations zero) to the tiles `sums` of `layout`. Runs the AVX2 tile kernel when
-/// the processor has one and the plain one otherwise: the same operations in the same order, so
-/// the same results.
+/// the processor has AVX2 and FMA, and the plain one otherwise: the same fused multiply-adds in
+/// the same order, so the same results.
 pub(super) fn add_products(
     layout: &ResidualLayout,
     sums: &mut [f64],
@@ -90,8 +90,8 @@ pub(super) fn add_products(
     count: usize,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the processor supports AVX2, checked just above.
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the processor supports AVX2 and FMA, checked just above.
         unsafe { avx2::add_products(layout, sums, panels, count) };
         return;
     }
@@ -108,7 +108,8 @@ pub(super) fn add_products(
 }
 
 /// A tile kernel: adds Σ_q rows_q[OFF + r]·cols_q[c] for r < ROWS, c < PANEL to the tile, summed
-/// over q in order in single precision, then added to the tile's double-precision sums.
+/// over q in order in single precision, each product added with one rounding (a fused
+/// multiply-add), then added to the tile's double-precision sums.
 type Kernel = fn(&mut [f64; TILE], &[f32], &[f32]);
 
 /// The tiles of `layout` in storage order, each given to the kernel for its row offset.
@@ -151,7 +152,7 @@ fn tile_add<const OFF: usize>(tile: &mut [f64; TILE], rows: &[f32], cols: &[f32]
     for (row, col) in rows.iter().zip(cols) {
         for r in 0..ROWS {
             for c in 0..PANEL {
-                acc[r][c] += row[OFF + r] * col[c];
+                acc[r][c] = row[OFF + r].mul_add(col[c], acc[r][c]);
             }
         }
     }
@@ -163,13 +164,13 @@ fn tile_add<const OFF: usize>(tile: &mut [f64; TILE], rows: &[f32], cols: &[f32]
 }
 
 /// The AVX2 tile kernel: eight 256-bit accumulators (two per row) stay in registers while the
-/// two panels stream by, 64 products per four broadcasts and two loads.
+/// two panels stream by, 64 fused multiply-adds per four broadcasts and two loads.
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use super::{PANEL, ROWS, ResidualLayout, TILE};
     use std::arch::x86_64::*;
 
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,fma")]
     pub(super) fn add_products(
         layout: &ResidualLayout,
         sums: &mut [f64],
@@ -188,8 +189,8 @@ mod avx2 {
         );
     }
 
-    /// The AVX2 variant of [`super::tile_add`]: the same products and sums in the same order.
-    #[target_feature(enable = "avx2")]
+    /// The AVX2 variant of [`super::tile_add`]: the same fused multiply-adds in the same order.
+    #[target_feature(enable = "avx2,fma")]
     fn tile_add<const OFF: usize>(tile: &mut [f64; TILE], rows: &[f32], cols: &[f32]) {
         let n = rows.len().min(cols.len()) / PANEL;
         let mut acc = [_mm256_setzero_ps(); 2 * ROWS];
@@ -205,8 +206,8 @@ mod avx2 {
             };
             for r in 0..ROWS {
                 let x = _mm256_set1_ps(row[OFF + r]);
-                acc[2 * r] = _mm256_add_ps(acc[2 * r], _mm256_mul_ps(x, c0));
-                acc[2 * r + 1] = _mm256_add_ps(acc[2 * r + 1], _mm256_mul_ps(x, c1));
+                acc[2 * r] = _mm256_fmadd_ps(x, c0, acc[2 * r]);
+                acc[2 * r + 1] = _mm256_fmadd_ps(x, c1, acc[2 * r + 1]);
             }
         }
         for (k, a) in acc.iter().enumerate() {
