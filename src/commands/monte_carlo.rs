@@ -214,7 +214,7 @@ fn run_shard(
         |done| bar.advance(done),
         |index, acc| {
             if written.is_ok() {
-                written = partial::write_block(&mut spool_w, index, &acc);
+                written = partial::write_block(&mut spool_w, index, acc);
             }
         },
     );

@@ -157,8 +157,11 @@ fn accumulate_lanes(
         lanes,
         pair,
     } = scratch;
-    tiles.clear();
+    // The first chunk overwrites the tiles; with no chunk at all they must read zero.
     tiles.resize(tiles::tiles_len(&acc.layout), 0.0);
+    if range.is_empty() {
+        tiles.fill(0.0);
+    }
     let lanes = match lanes {
         Some(l) if l.fixes() == schedule.fixes.len() => l,
         _ => lanes.insert(LaneSums::new(schedule)),
@@ -191,7 +194,7 @@ fn accumulate_lanes(
                 sum_groups(g.collect(), schedule, acc, lanes, panels, pair);
             }
         }
-        tiles::add_products(&acc.layout, tiles, panels, count);
+        tiles::add_products(&acc.layout, tiles, panels, count, start == range.start);
     }
     acc.count = range.end - range.start;
     tiles::unpack(&acc.layout, tiles, &mut acc.residual_products);

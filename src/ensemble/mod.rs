@@ -108,7 +108,7 @@ pub fn run_blocks_with(
     n: u64,
     blocks: std::ops::Range<u64>,
     progress: impl FnMut(u64) + Send,
-    on_block: impl FnMut(u64, Accumulator) + Send,
+    on_block: impl FnMut(u64, &Accumulator) + Send,
 ) {
     let prepared = Prepared::new(engine, model, schedule);
     run_blocks_prepared(
@@ -121,6 +121,8 @@ struct Emitter<P, B> {
     /// The next block to hand over.
     next: u64,
     waiting: std::collections::BTreeMap<u64, Accumulator>,
+    /// Sums handed over, kept for the next blocks: a block overwrites every number of them.
+    spare: Vec<Accumulator>,
     done: u64,
     progress: P,
     on_block: B,
@@ -142,7 +144,7 @@ pub fn run_blocks_prepared(
     n: u64,
     blocks: std::ops::Range<u64>,
     progress: impl FnMut(u64) + Send,
-    on_block: impl FnMut(u64, Accumulator) + Send,
+    on_block: impl FnMut(u64, &Accumulator) + Send,
 ) {
     use std::sync::atomic::{AtomicU64, Ordering};
     use std::sync::{Condvar, Mutex};
@@ -158,6 +160,7 @@ pub fn run_blocks_prepared(
     let emitter = Mutex::new(Emitter {
         next: blocks.start,
         waiting: Default::default(),
+        spare: Vec::new(),
         done: 0,
         progress,
         on_block,
@@ -172,14 +175,15 @@ pub fn run_blocks_prepared(
                 return;
             }
             // Every block before b is claimed by a running worker, so the wait ends.
-            drop(
-                turn.wait_while(lock(), |e| b >= e.next + window)
-                    .unwrap_or_else(|e| e.into_inner()),
-            );
+            let mut acc = turn
+                .wait_while(lock(), |e| b >= e.next + window)
+                .unwrap_or_else(|e| e.into_inner())
+                .spare
+                .pop()
+                .unwrap_or_else(|| Accumulator::new(&layout, model.residual_pair));
             let chunks = partition.block_chunks(b);
             let range = partition.chunk_realizations(chunks.start).start
                 ..partition.chunk_realizations(chunks.end - 1).end;
-            let mut acc = Accumulator::new(&layout, model.residual_pair);
             accumulate_into(
                 prepared,
                 model,
@@ -198,7 +202,8 @@ pub fn run_blocks_prepared(
                     break;
                 };
                 e.done += acc.count;
-                (e.on_block)(next, acc);
+                (e.on_block)(next, &acc);
+                e.spare.push(acc);
                 e.next += 1;
                 advanced = true;
             }
@@ -257,7 +262,7 @@ pub fn run_prepared(
         n,
         0..Partition::new(n).blocks,
         progress,
-        |_, block| total.merge(&block),
+        |_, block| total.merge(block),
     );
     total
 }

@@ -80,7 +80,9 @@ pub(super) fn panel_index(c: usize, q: usize, count: usize) -> usize {
 }
 
 /// Adds Σ_q ρ_q·ρ_qᵀ over the `count` stacked residual vectors ρ_q held in `panels` (rows of
-/// inactive realizations zero) to the tiles `sums` of `layout`. Runs the AVX2 tile kernel when
+/// inactive realizations zero) to the tiles `sums` of `layout`, or sets the tiles to them
+/// (`first`: whatever the tiles held before is overwritten, tile by tile while it is in cache,
+/// rather than zeroed in a pass of its own). Runs the AVX2 tile kernel when
 /// the processor has AVX2 and FMA, and the plain one otherwise: the same fused multiply-adds in
 /// the same order, so the same results.
 pub(super) fn add_products(
@@ -88,11 +90,12 @@ pub(super) fn add_products(
     sums: &mut [f64],
     panels: &[f32],
     count: usize,
+    first: bool,
 ) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the processor supports AVX2 and FMA, checked just above.
-        unsafe { avx2::add_products(layout, sums, panels, count) };
+        unsafe { avx2::add_products(layout, sums, panels, count, first) };
         return;
     }
     add_products_with(
@@ -100,6 +103,7 @@ pub(super) fn add_products(
         sums,
         panels,
         count,
+        first,
         tile_add::<0>,
         tile_add::<4>,
         tile_add::<8>,
@@ -120,6 +124,7 @@ fn add_products_with(
     sums: &mut [f64],
     panels: &[f32],
     count: usize,
+    first: bool,
     k0: Kernel,
     k4: Kernel,
     k8: Kernel,
@@ -139,7 +144,11 @@ fn add_products_with(
         };
         for pb in layout.first_col(a0) / PANEL..=last / PANEL {
             let cols = &panels[pb * width..][..width];
-            kernel(tiles.next().expect("a tile for every (a0, pb)"), rows, cols);
+            let tile = tiles.next().expect("a tile for every (a0, pb)");
+            if first {
+                *tile = [0.0; TILE];
+            }
+            kernel(tile, rows, cols);
         }
     }
 }
@@ -176,12 +185,14 @@ mod avx2 {
         sums: &mut [f64],
         panels: &[f32],
         count: usize,
+        first: bool,
     ) {
         super::add_products_with(
             layout,
             sums,
             panels,
             count,
+            first,
             |t, r, c| tile_add::<0>(t, r, c),
             |t, r, c| tile_add::<4>(t, r, c),
             |t, r, c| tile_add::<8>(t, r, c),
@@ -270,10 +281,10 @@ mod tests {
                     panels[panel_index(c, q, count)] = v as f32;
                 }
             }
-            let mut sums = vec![0.0; tiles_len(&layout)];
-            // Two chunks: the same realizations added twice.
-            add_products(&layout, &mut sums, &panels, count);
-            add_products(&layout, &mut sums, &panels, count);
+            // Two chunks: the same realizations set, then added again, over a stale start.
+            let mut sums = vec![f64::NAN; tiles_len(&layout)];
+            add_products(&layout, &mut sums, &panels, count, true);
+            add_products(&layout, &mut sums, &panels, count, false);
             let mut out = vec![f64::NAN; layout.len()];
             unpack(&layout, &sums, &mut out);
             for a in 0..m {
@@ -329,11 +340,11 @@ mod tests {
     fn single_precision_sums_stay_within_their_bound() {
         let layout = ResidualLayout::new(150, None);
         let (m, count) = (300, super::super::CHUNK as usize);
-        let mut sums = vec![0.0; tiles_len(&layout)];
+        let mut sums = vec![f64::NAN; tiles_len(&layout)];
         let mut exact = vec![0.0; layout.len()];
         for chunk in 0..40 {
             let (panels, rho) = random_panels(m, count, if chunk == 7 { 21 } else { count }, chunk);
-            add_products(&layout, &mut sums, &panels, count);
+            add_products(&layout, &mut sums, &panels, count, chunk == 0);
             for r in &rho {
                 for a in 0..m {
                     for b in 0..=a {
@@ -375,12 +386,13 @@ mod tests {
             &mut plain,
             &panels,
             count,
+            false,
             tile_add::<0>,
             tile_add::<4>,
             tile_add::<8>,
             tile_add::<12>,
         );
-        add_products(&layout, &mut fast, &panels, count);
+        add_products(&layout, &mut fast, &panels, count, false);
         assert!(
             plain
                 .iter()
