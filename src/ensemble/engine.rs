@@ -169,46 +169,62 @@ fn accumulate_lanes(
     lanes.set_weights(schedule);
     let m = 2 * schedule.fixes.len();
     let key = stream_key(seed, model.case());
-    for start in range.clone().step_by(CHUNK as usize) {
-        let chunk = start..(start + CHUNK).min(range.end);
-        let count = (chunk.end - chunk.start).div_ceil(LANES as u64) as usize * LANES;
+    for pass_start in range.clone().step_by(tiles::PASS as usize) {
+        let pass = pass_start..(pass_start + tiles::PASS).min(range.end);
+        let count = (pass.end - pass.start).div_ceil(LANES as u64) as usize * LANES;
         // Every entry is written below but the padding beyond component m − 1, zeroed here.
         panels.resize(tiles::panels_len(m, count), 0.0);
         tiles::zero_padding(panels, m, count);
-        let groups = chunk.clone().step_by(LANES).map(|first| {
-            let active = (chunk.end - first).min(LANES as u64) as usize;
-            (first, active)
-        });
-        match (prepared, model.truth()) {
-            (Prepared::Sample, TruthModel::Euler) => {
-                let g = groups.map(|(f, a)| SampleGroup::<true>::new(model, key, f, a));
-                sum_groups(g.collect(), schedule, acc, lanes, panels, pair);
-            }
-            (Prepared::Sample, TruthModel::Analytic) => {
-                let g = groups.map(|(f, a)| SampleGroup::<false>::new(model, key, f, a));
-                sum_groups(g.collect(), schedule, acc, lanes, panels, pair);
-            }
-            (Prepared::Epoch(plan), _) => {
-                let key = epoch::epoch_key(key);
-                let g = groups.map(|(f, a)| EpochGroup::new(plan, model, key, f, a));
-                sum_groups(g.collect(), schedule, acc, lanes, panels, pair);
+        for start in pass.clone().step_by(CHUNK as usize) {
+            let chunk = start..(start + CHUNK).min(pass.end);
+            let out = Panels {
+                panels,
+                first: (start - pass.start) as usize,
+                count,
+            };
+            let groups = chunk.clone().step_by(LANES).map(|first| {
+                let active = (chunk.end - first).min(LANES as u64) as usize;
+                (first, active)
+            });
+            match (prepared, model.truth()) {
+                (Prepared::Sample, TruthModel::Euler) => {
+                    let g = groups.map(|(f, a)| SampleGroup::<true>::new(model, key, f, a));
+                    sum_groups(g.collect(), schedule, acc, lanes, out, pair);
+                }
+                (Prepared::Sample, TruthModel::Analytic) => {
+                    let g = groups.map(|(f, a)| SampleGroup::<false>::new(model, key, f, a));
+                    sum_groups(g.collect(), schedule, acc, lanes, out, pair);
+                }
+                (Prepared::Epoch(plan), _) => {
+                    let key = epoch::epoch_key(key);
+                    let g = groups.map(|(f, a)| EpochGroup::new(plan, model, key, f, a));
+                    sum_groups(g.collect(), schedule, acc, lanes, out, pair);
+                }
             }
         }
-        tiles::add_products(&acc.layout, tiles, panels, count, start == range.start);
+        tiles::add_products(&acc.layout, tiles, panels, count, pass_start == range.start);
     }
     acc.count = range.end - range.start;
     tiles::unpack(&acc.layout, tiles, &mut acc.residual_products);
 }
 
+/// Where a chunk's residuals go: the panels of a pass of `count` realizations, from the pass's
+/// realization `first` on.
+struct Panels<'a> {
+    panels: &'a mut [f32],
+    first: usize,
+    count: usize,
+}
+
 /// Adds one chunk, the lane groups `groups`, to the per-fix sums of `acc` and to its single
-/// residual pair's products, and writes its residuals into `panels`, in single precision.
+/// residual pair's products, and writes its residuals into `out`, in single precision.
 #[inline(always)]
 fn sum_groups<G: LaneGroup>(
     mut groups: Vec<G>,
     schedule: &FilterSchedule,
     acc: &mut Accumulator,
     lanes: &mut LaneSums,
-    panels: &mut [f32],
+    out: Panels,
     pair: &mut Vec<[[Lanes; 2]; 2]>,
 ) {
     let count = groups.len() * LANES;
@@ -224,7 +240,8 @@ fn sum_groups<G: LaneGroup>(
             }
             for (c, r) in [2 * i, 2 * i + 1].into_iter().zip(&f.residual) {
                 for k in 0..LANES {
-                    panels[tiles::panel_index(c, g * LANES + k, count)] = r.0[k] as f32;
+                    let q = out.first + g * LANES + k;
+                    out.panels[tiles::panel_index(c, q, out.count)] = r.0[k] as f32;
                 }
             }
             // The residuals of the statement's single pair, kept in double precision.
