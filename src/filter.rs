@@ -234,8 +234,8 @@ impl FixCovariance {
     #[inline(always)]
     pub fn step<T: Real>(&self, estimate: &[T; 3], dz: &[T; 2]) -> ([T; 3], [T; 3], [T; 2]) {
         let phi = &self.phi_from_previous;
-        // Written out row by row (no closures), so that every operation is inlined into the
-        // vectorized callers.
+        // Written out row by row (no `std::array::from_fn`), so that every operation is inlined
+        // into the vectorized callers.
         let row = |r: usize| {
             T::splat(phi[(r, 0)]) * estimate[0]
                 + T::splat(phi[(r, 1)]) * estimate[1]

@@ -96,7 +96,8 @@ pub struct Scratch {
     tiles: Vec<f64>,
     panels: Vec<f32>,
     lanes: Option<LaneSums>,
-    /// Per lane group, the residuals at the earlier and the later fix of the single pair.
+    /// Per lane group, the residuals at the fixes i and m of the single pair (see
+    /// [`Accumulator::pair`]).
     pair: Vec<[[Lanes; 2]; 2]>,
 }
 
@@ -254,9 +255,9 @@ fn sum_groups<G: LaneGroup>(
         lanes.finish_fix(i, &mut acc.fixes[i]);
     }
     for q in 0..count {
-        let [earlier, later] = &pair[q / LANES];
+        let [at_i, at_m] = &pair[q / LANES];
         for (c, p) in acc.pair_products.iter_mut().enumerate() {
-            *p += earlier[c / 2].0[q % LANES] * later[c % 2].0[q % LANES];
+            *p += at_i[c / 2].0[q % LANES] * at_m[c % 2].0[q % LANES];
         }
     }
 }

@@ -124,8 +124,34 @@ struct Emitter<P, B> {
     /// Sums handed over, kept for the next blocks: a block overwrites every number of them.
     spare: Vec<Accumulator>,
     done: u64,
+    /// A worker panicked: the others stop instead of waiting for its block.
+    failed: bool,
     progress: P,
     on_block: B,
+}
+
+/// Set in each worker: if the worker panics, it marks the run failed, lets no further block be
+/// taken and wakes the waiting workers, so that every worker ends and `rayon::broadcast` hands
+/// the panic to the caller (rather than the others waiting forever for the lost block).
+struct Abort<'a, P, B> {
+    emitter: &'a std::sync::Mutex<Emitter<P, B>>,
+    turn: &'a std::sync::Condvar,
+    claimed: &'a std::sync::atomic::AtomicU64,
+    end: u64,
+}
+
+impl<P, B> Drop for Abort<'_, P, B> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            self.claimed
+                .store(self.end, std::sync::atomic::Ordering::SeqCst);
+            self.emitter
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .failed = true;
+            self.turn.notify_all();
+        }
+    }
 }
 
 /// [`run_blocks_with`] with the engine `prepared`.
@@ -162,25 +188,38 @@ pub fn run_blocks_prepared(
         waiting: Default::default(),
         spare: Vec::new(),
         done: 0,
+        failed: false,
         progress,
         on_block,
     });
     let turn = Condvar::new();
     let lock = || emitter.lock().unwrap_or_else(|e| e.into_inner());
     let worker = || {
+        let _abort = Abort {
+            emitter: &emitter,
+            turn: &turn,
+            claimed: &claimed,
+            end: blocks.end,
+        };
         let mut scratch = Scratch::default();
         loop {
             let b = claimed.fetch_add(1, Ordering::Relaxed);
             if b >= blocks.end {
                 return;
             }
-            // Every block before b is claimed by a running worker, so the wait ends.
-            let mut acc = turn
-                .wait_while(lock(), |e| b >= e.next + window)
-                .unwrap_or_else(|e| e.into_inner())
+            // Every block before b is claimed by a running worker, so the wait ends (or a
+            // worker failed, and the run with it).
+            let mut e = turn
+                .wait_while(lock(), |e| !e.failed && b >= e.next + window)
+                .unwrap_or_else(|e| e.into_inner());
+            if e.failed {
+                return;
+            }
+            let mut acc = e
                 .spare
                 .pop()
                 .unwrap_or_else(|| Accumulator::new(&layout, model.residual_pair));
+            drop(e);
             let chunks = partition.block_chunks(b);
             let range = partition.chunk_realizations(chunks.start).start
                 ..partition.chunk_realizations(chunks.end - 1).end;
@@ -194,6 +233,9 @@ pub fn run_blocks_prepared(
                 &mut scratch,
             );
             let mut e = lock();
+            if e.failed {
+                return;
+            }
             e.waiting.insert(b, acc);
             let mut advanced = false;
             loop {

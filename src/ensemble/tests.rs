@@ -118,3 +118,39 @@ fn streaming_moments_match_a_two_pass_computation() {
     let pair = moment(2 * earlier, 2 * later + 1);
     approx::assert_relative_eq!(stats.pair_moments[1], pair, max_relative = 1e-9);
 }
+
+/// A panic in one block (here in the caller's `on_block`) reaches the caller instead of leaving
+/// the other workers waiting for the lost block.
+#[test]
+fn a_panicking_block_ends_the_run_with_the_panic() {
+    let (m, s) = small();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let two = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            two.install(|| {
+                // 40 blocks of one chunk: far more than the window of blocks in flight.
+                run_blocks_with(
+                    Engine::Epoch,
+                    &m,
+                    &s,
+                    1,
+                    40 * CHUNK,
+                    0..40,
+                    |_| {},
+                    |b, _| {
+                        assert!(b != 0, "a failing block");
+                    },
+                )
+            })
+        }));
+        tx.send(result.is_err()).unwrap();
+    });
+    let panicked = rx
+        .recv_timeout(std::time::Duration::from_secs(60))
+        .expect("the run returned");
+    assert!(panicked);
+}

@@ -13,11 +13,13 @@
 //! Single precision within a pass doubles the products per instruction. Its rounding is far
 //! below the sampling noise of the sums: a pass's sum of K = 128 products is within
 //! [`PRODUCT_RELATIVE_ERROR`] ≈ 7.7·10⁻⁶ of the exact sum relative to √(Σρ_a²·Σρ_b²) (the
-//! worst case; typically √K·2⁻²⁴ ≈ 7·10⁻⁷), and these errors are independent from pass to
-//! pass, so a correlation estimated from N realizations moves by about 7·10⁻⁷/√K ≈ 6·10⁻⁸ of its
-//! own standard error, whatever N. Measured: 1.1·10⁻⁷ relative at most over 40 passes of random
-//! residuals (tests below), and every number of the default report within 4.4·10⁻⁷ relative of
-//! the double-precision sums, every verdict and count unchanged (docs/SPEED.md).
+//! worst case, to first order), and the errors of different passes are independent, so a sum
+//! over N realizations moves by about 2⁻²⁴·√K ≈ 7·10⁻⁷ of its own standard error, whatever N.
+//! Measured: 1.1·10⁻⁷ relative at most over 40 passes of random residuals (tests below), and
+//! every number of the default report within 4.4·10⁻⁷ relative of the double-precision sums,
+//! every verdict and count unchanged (docs/SPEED.md). Residuals are assumed within single
+//! precision's range (|ρ| between about 10⁻¹⁹ and 10¹⁹, so that no product underflows or
+//! overflows): metres and metres per second are.
 
 use super::layout::ResidualLayout;
 
