@@ -221,14 +221,14 @@ fn stats(prepared: &Prepared, m: &Model, s: &FilterSchedule, seed: u64, n: u64) 
     EnsembleStats::from_sums(&ensemble::run_prepared(prepared, m, s, seed, n, |_| {}), s)
 }
 
-/// N = 50 000 per engine and case. 4 cases × 150 fixes × 2 stages × 10 scores = 12 000 members;
+/// N = 100 000 per engine and case. 4 cases × 150 fixes × 2 stages × 10 scores = 12 000 members;
 /// with the Bonferroni bound at a family-wise rate of 10⁻³ (|z| ≤ 5.4) a false alarm has
 /// probability below 10⁻³ (the scores are positively correlated across fixes, which only
 /// lowers it).
 #[test]
 fn the_engines_agree_in_distribution() {
     let c = Config::default();
-    let n = 50_000;
+    let n = 100_000;
     let mut scores = Vec::new();
     for case in ALL_CASES {
         let (m, s) = model(&c, case);
@@ -255,10 +255,10 @@ fn the_engines_agree_in_distribution() {
 }
 
 /// Negative control: the same comparison, Euler truth with point samples, against an epoch
-/// engine whose interval noise covariance is 1.1× the true one; N = 200 000 per engine. Measured
-/// at N = 100 000 (seed 4), the mean a priori NEES of the last fixes differs by z ≈ −6.7 (−14.7
-/// at 1.2×, −38.8 at 1.5×); at twice the N the expected score is about −9.5, far beyond the bound
-/// of 5.4 the comparison uses for its 12 000 members.
+/// engine whose interval noise covariance is 1.1× the true one; N = 200 000 per engine. Measured:
+/// the mean a priori NEES at the last fix differs by z = −11.7, far beyond the bound of 5.4 the
+/// comparison uses for its 12 000 members (at N = 100 000 it was −6.7, at 1.2× −14.7, at 1.5×
+/// −38.8).
 #[test]
 fn the_comparison_detects_a_wrong_interval_covariance() {
     let c = Config::default();
