@@ -1,9 +1,10 @@
 //! The Monte Carlo ensemble: N realizations run in parallel and accumulated as they are produced.
 //!
 //! Memory does not grow with N: realizations are grouped into chunks of [`CHUNK`] consecutive
-//! indices, each chunk is summed into its own [`Accumulator`], and chunk accumulators are merged
-//! into the total in chunk order. The chunk boundaries depend on N alone, so the result is
-//! bit-for-bit the same on one thread or many.
+//! indices and blocks of consecutive chunks; each block is summed into its own [`Accumulator`]
+//! by one worker, chunk after chunk, and the blocks are merged into the total in block order.
+//! The boundaries depend on N alone, so the result is bit-for-bit the same on one thread or
+//! many.
 
 mod engine;
 pub mod epoch;
@@ -41,8 +42,8 @@ pub fn layout_of(model: &Model) -> ResidualLayout {
 pub const MAX_BLOCKS: u64 = 256;
 
 /// How the N realizations of an ensemble are grouped, by N alone: chunks of [`CHUNK`]
-/// consecutive indices, each summed into its own accumulator; blocks of consecutive chunks,
-/// each the fold of its chunks in order; the ensemble is the fold of its blocks in order. A
+/// consecutive indices; blocks of consecutive chunks, each summed chunk after chunk in a fixed
+/// order (see [`accumulate_into`]); the ensemble is the fold of its blocks in order. A
 /// shard runs whole blocks, so shards merged in block order give the sums of one run, number
 /// for number.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
