@@ -107,7 +107,7 @@ crate::lanes::vectorized! {
     /// A chunk's realizations go in lane groups of [`LANES`], all advanced fix by fix: at each
     /// fix every lane adds its realization into its own sums, and the lanes are added up in lane
     /// order, onto the sums so far, when every group has passed the fix. The chunk's residual
-    /// products are then added in one pass over its stacked residuals (see [`tiles`]).
+    /// products are then added in one pass over its stacked residuals (see `ensemble::tiles`).
     pub fn accumulate_into(
         prepared: &Prepared,
         model: &Model,

@@ -25,7 +25,7 @@ pub use lane_sums::LaneFix;
 pub use layout::ResidualLayout;
 pub use stats::{EnsembleStats, FixStats, StageStats};
 pub use sums::{Accumulator, FixSums, StageSums};
-pub use tiles::PRODUCT_RELATIVE_ERROR;
+pub use tiles::{PASS, PRODUCT_RELATIVE_ERROR};
 
 /// Realizations summed sequentially into one accumulator before it is merged.
 pub const CHUNK: u64 = 64;

@@ -149,7 +149,7 @@ pub struct ResidualPairs {
     pub max_lag: usize,
 }
 
-/// The summary of a [`MeanErrorPrediction`].
+/// The summary of a [`MeanErrorPrediction`](crate::study::analysis::MeanErrorPrediction).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PredictionSummary {
     /// The worst |e_ave − m_pred| / (σ/√N) over fixes, stages and states.

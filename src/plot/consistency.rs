@@ -98,7 +98,7 @@ impl Statistic<'_> {
 /// its expected value 3 and the χ² band of `nees`. Bottom: the average NIS (1/N) Σ rᵀS⁻¹r against
 /// 2 and the band of `nis`.
 ///
-/// A statistic that reaches [`FAR_RATIO`] times its band's upper end (33 against a band
+/// A statistic that reaches `FAR_RATIO` (3) times its band's upper end (33 against a band
 /// [2.9, 3.1], say) would flatten the band to a line on a linear axis: its row then shows the
 /// whole run on a log axis, and beside it the run again on an axis enlarged around the band.
 pub fn consistency(stats: &EnsembleStats, nees: &Check, nis: &Check) -> PlotResult {
