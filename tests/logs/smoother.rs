@@ -50,8 +50,11 @@ fn smoothed_errors_are_consistent_with_their_sigma_over_an_ensemble() {
     config.ensemble.truth = TruthModel::Euler;
     let (model, schedule) = common::model_of(&config);
     let settings = Settings::from_model(&model);
-    // Σ_l (e_l / σ_l)² per sample and state: χ²(L) for a consistent smoother.
+    // Σ_l (e_l / σ_l)² per sample and state: χ²(L) for a consistent smoother. Negative control,
+    // `wrong`: the filtered estimates judged against the smoothed σ, which the same test must
+    // reject (before the last fix the smoother is more certain than the filter).
     let mut sums = [[0.0f64; 3]; SAMPLES.len()];
+    let mut wrong = [[0.0f64; 3]; SAMPLES.len()];
     for l in 0..realizations {
         let (mut accel, mut gps, mut truth) = (Vec::new(), Vec::new(), Vec::new());
         let mut writer = LogWriter::new(&model.timeline, &mut accel, &mut gps, &mut truth).unwrap();
@@ -77,12 +80,20 @@ fn smoothed_errors_are_consistent_with_their_sigma_over_an_ensemble() {
             for k in 0..3 {
                 let z = (true_dx[k] - e[10 + k]) / e[13 + k];
                 sums[m][k] += z * z;
+                let z = (true_dx[k] - e[4 + k]) / e[13 + k];
+                wrong[m][k] += z * z;
             }
         }
     }
     let members = (SAMPLES.len() * 3) as f64;
     let (lo, hi) = chi_squared_band(realizations as f64, 1.0, 0.01 / members);
-    eprintln!("χ²({realizations}) band [{lo:.1}, {hi:.1}]; sums {sums:.1?}");
+    eprintln!("χ²({realizations}) band [{lo:.1}, {hi:.1}]; sums {sums:.1?}; control {wrong:.1?}");
+    let rejected = wrong
+        .iter()
+        .flatten()
+        .filter(|s| !(lo..=hi).contains(*s))
+        .count();
+    assert!(rejected > 0, "the control was not rejected: {wrong:?}");
     for (m, row) in sums.iter().enumerate() {
         for (k, &s) in row.iter().enumerate() {
             assert!(
