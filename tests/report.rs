@@ -304,6 +304,26 @@ fn conclusions_follow_the_verdicts() {
     );
 }
 
+/// With no sampled ensembles the sensitivity section says so, and quotes no sampling error.
+#[test]
+fn a_report_without_sampled_detection_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = report(
+        dir.path(),
+        "[profile]\nduration_s = 2.0\n[ensemble]\nrealizations = 200\n[sensitivity]\ndraws = 0\n",
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = page(dir.path());
+    assert!(
+        html.contains("It is not sampled in this report"),
+        "no word on the missing sample"
+    );
+    assert!(
+        !html.contains("√0") && !html.contains(" 0 ensembles"),
+        "a sample of none quoted"
+    );
+}
+
 #[test]
 fn a_short_run_quotes_only_times_within_it() {
     let dir = tempfile::tempdir().unwrap();

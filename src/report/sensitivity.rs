@@ -196,6 +196,7 @@ pub fn view(s: &Sensitivity, numbers: &mut Numbering) -> Result<SensitivityView,
         realizations: count(s.plan.realizations),
         ensembles: count(s.plan.ensembles),
         draws: count(s.cases.first().map_or(0, |c| c.draws)),
+        sampled: s.cases.first().is_some_and(|c| c.draws > 0),
         engine_words: match s.plan.engine {
             Engine::Sample => "per-sample engine (every accelerometer sample drawn and integrated)",
             Engine::Epoch => "epoch engine (one exact draw of the accelerometer noise's effect per GPS interval, the same distribution at the fixes as sample by sample)",

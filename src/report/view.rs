@@ -352,6 +352,8 @@ pub struct SensitivityView {
     pub ensembles: String,
     /// Sampled ensembles per case behind the predictions.
     pub draws: String,
+    /// Whether the detection was sampled at all (`sensitivity.draws` > 0).
+    pub sampled: bool,
     /// The engine of the Monte Carlo ensembles, in words.
     pub engine_words: String,
     /// Ensembles per case, in words: "one independent Monte Carlo ensemble".
