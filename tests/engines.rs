@@ -283,29 +283,7 @@ fn the_comparison_detects_a_wrong_interval_covariance() {
 }
 
 fn accelcal(args: &[&str], dir: &std::path::Path) -> std::process::Output {
-    std::process::Command::new(common::bin())
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the binary runs")
-}
-
-/// The JSON of `path` without its timing fields.
-fn summary(path: &std::path::Path) -> serde_json::Value {
-    fn strip(v: &mut serde_json::Value) {
-        match v {
-            serde_json::Value::Object(m) => {
-                m.remove("elapsed_s");
-                m.remove("realizations_per_s");
-                m.values_mut().for_each(strip);
-            }
-            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
-            _ => {}
-        }
-    }
-    let mut v = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
-    strip(&mut v);
-    v
+    common::run_in(dir, args, None)
 }
 
 /// `accelcal ensemble --engine epoch` names its engine in the summary; its shards merge into the
@@ -326,10 +304,10 @@ fn the_engine_is_recorded_and_shards_of_different_engines_do_not_merge() {
     let base = ["ensemble", "--config", "c.toml", "--quiet"];
     run(&[&base[..], &["--engine", "epoch", "--json", "one.json"]].concat());
     run(&[&base[..], &["--json", "sample.json"]].concat());
-    let one = summary(&d.join("one.json"));
+    let one = common::summary_without_timing(&d.join("one.json"));
     assert_eq!(one["summary"]["engine"], "epoch");
     assert_eq!(
-        summary(&d.join("sample.json"))["summary"]["engine"],
+        common::summary_without_timing(&d.join("sample.json"))["summary"]["engine"],
         "sample"
     );
     for (k, engine) in [(1, "epoch"), (2, "epoch"), (2, "sample")] {
@@ -349,7 +327,7 @@ fn the_engine_is_recorded_and_shards_of_different_engines_do_not_merge() {
         "merged.json",
         "--quiet",
     ]);
-    assert_eq!(summary(&d.join("merged.json")), one);
+    assert_eq!(common::summary_without_timing(&d.join("merged.json")), one);
     let o = accelcal(&["merge", "epoch1.bin", "sample2.bin", "--quiet"], d);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);

@@ -12,34 +12,11 @@ const CONFIG: &str =
     "[profile]\nduration_s = 4.0\n[ensemble]\nrealizations = 1500\ntruth = \"euler\"\n";
 
 fn accelcal(args: &[&str], dir: &Path, threads: usize) -> Output {
-    Command::new(common::bin())
-        .args(args)
-        .current_dir(dir)
-        .env("RAYON_NUM_THREADS", threads.to_string())
-        .output()
-        .expect("the binary runs")
+    common::run_in(dir, args, Some(threads))
 }
 
 fn ok(o: &Output) {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-}
-
-/// The JSON of `path` without its timing fields.
-fn summary(path: &Path) -> serde_json::Value {
-    fn strip(v: &mut serde_json::Value) {
-        match v {
-            serde_json::Value::Object(m) => {
-                m.remove("elapsed_s");
-                m.remove("realizations_per_s");
-                m.values_mut().for_each(strip);
-            }
-            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
-            _ => {}
-        }
-    }
-    let mut v = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
-    strip(&mut v);
-    v
 }
 
 fn shard(dir: &Path, k: usize, m: usize, seed: &str, file: &str, threads: usize) {
@@ -81,7 +58,7 @@ fn three_shards_merged_in_any_order_equal_one_run() {
     for (k, threads) in [(1, 1), (2, 2), (3, 3)] {
         shard(d, k, 3, "2017", &format!("p{k}.bin"), threads);
     }
-    let whole = summary(&d.join("whole.json"));
+    let whole = common::summary_without_timing(&d.join("whole.json"));
     for order in [
         ["p1.bin", "p2.bin", "p3.bin"],
         ["p3.bin", "p1.bin", "p2.bin"],
@@ -90,7 +67,11 @@ fn three_shards_merged_in_any_order_equal_one_run() {
         args.extend(order);
         args.extend(["--json", "merged.json", "--quiet"]);
         ok(&accelcal(&args, d, 2));
-        assert_eq!(summary(&d.join("merged.json")), whole, "order {order:?}");
+        assert_eq!(
+            common::summary_without_timing(&d.join("merged.json")),
+            whole,
+            "order {order:?}"
+        );
     }
     // A differing ensemble is seen: the comparison is not vacuous.
     ok(&accelcal(
@@ -107,7 +88,7 @@ fn three_shards_merged_in_any_order_equal_one_run() {
         d,
         2,
     ));
-    assert_ne!(summary(&d.join("other.json")), whole);
+    assert_ne!(common::summary_without_timing(&d.join("other.json")), whole);
 }
 
 /// `merge` with `files` must exit 2 naming `culprit` and write nothing.
@@ -198,7 +179,7 @@ fn long_runs_test_lags_and_say_so() {
         d,
         2,
     ));
-    let e = summary(&d.join("e.json"));
+    let e = common::summary_without_timing(&d.join("e.json"));
     let s = &e["summary"];
     assert_eq!(s["all_passed"], true, "{}", s["checks"]);
     assert_eq!(s["residual_pairs"]["all_pairs"], false);
@@ -264,5 +245,8 @@ fn the_slurm_example_runs_each_array_task_as_a_shard() {
         d,
         2,
     ));
-    assert_eq!(summary(&d.join("m.json")), summary(&d.join("whole.json")));
+    assert_eq!(
+        common::summary_without_timing(&d.join("m.json")),
+        common::summary_without_timing(&d.join("whole.json"))
+    );
 }

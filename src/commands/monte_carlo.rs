@@ -204,8 +204,8 @@ fn run_shard(
     // The header carries the run time, so blocks wait in a second temporary until the run ends.
     let spool = tempfile_beside(path)?;
     let mut spool_w = std::io::BufWriter::new(std::fs::File::create(&spool)?);
-    ensemble::run_blocks_with(
-        engine,
+    ensemble::run_blocks_prepared(
+        &ensemble::Prepared::new(engine, model, schedule),
         model,
         schedule,
         e.seed,

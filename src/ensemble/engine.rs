@@ -95,7 +95,7 @@ pub fn accumulate(
 pub struct Scratch {
     tiles: Vec<f64>,
     panels: Vec<f32>,
-    lanes: Option<LaneSums>,
+    lanes: LaneSums,
     /// Per lane group, the residuals at the fixes i and m of the single pair (see
     /// [`Accumulator::pair`]).
     pair: Vec<[[Lanes; 2]; 2]>,
@@ -163,10 +163,6 @@ fn accumulate_lanes(
     if range.is_empty() {
         tiles.fill(0.0);
     }
-    let lanes = match lanes {
-        Some(l) if l.fixes() == schedule.fixes.len() => l,
-        _ => lanes.insert(LaneSums::new(schedule)),
-    };
     lanes.set_weights(schedule);
     let m = 2 * schedule.fixes.len();
     let key = stream_key(seed, model.case());

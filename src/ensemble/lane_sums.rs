@@ -106,29 +106,15 @@ struct Weights {
     s: [f64; 3],
 }
 
-/// The per-lane sums of the fix being summed, and the weights of every fix's quadratic forms.
-#[derive(Clone, Debug)]
+/// The per-lane sums of the fix being summed, and the weights of every fix's quadratic forms
+/// (none until [`LaneSums::set_weights`]).
+#[derive(Clone, Debug, Default)]
 pub struct LaneSums {
     current: LaneFixSums,
     weights: Vec<Weights>,
 }
 
 impl LaneSums {
-    /// Empty sums for the fixes of `schedule`.
-    pub fn new(schedule: &FilterSchedule) -> Self {
-        let mut s = Self {
-            current: LaneFixSums::default(),
-            weights: Vec::new(),
-        };
-        s.set_weights(schedule);
-        s
-    }
-
-    /// Number of fixes.
-    pub fn fixes(&self) -> usize {
-        self.weights.len()
-    }
-
     /// Takes the weights of the quadratic forms from `schedule`, with empty sums.
     pub fn set_weights(&mut self, schedule: &FilterSchedule) {
         let upper = |m: &Matrix3| {

@@ -97,26 +97,6 @@ impl Partition {
     }
 }
 
-/// Runs blocks `blocks` of the `n` realizations of `model` under `seed` in parallel with the
-/// engine `engine`, and hands each block's sums to `on_block` as it is finished, in block order.
-/// `progress` is called with the number of realizations of these blocks finished so far.
-#[allow(clippy::too_many_arguments)]
-pub fn run_blocks_with(
-    engine: Engine,
-    model: &Model,
-    schedule: &FilterSchedule,
-    seed: u64,
-    n: u64,
-    blocks: std::ops::Range<u64>,
-    progress: impl FnMut(u64) + Send,
-    on_block: impl FnMut(u64, &Accumulator) + Send,
-) {
-    let prepared = Prepared::new(engine, model, schedule);
-    run_blocks_prepared(
-        &prepared, model, schedule, seed, n, blocks, progress, on_block,
-    );
-}
-
 /// Finished blocks waiting for their turn, and the callbacks that take them in block order.
 struct Emitter<P, B> {
     /// The next block to hand over.
@@ -155,7 +135,9 @@ impl<P, B> Drop for Abort<'_, P, B> {
     }
 }
 
-/// [`run_blocks_with`] with the engine `prepared`.
+/// Runs blocks `blocks` of the `n` realizations of `model` under `seed` in parallel with the
+/// engine `prepared`, and hands each block's sums to `on_block` as it is finished, in block
+/// order. `progress` is called with the number of realizations of these blocks finished so far.
 ///
 /// Each block is summed by one thread, chunk after chunk (see [`accumulate_into`]): its sums
 /// depend on the block's realizations alone, never on the thread count. One worker per thread

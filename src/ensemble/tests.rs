@@ -133,8 +133,8 @@ fn a_panicking_block_ends_the_run_with_the_panic() {
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             two.install(|| {
                 // 40 blocks of one chunk: far more than the window of blocks in flight.
-                run_blocks_with(
-                    Engine::Epoch,
+                run_blocks_prepared(
+                    &Prepared::new(Engine::Epoch, &m, &s),
                     &m,
                     &s,
                     1,

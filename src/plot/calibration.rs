@@ -33,14 +33,6 @@ fn fitted(name: &str, unit: &str, values: impl IntoIterator<Item = f64>, ticks: 
     Axis::linear(name, unit, range, ticks)
 }
 
-fn layout(y_area_px: u32, last: bool) -> Layout {
-    Layout {
-        y_area_px,
-        x_title: last,
-        title: true,
-    }
-}
-
 /// Top: the bias estimate at every fix, filtered (a posteriori) and smoothed, each with ±1σ.
 /// Bottom: the two σ on a log axis. The axes of the top panel are fitted after the first second
 /// (or quarter of the log), where the prior's σ has collapsed.
@@ -87,7 +79,7 @@ pub fn calibration_bias(fixes: &[FixReport]) -> PlotResult {
             "Bias estimate at each fix, ±1σ",
             time.clone(),
             bias_axis,
-            layout(y_area_px, false),
+            Layout::titled(y_area_px, false),
         )?;
         let band = |k: &dyn Fn(&FixReport) -> (f64, f64), sign: f64| -> Vec<f64> {
             fixes
@@ -125,7 +117,7 @@ pub fn calibration_bias(fixes: &[FixReport]) -> PlotResult {
             "σ of the bias: filtered and smoothed",
             time,
             sigma_axis,
-            layout(y_area_px, true),
+            Layout::titled(y_area_px, true),
         )?;
         q.line(
             fixes.iter().map(|f| (f.t_s, f.filtered_sigma[2])),
@@ -202,7 +194,7 @@ pub fn calibration_trajectory(fixes: &[FixReport]) -> PlotResult {
                 &format!("{}: GPS, integrated, corrected", super::capitalized(name)),
                 time.clone(),
                 left[row].clone(),
-                layout(left_px, last),
+                Layout::titled(left_px, last),
             )?;
             p.line(
                 fixes.iter().map(|f| (f.t_s, f.integrated[k])),
@@ -222,7 +214,7 @@ pub fn calibration_trajectory(fixes: &[FixReport]) -> PlotResult {
                 &format!("{} drift of the integration", super::capitalized(name)),
                 time.clone(),
                 right[row].clone(),
-                layout(right_px, last),
+                Layout::titled(right_px, last),
             )?;
             let lo: Vec<f64> = fixes
                 .iter()
@@ -289,7 +281,7 @@ pub fn calibration_residuals(fixes: &[FixReport]) -> PlotResult {
                 &format!("{} at each fix", super::capitalized(names[k].0)),
                 time.clone(),
                 axes[k].clone(),
-                layout(y_area_px, k == 1),
+                Layout::titled(y_area_px, k == 1),
             )?;
             let s: Vec<f64> = fixes.iter().map(|f| f.residual_sigma[k]).collect();
             let scaled = |c: f64| s.iter().map(|v| c * v).collect::<Vec<_>>();
@@ -338,7 +330,7 @@ pub fn calibration_nis(fixes: &[FixReport], test: &NisTest) -> PlotResult {
             ),
             time,
             axis,
-            layout(y_area_px, true),
+            Layout::titled(y_area_px, true),
         )?;
         p.hline(2.0, BLACK.mix(0.4).stroke_width(1))?;
         p.hline(test.per_fix_lower, BLACK.stroke_width(1))?;

@@ -64,11 +64,7 @@ fn per_state(
             &title(k),
             time.clone(),
             axes[k].clone(),
-            Layout {
-                y_area_px,
-                x_title: k == 2,
-                title: true,
-            },
+            Layout::titled(y_area_px, k == 2),
         )?;
         draw(&p, k)?;
         Ok(())
@@ -137,11 +133,7 @@ pub fn accuracy_ratio(cases: &[CaseSeries<'_>]) -> PlotResult {
                 &title,
                 time.clone(),
                 axis.clone(),
-                Layout {
-                    y_area_px: area,
-                    x_title: k == 2,
-                    title: true,
-                },
+                Layout::titled(area, k == 2),
             )?;
             p.hline(1.0, BLACK.stroke_width(1))?;
             p.hline(1.05, REFERENCE.stroke_width(1))?;

@@ -162,11 +162,7 @@ pub fn consistency(stats: &EnsembleStats, nees: &Check, nis: &Check) -> PlotResu
         let parts = rows(root, &[legend_px, ROW_PX]);
         draw_legend(&parts[0], &legend)?;
         for (row, (stat, scale)) in statistics.iter().zip(&scales).enumerate() {
-            let layout = |y_area_px| Layout {
-                y_area_px,
-                x_title: row == 1,
-                title: true,
-            };
+            let layout = |y_area_px| Layout::titled(y_area_px, row == 1);
             let over = if row == 0 {
                 format!(
                     " over N = {} realizations",

@@ -85,11 +85,7 @@ pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
     ];
     render_state_rows(ROW_PX, &legend, |area, k| {
         let cols = columns(area, &[WIDTH_PX / 2]);
-        let layout = |y_area_px| Layout {
-            y_area_px,
-            x_title: k == 2,
-            title: true,
-        };
+        let layout = |y_area_px| Layout::titled(y_area_px, k == 2);
         let name = state_name(k);
         let p = Panel::new(
             &cols[0],

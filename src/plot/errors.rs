@@ -37,16 +37,12 @@ pub fn realization_errors(r: &Realization) -> PlotResult {
     let zoom_time = Axis::linear("time", "s", zoom, 5);
     let error_axes: Vec<Axis> = (0..3).map(|k| error_axis(r, k, settle)).collect();
     let sigma_axes: Vec<Axis> = (0..3).map(|k| sigma_axis(r, k, zoom)).collect();
-    let full_layout = |last: bool| Layout {
-        y_area_px: y_label_area(&error_axes.iter().collect::<Vec<_>>()),
-        x_title: last,
-        title: true,
-    };
-    let zoom_layout = |last: bool| Layout {
-        y_area_px: y_label_area(&sigma_axes.iter().collect::<Vec<_>>()),
-        x_title: last,
-        title: true,
-    };
+    let (full_area, zoom_area) = (
+        y_label_area(&error_axes.iter().collect::<Vec<_>>()),
+        y_label_area(&sigma_axes.iter().collect::<Vec<_>>()),
+    );
+    let full_layout = |last: bool| Layout::titled(full_area, last);
+    let zoom_layout = |last: bool| Layout::titled(zoom_area, last);
 
     let legend = [
         Entry::new(Swatch::Line(BLUE.stroke_width(1)), "error e = δx − δx̂"),

@@ -83,11 +83,7 @@ pub fn mean_error(stats: &EnsembleStats, check: &Check, predicted: &[[[f64; 3]; 
     render_state_rows(ROW_PX, &legend, |area, k| {
         let cols = columns(area, &[FULL_COLUMN_PX]);
         let name = capitalized(state_name(k));
-        let layout = |y_area_px| Layout {
-            y_area_px,
-            x_title: k == 2,
-            title: true,
-        };
+        let layout = |y_area_px| Layout::titled(y_area_px, k == 2);
         let full = Panel::new(
             &cols[0],
             &format!(

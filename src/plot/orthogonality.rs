@@ -61,11 +61,7 @@ pub fn orthogonality(stats: &EnsembleStats, check: &Check) -> PlotResult {
                 ),
                 time.clone(),
                 y.clone(),
-                Layout {
-                    y_area_px,
-                    x_title: j == 2,
-                    title: true,
-                },
+                Layout::titled(y_area_px, j == 2),
             )?;
             p.hline(0.0, REFERENCE.stroke_width(1))?;
             p.hline(check.upper, BLACK.stroke_width(1))?;

@@ -117,6 +117,17 @@ pub(crate) struct Layout {
     pub title: bool,
 }
 
+impl Layout {
+    /// A panel with a title strip, its x-axis title shown when `x_title` (the bottom row).
+    pub fn titled(y_area_px: u32, x_title: bool) -> Self {
+        Self {
+            y_area_px,
+            x_title,
+            title: true,
+        }
+    }
+}
+
 /// A framed chart with its axes, ready to draw data in data coordinates.
 pub(crate) struct Panel<'b> {
     chart: Chart<'b>,

@@ -151,11 +151,7 @@ pub fn residual_whiteness(stats: &EnsembleStats, check: &Check, pair: &ResidualP
             &map_title,
             map_x,
             map_y,
-            Layout {
-                y_area_px: map_area,
-                x_title: true,
-                title: true,
-            },
+            Layout::titled(map_area, true),
         )?;
         // Levels of every cell, by row (block of t_i) and column (block of t_m ≤ t_i).
         let grid: Vec<Vec<Option<usize>>> = (0..cells)
@@ -220,11 +216,7 @@ pub fn residual_whiteness(stats: &EnsembleStats, check: &Check, pair: &ResidualP
             ),
             pair_x,
             pair_y,
-            Layout {
-                y_area_px: pair_area,
-                x_title: true,
-                title: true,
-            },
+            Layout::titled(pair_area, true),
         )?;
         p.vline(0.0, REFERENCE.stroke_width(1))?;
         p.vline(pair.bound, BLACK.stroke_width(1))?;

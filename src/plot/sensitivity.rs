@@ -76,11 +76,7 @@ pub fn sigma_ratio(series: &[SensitivitySeries]) -> PlotResult {
             ),
             x.clone(),
             axes[k].clone(),
-            Layout {
-                y_area_px,
-                x_title: k == 2,
-                title: true,
-            },
+            Layout::titled(y_area_px, k == 2),
         )?;
         p.hline(1.0, GREY.stroke_width(1))?;
         for (i, s) in series.iter().enumerate() {

@@ -119,11 +119,7 @@ pub fn trajectory(r: &Realization) -> PlotResult {
             [None, Some(|x| x.computed_v_m_s), Some(|x| x.computed_p_m)];
         for row in 0..3 {
             let cols = columns(&parts[row + 1], &[WIDTH_PX / 2]);
-            let layout = |y_area_px| Layout {
-                y_area_px,
-                x_title: row == 2,
-                title: true,
-            };
+            let layout = |y_area_px| Layout::titled(y_area_px, row == 2);
             let p = Panel::new(
                 &cols[0],
                 titles_left[row],

@@ -3,6 +3,9 @@
 
 pub mod plain;
 
+use std::path::Path;
+use std::process::{Command, Output};
+
 use accelcal::checks::Verdicts;
 use accelcal::config::{Config, TruthModel};
 use accelcal::filter::FilterSchedule;
@@ -30,4 +33,32 @@ pub fn verdicts_of(config: &Config, truth: TruthModel) -> Verdicts {
 /// Path of the built binary.
 pub fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_accelcal")
+}
+
+/// Runs the binary with `args` in `dir`; `threads` sets its thread count when given.
+pub fn run_in(dir: &Path, args: &[&str], threads: Option<usize>) -> Output {
+    let mut c = Command::new(bin());
+    c.args(args).current_dir(dir);
+    if let Some(t) = threads {
+        c.env("RAYON_NUM_THREADS", t.to_string());
+    }
+    c.output().expect("the binary runs")
+}
+
+/// The JSON of `path` without its timing fields (`elapsed_s`, `realizations_per_s`).
+pub fn summary_without_timing(path: &Path) -> serde_json::Value {
+    fn strip(v: &mut serde_json::Value) {
+        match v {
+            serde_json::Value::Object(m) => {
+                m.remove("elapsed_s");
+                m.remove("realizations_per_s");
+                m.values_mut().for_each(strip);
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    let mut v = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    strip(&mut v);
+    v
 }

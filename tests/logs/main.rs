@@ -12,15 +12,11 @@ mod round_trip;
 mod smoother;
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 /// Runs the binary in `dir`.
 pub fn run(args: &[&str], dir: &Path) -> Output {
-    Command::new(common::bin())
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the binary runs")
+    common::run_in(dir, args, None)
 }
 
 /// Standard error as text.
