@@ -7,8 +7,8 @@ use plotters::style::{Color, ShapeStyle};
 
 use super::axis::{Axis, y_label_area};
 use super::geometry::{Point, extent, padded, settled_from, time_span};
-use super::legend::{Entry, Swatch, draw_legend, legend_height};
-use super::panel::{Layout, Panel, columns, render, rows};
+use super::legend::{Entry, Swatch, render_under_legend};
+use super::panel::{Layout, Panel, columns};
 use super::{BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotError, PlotResult, VERMILLION, WIDTH_PX};
 use crate::calibrate::NisTest;
 use crate::calibrate::summary::FixReport;
@@ -69,13 +69,10 @@ pub fn calibration_bias(fixes: &[FixReport]) -> PlotResult {
         Entry::new(Swatch::Line(BLUE.stroke_width(2)), "smoothed"),
         Entry::new(Swatch::Block(BLUE.mix(0.2).filled()), "smoothed ±1σ"),
     ];
-    let legend_px = legend_height(&legend);
-    render(legend_px + 2 * ROW_PX + 30, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX]);
-        draw_legend(&parts[0], &legend)?;
+    render_under_legend(&legend, &[ROW_PX, ROW_PX + 30], 0, |parts| {
         let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
         let p = Panel::new(
-            &parts[1],
+            &parts[0],
             "Bias estimate at each fix, ±1σ",
             time.clone(),
             bias_axis,
@@ -113,7 +110,7 @@ pub fn calibration_bias(fixes: &[FixReport]) -> PlotResult {
             BLUE.stroke_width(2),
         )?;
         let q = Panel::new(
-            &parts[2],
+            &parts[1],
             "σ of the bias: filtered and smoothed",
             time,
             sigma_axis,
@@ -180,14 +177,11 @@ pub fn calibration_trajectory(fixes: &[FixReport]) -> PlotResult {
         Entry::new(Swatch::Line(BLUE.stroke_width(2)), "corrected (smoothed)"),
         Entry::new(Swatch::Block(BLUE.mix(0.2).filled()), "smoothed ±1σ"),
     ];
-    let legend_px = legend_height(&legend);
-    render(legend_px + 2 * ROW_PX + 30, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX]);
-        draw_legend(&parts[0], &legend)?;
+    render_under_legend(&legend, &[ROW_PX, ROW_PX + 30], 0, |parts| {
         let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
         for (row, &k) in comp.iter().enumerate() {
             let last = row == 1;
-            let cols = columns(&parts[row + 1], &[WIDTH_PX / 2]);
+            let cols = columns(&parts[row], &[WIDTH_PX / 2]);
             let (name, _) = names[row];
             let p = Panel::new(
                 &cols[0],
@@ -270,14 +264,11 @@ pub fn calibration_residuals(fixes: &[FixReport]) -> PlotResult {
         Entry::new(Swatch::Block(ORANGE.mix(0.35).filled()), "±√S (1σ)"),
         Entry::new(Swatch::Block(ORANGE.mix(0.15).filled()), "±2√S"),
     ];
-    let legend_px = legend_height(&legend);
-    render(legend_px + 2 * ROW_PX + 30, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX]);
-        draw_legend(&parts[0], &legend)?;
+    render_under_legend(&legend, &[ROW_PX, ROW_PX + 30], 0, |parts| {
         let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
         for k in 0..2 {
             let p = Panel::new(
-                &parts[k + 1],
+                &parts[k],
                 &format!("{} at each fix", super::capitalized(names[k].0)),
                 time.clone(),
                 axes[k].clone(),
@@ -318,12 +309,9 @@ pub fn calibration_nis(fixes: &[FixReport], test: &NisTest) -> PlotResult {
         ),
         Entry::new(Swatch::Line(BLACK.stroke_width(1)), "per-fix χ²(2) band"),
     ];
-    let legend_px = legend_height(&legend);
-    render(legend_px + ROW_PX + 30, |root| {
-        let parts = rows(root, &[legend_px]);
-        draw_legend(&parts[0], &legend)?;
+    render_under_legend(&legend, &[ROW_PX + 30], 0, |parts| {
         let p = Panel::new(
-            &parts[1],
+            &parts[0],
             &format!(
                 "NIS per fix; mean {:.3} over {} fixes, sequence test: {}",
                 test.mean, test.fixes, test.verdict

@@ -4,8 +4,8 @@ use plotters::style::{Color, RGBColor};
 
 use super::axis::{Axis, y_label_area};
 use super::geometry::{Point, extent, padded, time_span};
-use super::legend::{Entry, Swatch, draw_legend, legend_height};
-use super::panel::{Area, Layout, Panel, columns, render, rows};
+use super::legend::{Entry, Swatch, render_under_legend};
+use super::panel::{Area, Layout, Panel, columns};
 use super::{BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotError, PlotResult, REFERENCE};
 use crate::checks::Check;
 use crate::ensemble::EnsembleStats;
@@ -155,12 +155,9 @@ pub fn consistency(stats: &EnsembleStats, nees: &Check, nis: &Check) -> PlotResu
         Entry::new(Swatch::Line(REFERENCE.stroke_width(1)), "expected value"),
         Entry::new(Swatch::Line(BLACK.stroke_width(1)), "χ² acceptance band"),
     ];
-    let legend_px = legend_height(&legend);
     let last_row_px = ROW_PX + 24;
 
-    render(legend_px + ROW_PX + last_row_px + 6, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX]);
-        draw_legend(&parts[0], &legend)?;
+    render_under_legend(&legend, &[ROW_PX, last_row_px + 6], 0, |parts| {
         for (row, (stat, scale)) in statistics.iter().zip(&scales).enumerate() {
             let layout = |y_area_px| Layout::titled(y_area_px, row == 1);
             let over = if row == 0 {
@@ -172,7 +169,7 @@ pub fn consistency(stats: &EnsembleStats, nees: &Check, nis: &Check) -> PlotResu
                 String::new()
             };
             let (lower, upper) = (stat.check.lower, stat.check.upper);
-            let area: &Area<'_> = &parts[row + 1];
+            let area: &Area<'_> = &parts[row];
             match scale {
                 Scale::Linear(axis) => {
                     let p = Panel::new(

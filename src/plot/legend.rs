@@ -108,6 +108,25 @@ fn draw_swatch(area: &Area<'_>, swatch: Swatch, x: i32, y: i32) -> Result<(), Pl
     Ok(())
 }
 
+/// A figure of the legend `legend` over rows of the heights `heights`, px, and a bottom margin of
+/// `bottom_px`; `draw` fills the rows (their areas in order, the legend's not among them).
+pub(crate) fn render_under_legend(
+    legend: &[Entry],
+    heights: &[u32],
+    bottom_px: u32,
+    draw: impl FnOnce(&[Area<'_>]) -> Result<(), PlotError>,
+) -> PlotResult {
+    let legend_px = legend_height(legend);
+    let split: Vec<u32> = std::iter::once(legend_px)
+        .chain(heights.iter().copied())
+        .collect();
+    render(split.iter().sum::<u32>() + bottom_px, |root| {
+        let parts = rows(root, &split);
+        draw_legend(&parts[0], legend)?;
+        draw(&parts[1..=heights.len()])
+    })
+}
+
 /// A figure of the legend `legend` over one row per state (position, velocity, bias), each
 /// `row_px` high but the last, which is taller to hold the time axis's title; `draw` fills row
 /// k's area.
@@ -116,12 +135,8 @@ pub(crate) fn render_state_rows(
     legend: &[Entry],
     mut draw: impl FnMut(&Area<'_>, usize) -> Result<(), PlotError>,
 ) -> PlotResult {
-    let legend_px = legend_height(legend);
-    let last_row_px = row_px + 24;
-    render(legend_px + 2 * row_px + last_row_px + 6, |root| {
-        let parts = rows(root, &[legend_px, row_px, row_px, last_row_px]);
-        draw_legend(&parts[0], legend)?;
-        for (k, area) in parts[1..4].iter().enumerate() {
+    render_under_legend(legend, &[row_px, row_px, row_px + 24], 6, |parts| {
+        for (k, area) in parts.iter().enumerate() {
             draw(area, k)?;
         }
         Ok(())

@@ -3,8 +3,8 @@
 use plotters::style::{Color, RGBColor};
 
 use super::axis::{Axis, y_label_area};
-use super::legend::{Entry, Swatch, draw_legend, legend_height};
-use super::panel::{Layout, Panel, columns, render, rows};
+use super::legend::{Entry, Swatch, render_under_legend};
+use super::panel::{Layout, Panel, columns, rows};
 use super::{BLACK, BLUE, GRID, PlotResult, REFERENCE, TICK_LABEL_PX, VERMILLION};
 use super::{font, text_width};
 use crate::checks::{Check, ResidualPair, residual_z};
@@ -138,12 +138,8 @@ pub fn residual_whiteness(stats: &EnsembleStats, check: &Check, pair: &ResidualP
             format!("±{:.2} bound of the pair", pair.bound),
         ),
     ];
-    let legend_px = legend_height(&legend);
-
-    render(legend_px + MAP_PX + SCALE_PX + 6, |root| {
-        let parts = rows(root, &[legend_px, MAP_PX + SCALE_PX]);
-        draw_legend(&parts[0], &legend)?;
-        let cols = columns(&parts[1], &[MAP_COLUMN_PX]);
+    render_under_legend(&legend, &[MAP_PX + SCALE_PX], 6, |parts| {
+        let cols = columns(&parts[0], &[MAP_COLUMN_PX]);
         let left = rows(&cols[0], &[MAP_PX]);
 
         let map = Panel::new(

@@ -5,8 +5,8 @@ use plotters::style::Color;
 
 use super::axis::{Axis, y_label_area};
 use super::geometry::{before, clipped_until, extent, padded, settled_from, time_span};
-use super::legend::{Entry, Swatch, draw_legend, legend_height};
-use super::panel::{Layout, Panel, columns, render, rows};
+use super::legend::{Entry, Swatch, render_under_legend};
+use super::panel::{Layout, Panel, columns};
 use super::{BLUE, BLUISH_GREEN, PlotResult, VERMILLION, WIDTH_PX};
 use crate::realization::{Realization, SampleRecord};
 
@@ -102,12 +102,9 @@ pub fn trajectory(r: &Realization) -> PlotResult {
         ),
         Entry::new(Swatch::Line(VERMILLION.stroke_width(2)), "filter estimate"),
     ];
-    let legend_px = legend_height(&legend);
     let last_row_px = ROW_PX + 24;
 
-    render(legend_px + 2 * ROW_PX + last_row_px + 6, |root| {
-        let parts = rows(root, &[legend_px, ROW_PX, ROW_PX, last_row_px]);
-        draw_legend(&parts[0], &legend)?;
+    render_under_legend(&legend, &[ROW_PX, ROW_PX, last_row_px], 6, |parts| {
         let titles_left = [
             "True acceleration a(t)",
             "Velocity: truth v and integrated v_{c}",
@@ -118,7 +115,7 @@ pub fn trajectory(r: &Realization) -> PlotResult {
         let computed: [Option<Series>; 3] =
             [None, Some(|x| x.computed_v_m_s), Some(|x| x.computed_p_m)];
         for row in 0..3 {
-            let cols = columns(&parts[row + 1], &[WIDTH_PX / 2]);
+            let cols = columns(&parts[row], &[WIDTH_PX / 2]);
             let layout = |y_area_px| Layout::titled(y_area_px, row == 2);
             let p = Panel::new(
                 &cols[0],
