@@ -2,7 +2,7 @@
 //! verifies the filter with Monte Carlo statistics, and writes the study up as an HTML report.
 //!
 //! The pipeline, one module per step, each depending only on the ones before it:
-//! [`config`] → [`model`] → [`filter`] → [`simulation`] → [`realization`], [`ensemble`] →
+//! [`config`] → [`model`] → [`state`] → [`filter`] → [`simulation`] → [`realization`], [`ensemble`] →
 //! [`stats`], [`checks`] → [`study`], [`sensitivity`] → [`export`], [`plot`] → [`report`].
 //! Below the study, [`logs`] reads and writes sensor logs and [`calibrate`] runs the filter and a
 //! smoother over them. [`format`](mod@format), [`output`], [`progress`] and [`error`] are leaves
@@ -29,5 +29,6 @@ pub mod realization;
 pub mod report;
 pub mod sensitivity;
 pub mod simulation;
+pub mod state;
 pub mod stats;
 pub mod study;

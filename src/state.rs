@@ -1,0 +1,223 @@
+//! The state model: what the filter estimates and what the GPS measures.
+//!
+//! A [`StateModel`] owns everything that depends on the choice of state: its dimension `N` and the
+//! measurement's `M` (nalgebra static sizes), the names, symbols and units of every variable, the
+//! transition Φ(t, τ), the process noise Q(t, τ), the observation matrix H, the measurement noise
+//! R and the prior covariance P(0). The filter, the engines, the ensemble statistics, the checks
+//! and the report ask the model; none of them writes a dimension or a state index.
+//!
+//! [`ErrorState`] is the accelerometer's error state δx = (δp, δv, b) of the problem statement:
+//! position error (m), velocity error (m/s) and accelerometer bias (m/s²), measured by GPS through
+//! (δp, δv). Its named indices ([`ErrorState::POSITION`], [`ErrorState::VELOCITY`],
+//! [`ErrorState::BIAS`]) and sizes ([`ErrorState::DIM`], [`ErrorState::MEAS`]) are the only place
+//! the numbers 0, 1, 2, 3 of the state appear.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::model::NoiseStats;
+
+/// One variable of a state or of a measurement.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Variable {
+    /// Machine name, used in JSON fields and CSV columns (`"position"`, `"bias"`).
+    pub key: &'static str,
+    /// Name in words, for prose and table headers (`"position error"`).
+    pub name: &'static str,
+    /// Symbol in the report's notation (`"δp"`).
+    pub symbol: &'static str,
+    /// SI unit (`"m/s²"`).
+    pub unit: &'static str,
+}
+
+/// A linear Gaussian state model with `N` states and `M` measured components.
+///
+/// Between fixes the state moves as x(t + τ) = Φ(t, τ)·x(t) + w, w ~ N(0, Q(t, τ)); a fix measures
+/// z = H·x + η, η ~ N(0, R); the prior is x(0) ~ N(0, P(0)). Φ and Q may depend on the time t at
+/// which the step starts (a state that multiplies a known input), never on the realization.
+pub trait StateModel<const N: usize, const M: usize> {
+    /// The state's variables, in state order.
+    const STATES: [Variable; N];
+    /// The measurement's components, in measurement order.
+    const MEASUREMENTS: [Variable; M];
+
+    /// Transition Φ(t, τ) of the state over [t, t + τ].
+    fn transition(&self, t_s: f64, tau_s: f64) -> SMatrix<f64, N, N>;
+    /// Process noise covariance Q(t, τ) accumulated over [t, t + τ].
+    fn process_noise(&self, t_s: f64, tau_s: f64) -> SMatrix<f64, N, N>;
+    /// Observation matrix H.
+    fn observation(&self) -> SMatrix<f64, M, N>;
+    /// Measurement noise covariance R.
+    fn measurement_noise(&self) -> SMatrix<f64, M, M>;
+    /// Prior covariance P(0).
+    fn initial_covariance(&self) -> SMatrix<f64, N, N>;
+}
+
+/// The accelerometer's error state δx = (δp, δv, b) for one set of noise statistics.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorState {
+    /// The noise statistics (the truth's, or the ones a filter assumes).
+    pub stats: NoiseStats,
+}
+
+impl ErrorState {
+    /// Number of states.
+    pub const DIM: usize = 3;
+    /// Number of measured components.
+    pub const MEAS: usize = 2;
+    /// Index of the position error δp = p − p_c, m.
+    pub const POSITION: usize = 0;
+    /// Index of the velocity error δv = v − v_c, m/s.
+    pub const VELOCITY: usize = 1;
+    /// Index of the accelerometer bias b, m/s².
+    pub const BIAS: usize = 2;
+    /// Index of the GPS position in a measurement or residual.
+    pub const GPS_POSITION: usize = 0;
+    /// Index of the GPS velocity in a measurement or residual.
+    pub const GPS_VELOCITY: usize = 1;
+}
+
+/// A vector of the error state (m, m/s, m/s²).
+pub type StateVector = SVector<f64, { ErrorState::DIM }>;
+/// A state-space matrix: covariance or transition.
+pub type StateMatrix = SMatrix<f64, { ErrorState::DIM }, { ErrorState::DIM }>;
+/// A GPS measurement or residual (m, m/s).
+pub type MeasVector = SVector<f64, { ErrorState::MEAS }>;
+/// A measurement-space matrix: R, S.
+pub type MeasMatrix = SMatrix<f64, { ErrorState::MEAS }, { ErrorState::MEAS }>;
+
+impl StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }> for ErrorState {
+    const STATES: [Variable; ErrorState::DIM] = [
+        Variable {
+            key: "position",
+            name: "position error",
+            symbol: "δp",
+            unit: "m",
+        },
+        Variable {
+            key: "velocity",
+            name: "velocity error",
+            symbol: "δv",
+            unit: "m/s",
+        },
+        Variable {
+            key: "bias",
+            name: "bias",
+            symbol: "b",
+            unit: "m/s²",
+        },
+    ];
+    const MEASUREMENTS: [Variable; ErrorState::MEAS] = [
+        Variable {
+            key: "position",
+            name: "GPS position",
+            symbol: "δz_p",
+            unit: "m",
+        },
+        Variable {
+            key: "velocity",
+            name: "GPS velocity",
+            symbol: "δz_v",
+            unit: "m/s",
+        },
+    ];
+
+    /// # Formula
+    /// ```text
+    /// Φ(τ) = [1  τ  −τ²/2]
+    ///        [0  1  −τ   ]
+    ///        [0  0   1   ]
+    /// ```
+    /// eq. (5) composed over τ/Δt steps: Φ is unipotent, so Φ(Δt)ⁿ = Φ(n·Δt) exactly.
+    fn transition(&self, _t_s: f64, tau_s: f64) -> StateMatrix {
+        StateMatrix::new(
+            1.0,
+            tau_s,
+            -0.5 * tau_s * tau_s,
+            0.0,
+            1.0,
+            -tau_s,
+            0.0,
+            0.0,
+            1.0,
+        )
+    }
+
+    /// # Formula
+    /// Q(τ) = Γ·W·Γᵀ with Γ = −(τ²/2, τ, 0)ᵀ (eq. 5: the noise enters position with −τ²/2 and
+    /// velocity with −τ) and W the accelerometer's white-noise variance: the covariance of one
+    /// accelerometer step of length τ.
+    fn process_noise(&self, _t_s: f64, tau_s: f64) -> StateMatrix {
+        let gamma = StateVector::new(-0.5 * tau_s * tau_s, -tau_s, 0.0);
+        gamma * gamma.transpose() * self.stats.accel_noise_var_m2_s4
+    }
+
+    /// GPS sees the position and velocity errors.
+    fn observation(&self) -> SMatrix<f64, { ErrorState::MEAS }, { ErrorState::DIM }> {
+        let mut h = SMatrix::zeros();
+        h[(Self::GPS_POSITION, Self::POSITION)] = 1.0;
+        h[(Self::GPS_VELOCITY, Self::VELOCITY)] = 1.0;
+        h
+    }
+
+    /// R = diag(σ_p², σ_v²).
+    fn measurement_noise(&self) -> MeasMatrix {
+        MeasMatrix::from_diagonal(&MeasVector::new(
+            self.stats.gps_position_sigma_m.powi(2),
+            self.stats.gps_velocity_sigma_m_s.powi(2),
+        ))
+    }
+
+    /// P(0) = diag(σ_p0², σ_v0², σ_b²).
+    fn initial_covariance(&self) -> StateMatrix {
+        StateMatrix::from_diagonal(&StateVector::new(
+            self.stats.initial_position_sigma_m.powi(2),
+            self.stats.initial_velocity_sigma_m_s.powi(2),
+            self.stats.bias_var_m2_s4,
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+    use crate::filter::{ErrorStateModel, process_noise, transition};
+    use crate::model::Model;
+
+    /// The model's matrices are the filter's, bit for bit.
+    #[test]
+    fn matrices_equal_the_filters() {
+        let m = Model::new(&Config::default()).unwrap();
+        let model = ErrorState {
+            stats: m.filter_stats,
+        };
+        let filter = ErrorStateModel::new(m.timeline.dt_s, &m.filter_stats);
+        let dt = m.timeline.dt_s;
+        assert_eq!(model.transition(0.0, dt), transition(dt));
+        assert_eq!(
+            model.process_noise(0.0, dt),
+            process_noise(dt, m.filter_stats.accel_noise_var_m2_s4)
+        );
+        assert_eq!(model.observation(), filter.h);
+        assert_eq!(model.measurement_noise(), filter.r);
+        assert_eq!(model.initial_covariance(), filter.p0);
+    }
+
+    /// Names and indices agree.
+    #[test]
+    fn indices_name_their_variables() {
+        let states = <ErrorState as StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }>>::STATES;
+        assert_eq!(states[ErrorState::BIAS].key, "bias");
+        assert_eq!(states[ErrorState::POSITION].unit, "m");
+        assert_eq!(states[ErrorState::VELOCITY].unit, "m/s");
+        let h = ErrorState {
+            stats: Model::new(&Config::default()).unwrap().filter_stats,
+        }
+        .observation();
+        assert_eq!(
+            h.column(ErrorState::BIAS).norm(),
+            0.0,
+            "the bias is not measured"
+        );
+    }
+}
