@@ -11,19 +11,16 @@ use nalgebra::{SMatrix, SVector};
 use crate::error::FilterError;
 use crate::lanes::Real;
 use crate::model::{NoiseStats, Timeline};
+use crate::state::{ErrorState, StateModel};
 
-/// A 2-vector: a GPS measurement or residual (m, m/s).
-pub type Vector2 = SVector<f64, 2>;
-/// A 3-vector of the error state (m, m/s, m/s²).
-pub type Vector3 = SVector<f64, 3>;
-/// A 2×2 matrix: measurement-space covariance.
-pub type Matrix2 = SMatrix<f64, 2, 2>;
-/// A 3×3 matrix: state-space covariance or transition.
-pub type Matrix3 = SMatrix<f64, 3, 3>;
-/// Measurement matrix H, 2×3.
-pub type Matrix2x3 = SMatrix<f64, 2, 3>;
-/// Kalman gain K, 3×2.
-pub type Matrix3x2 = SMatrix<f64, 3, 2>;
+pub use crate::state::{
+    MeasMatrix as Matrix2, MeasVector as Vector2, StateMatrix as Matrix3, StateVector as Vector3,
+    process_noise, transition,
+};
+/// Measurement matrix H of the error state.
+pub type Matrix2x3 = SMatrix<f64, { ErrorState::MEAS }, { ErrorState::DIM }>;
+/// Kalman gain K of the error state.
+pub type Matrix3x2 = SMatrix<f64, { ErrorState::DIM }, { ErrorState::MEAS }>;
 
 /// A component of the error state δx = (δp, δv, b); the first two are also the components of a
 /// GPS measurement and of a residual.
@@ -39,22 +36,24 @@ pub enum Component {
 
 impl Component {
     /// The state components, in state order.
-    pub const STATE: [Component; 3] = [Component::Position, Component::Velocity, Component::Bias];
+    pub const STATE: [Component; ErrorState::DIM] =
+        [Component::Position, Component::Velocity, Component::Bias];
     /// The measured components, in measurement order.
-    pub const MEASURED: [Component; 2] = [Component::Position, Component::Velocity];
+    pub const MEASURED: [Component; ErrorState::MEAS] = [Component::Position, Component::Velocity];
 
     /// Index in the state vector.
     pub fn index(self) -> usize {
-        self as usize
+        match self {
+            Component::Position => ErrorState::POSITION,
+            Component::Velocity => ErrorState::VELOCITY,
+            Component::Bias => ErrorState::BIAS,
+        }
     }
 
     /// The unit of the component.
     pub fn unit(self) -> &'static str {
-        match self {
-            Component::Position => "m",
-            Component::Velocity => "m/s",
-            Component::Bias => "m/s²",
-        }
+        <ErrorState as StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }>>::STATES[self.index()]
+            .unit
     }
 }
 
@@ -77,100 +76,51 @@ pub fn rows<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> [[f64; C]
     std::array::from_fn(|r| std::array::from_fn(|c| m[(r, c)]))
 }
 
-/// Transition Φ(τ) of the error state over τ seconds, eq. (5) composed over τ/Δt steps.
-///
-/// # Formula
-/// ```text
-/// Φ(τ) = [1  τ  −τ²/2]
-///        [0  1  −τ   ]
-///        [0  0   1   ]
-/// ```
-/// Φ is unipotent (Φ − I is nilpotent), so Φ(Δt)ⁿ = Φ(n·Δt) exactly.
-///
-/// # Examples
-/// ```
-/// use accelcal::filter::transition;
-/// let phi = transition(0.005);
-/// let phi40 = transition(0.2);
-/// assert!((phi.pow(40) - phi40).norm() < 1e-12);
-/// ```
-pub fn transition(tau_s: f64) -> Matrix3 {
-    Matrix3::new(
-        1.0,
-        tau_s,
-        -0.5 * tau_s * tau_s,
-        0.0,
-        1.0,
-        -tau_s,
-        0.0,
-        0.0,
-        1.0,
-    )
-}
-
-/// Process noise covariance Q(τ) = Γ·W·Γᵀ of one accelerometer step of τ seconds, (m, m/s, m/s²)².
-///
-/// # Formula
-/// Γ = −(τ²/2, τ, 0)ᵀ (eq. 5: the noise enters position with −τ²/2 and velocity with −τ), W the
-/// accelerometer's white-noise variance `accel_noise_var_m2_s4`.
-pub fn process_noise(tau_s: f64, accel_noise_var_m2_s4: f64) -> Matrix3 {
-    let gamma = Vector3::new(-0.5 * tau_s * tau_s, -tau_s, 0.0);
-    gamma * gamma.transpose() * accel_noise_var_m2_s4
-}
-
-/// The linear Gaussian error-state system of eqs. (5) and (6), for one set of noise statistics.
+/// The linear Gaussian system a filter runs (eqs. 5 and 6 for the error state), on a grid of
+/// nominal step Δt, for one set of noise statistics.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ErrorStateModel {
-    /// The nominal accelerometer step Δt that [`ErrorStateModel::phi`] and
-    /// [`ErrorStateModel::q`] are computed for, s.
+pub struct FilterModel<const N: usize = { ErrorState::DIM }, const M: usize = { ErrorState::MEAS }>
+{
+    /// The nominal step Δt that [`FilterModel::phi`] and [`FilterModel::q`] are computed for, s.
     pub dt_s: f64,
-    /// Accelerometer white-noise variance W the filter assumes, (m/s²)²; gives Q for any step.
-    pub accel_noise_var_m2_s4: f64,
-    /// One-step transition Φ(Δt).
-    pub phi: Matrix3,
-    /// Process noise covariance per step, Q = Γ·W·Γᵀ with Γ = −(Δt²/2, Δt, 0)ᵀ, (m, m/s, m/s²)².
-    pub q: Matrix3,
-    /// Measurement matrix H: GPS sees position and velocity errors.
-    pub h: Matrix2x3,
-    /// Measurement noise covariance R = diag(σ_p², σ_v²), (m, m/s)².
-    pub r: Matrix2,
-    /// Initial covariance P(0) = diag(σ_p0², σ_v0², σ_b²).
-    pub p0: Matrix3,
+    /// One-step transition Φ(0, Δt) (the step at any time for a time-invariant model).
+    pub phi: SMatrix<f64, N, N>,
+    /// Process noise covariance of the step Q(0, Δt).
+    pub q: SMatrix<f64, N, N>,
+    /// Measurement matrix H.
+    pub h: SMatrix<f64, M, N>,
+    /// Measurement noise covariance R.
+    pub r: SMatrix<f64, M, M>,
+    /// Prior covariance P(0).
+    pub p0: SMatrix<f64, N, N>,
 }
 
-impl ErrorStateModel {
-    /// The system for sample period `dt_s` and the statistics `stats`.
+/// The filter model of the accelerometer's error state.
+pub type ErrorStateModel = FilterModel;
+
+impl FilterModel {
+    /// The error-state system for sample period `dt_s` and the statistics `stats`.
     pub fn new(dt_s: f64, stats: &NoiseStats) -> Self {
+        Self::of(&ErrorState { stats: *stats }, dt_s)
+    }
+}
+
+impl<const N: usize, const M: usize> FilterModel<N, M> {
+    /// The matrices of `model` at the nominal step `dt_s`.
+    pub fn of<S: StateModel<N, M>>(model: &S, dt_s: f64) -> Self {
         Self {
             dt_s,
-            accel_noise_var_m2_s4: stats.accel_noise_var_m2_s4,
-            phi: transition(dt_s),
-            q: process_noise(dt_s, stats.accel_noise_var_m2_s4),
-            h: Matrix2x3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0),
-            r: Matrix2::new(
-                stats.gps_position_sigma_m.powi(2),
-                0.0,
-                0.0,
-                stats.gps_velocity_sigma_m_s.powi(2),
-            ),
-            p0: Matrix3::from_diagonal(&Vector3::new(
-                stats.initial_position_sigma_m.powi(2),
-                stats.initial_velocity_sigma_m_s.powi(2),
-                stats.bias_var_m2_s4,
-            )),
+            phi: model.transition(0.0, dt_s),
+            q: model.process_noise(0.0, dt_s),
+            h: model.observation(),
+            r: model.measurement_noise(),
+            p0: model.initial_covariance(),
         }
     }
 
     /// One propagation step P ← Φ·P·Φᵀ + Q, kept symmetric.
-    pub fn propagate(&self, p: &Matrix3) -> Matrix3 {
+    pub fn propagate(&self, p: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
         symmetrize(self.phi * p * self.phi.transpose() + self.q)
-    }
-
-    /// One propagation step over a step of its own length `tau_s`, as a log with irregular time
-    /// stamps needs: P ← Φ(τ)·P·Φ(τ)ᵀ + Q(τ), kept symmetric.
-    pub fn propagate_over(&self, p: &Matrix3, tau_s: f64) -> Matrix3 {
-        let phi = transition(tau_s);
-        symmetrize(phi * p * phi.transpose() + process_noise(tau_s, self.accel_noise_var_m2_s4))
     }
 
     /// The measurement update of the covariance at a fix at `time_s` whose a priori covariance is
@@ -182,10 +132,10 @@ impl ErrorStateModel {
     /// [`FilterError`] when S, P⁻ or P⁺ is not positive definite.
     pub fn update_covariance(
         &self,
-        p_prior: &Matrix3,
+        p_prior: &SMatrix<f64, N, N>,
         time_s: f64,
-        phi_from_previous: Matrix3,
-    ) -> Result<FixCovariance, FilterError> {
+        phi_from_previous: SMatrix<f64, N, N>,
+    ) -> Result<FixCovariance<N, M>, FilterError> {
         update_covariance(self, p_prior, time_s, phi_from_previous)
     }
 
@@ -194,10 +144,10 @@ impl ErrorStateModel {
     #[inline]
     pub fn update_estimate(
         &self,
-        fix: &FixCovariance,
-        prior: &Vector3,
-        dz: &Vector2,
-    ) -> (Vector3, Vector2) {
+        fix: &FixCovariance<N, M>,
+        prior: &SVector<f64, N>,
+        dz: &SVector<f64, M>,
+    ) -> (SVector<f64, N>, SVector<f64, M>) {
         let residual = dz - self.h * prior;
         (prior + fix.gain * residual, residual)
     }
@@ -205,25 +155,28 @@ impl ErrorStateModel {
 
 /// The filter's covariances and gain at one GPS fix.
 #[derive(Clone, Debug, PartialEq)]
-pub struct FixCovariance {
+pub struct FixCovariance<
+    const N: usize = { ErrorState::DIM },
+    const M: usize = { ErrorState::MEAS },
+> {
     /// Time of the fix, s.
     pub time_s: f64,
     /// Transition of the estimate from the previous fix (or from t = 0) to this one.
-    pub phi_from_previous: Matrix3,
+    pub phi_from_previous: SMatrix<f64, N, N>,
     /// A priori covariance P(t_i⁻).
-    pub p_prior: Matrix3,
+    pub p_prior: SMatrix<f64, N, N>,
     /// A posteriori covariance P(t_i⁺).
-    pub p_post: Matrix3,
+    pub p_post: SMatrix<f64, N, N>,
     /// Kalman gain K = P⁻·Hᵀ·S⁻¹.
-    pub gain: Matrix3x2,
+    pub gain: SMatrix<f64, N, M>,
     /// Innovation covariance S = H·P⁻·Hᵀ + R.
-    pub s: Matrix2,
+    pub s: SMatrix<f64, M, M>,
     /// S⁻¹, for the normalized innovation squared.
-    pub s_inv: Matrix2,
+    pub s_inv: SMatrix<f64, M, M>,
     /// (P⁻)⁻¹, for the a priori normalized estimation error squared.
-    pub p_prior_inv: Matrix3,
+    pub p_prior_inv: SMatrix<f64, N, N>,
     /// (P⁺)⁻¹, for the a posteriori normalized estimation error squared.
-    pub p_post_inv: Matrix3,
+    pub p_post_inv: SMatrix<f64, N, N>,
 }
 
 impl FixCovariance {
@@ -232,7 +185,15 @@ impl FixCovariance {
     /// δx̂⁺ = δx̂⁻ + K·r, returned as (prior, post, residual). Written once over [`Real`] so that
     /// every engine performs the same operations in the same order.
     #[inline(always)]
-    pub fn step<T: Real>(&self, estimate: &[T; 3], dz: &[T; 2]) -> ([T; 3], [T; 3], [T; 2]) {
+    pub fn step<T: Real>(
+        &self,
+        estimate: &[T; ErrorState::DIM],
+        dz: &[T; ErrorState::MEAS],
+    ) -> (
+        [T; ErrorState::DIM],
+        [T; ErrorState::DIM],
+        [T; ErrorState::MEAS],
+    ) {
         let phi = &self.phi_from_previous;
         // Written out row by row (no `std::array::from_fn`), so that every operation is inlined
         // into the vectorized callers.
@@ -241,9 +202,12 @@ impl FixCovariance {
                 + T::splat(phi[(r, 1)]) * estimate[1]
                 + T::splat(phi[(r, 2)]) * estimate[2]
         };
-        let prior: [T; 3] = [row(0), row(1), row(2)];
+        let prior = [row(0), row(1), row(2)];
         // H selects (δp, δv).
-        let residual = [dz[0] - prior[0], dz[1] - prior[1]];
+        let residual = [
+            dz[ErrorState::GPS_POSITION] - prior[ErrorState::POSITION],
+            dz[ErrorState::GPS_VELOCITY] - prior[ErrorState::VELOCITY],
+        ];
         let k = &self.gain;
         let gain = |r: usize| {
             prior[r] + (T::splat(k[(r, 0)]) * residual[0] + T::splat(k[(r, 1)]) * residual[1])
@@ -255,44 +219,82 @@ impl FixCovariance {
 
 /// Every covariance and gain of the filter over a time grid, computed once and shared.
 #[derive(Clone, Debug, PartialEq)]
-pub struct FilterSchedule {
+pub struct FilterSchedule<
+    const N: usize = { ErrorState::DIM },
+    const M: usize = { ErrorState::MEAS },
+> {
     /// The system the filter assumes.
-    pub model: ErrorStateModel,
+    pub model: FilterModel<N, M>,
     /// One entry per GPS fix.
-    pub fixes: Vec<FixCovariance>,
+    pub fixes: Vec<FixCovariance<N, M>>,
 }
 
 impl FilterSchedule {
-    /// Runs the covariance recursion over `timeline` for the statistics `stats`: propagation at
-    /// every accelerometer sample, a Joseph-form update at every fix.
+    /// Runs the covariance recursion of the error state over `timeline` for the statistics
+    /// `stats`: propagation at every accelerometer sample, a Joseph-form update at every fix.
     ///
     /// # Errors
     /// [`FilterError`] when S or P stops being positive definite.
     pub fn new(timeline: &Timeline, stats: &NoiseStats) -> Result<Self, FilterError> {
-        let model = ErrorStateModel::new(timeline.dt_s, stats);
-        let mut p = model.p0;
+        Self::of(&ErrorState { stats: *stats }, timeline)
+    }
+}
+
+impl<const N: usize, const M: usize> FilterSchedule<N, M> {
+    /// Runs the covariance recursion of `model` over `timeline`: P ← Φ(t_j, Δt)·P·Φᵀ + Q(t_j, Δt)
+    /// at every accelerometer sample, a Joseph-form update at every fix. The estimate's transition
+    /// between fixes is the model's Φ over the whole interval.
+    ///
+    /// # Errors
+    /// [`FilterError`] when S or P stops being positive definite.
+    pub fn of<S: StateModel<N, M>>(model: &S, timeline: &Timeline) -> Result<Self, FilterError> {
+        let system = FilterModel::of(model, timeline.dt_s);
+        let mut p = system.p0;
         let mut j = 0;
         let mut fixes = Vec::with_capacity(timeline.fixes());
         for &jf in &timeline.fix_steps {
-            let phi_from_previous = transition((jf - j) as f64 * timeline.dt_s);
+            let t_from = timeline.time_s(j);
+            let phi_from_previous = model.transition(t_from, (jf - j) as f64 * timeline.dt_s);
             while j < jf {
-                p = model.propagate(&p);
+                p = propagate_at(model, &system, &p, timeline.time_s(j));
                 j += 1;
             }
             let time_s = timeline.time_s(jf);
-            let p_prior = p;
-            let fix = update_covariance(&model, &p_prior, time_s, phi_from_previous)?;
+            let fix = update_covariance(&system, &p, time_s, phi_from_previous)?;
             p = fix.p_post;
             fixes.push(fix);
         }
-        Ok(Self { model, fixes })
+        Ok(Self {
+            model: system,
+            fixes,
+        })
     }
+}
 
-    /// Measurement update of the estimate at fix `i`: returns the a posteriori estimate and the
-    /// residual r = δz − H·δx̂⁻.
-    #[inline]
-    pub fn update(&self, i: usize, prior: &Vector3, dz: &Vector2) -> (Vector3, Vector2) {
-        self.model.update_estimate(&self.fixes[i], prior, dz)
+/// One propagation step of `model` over a step of its own length `tau_s` from `t_s`, as a log
+/// with irregular time stamps needs: P ← Φ(t, τ)·P·Φ(t, τ)ᵀ + Q(t, τ), kept symmetric.
+pub fn propagate_over<S: StateModel<N, M>, const N: usize, const M: usize>(
+    model: &S,
+    p: &SMatrix<f64, N, N>,
+    t_s: f64,
+    tau_s: f64,
+) -> SMatrix<f64, N, N> {
+    let phi = model.transition(t_s, tau_s);
+    symmetrize(phi * p * phi.transpose() + model.process_noise(t_s, tau_s))
+}
+
+/// One propagation step from `t_s`: the nominal step when the model does not depend on time, so
+/// that a time-invariant model costs no matrix construction per step.
+fn propagate_at<S: StateModel<N, M>, const N: usize, const M: usize>(
+    model: &S,
+    system: &FilterModel<N, M>,
+    p: &SMatrix<f64, N, N>,
+    t_s: f64,
+) -> SMatrix<f64, N, N> {
+    if S::TIME_INVARIANT {
+        system.propagate(p)
+    } else {
+        propagate_over(model, p, t_s, system.dt_s)
     }
 }
 
@@ -302,21 +304,21 @@ fn symmetrize<const D: usize>(m: SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
 }
 
 /// The measurement update of the covariance at one fix.
-fn update_covariance(
-    model: &ErrorStateModel,
-    p_prior: &Matrix3,
+fn update_covariance<const N: usize, const M: usize>(
+    model: &FilterModel<N, M>,
+    p_prior: &SMatrix<f64, N, N>,
     time_s: f64,
-    phi_from_previous: Matrix3,
-) -> Result<FixCovariance, FilterError> {
+    phi_from_previous: SMatrix<f64, N, N>,
+) -> Result<FixCovariance<N, M>, FilterError> {
     let h = &model.h;
     let s = symmetrize(h * p_prior * h.transpose() + model.r);
     let s_chol = s
         .cholesky()
         .ok_or(FilterError::InnovationNotPositiveDefinite { time_s })?;
     // K = P⁻Hᵀ S⁻¹, from the Cholesky solve S·Kᵀ = H·P⁻ (P⁻ symmetric).
-    let gain: Matrix3x2 = s_chol.solve(&(h * p_prior)).transpose();
+    let gain: SMatrix<f64, N, M> = s_chol.solve(&(h * p_prior)).transpose();
     // Joseph form: P⁺ = (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ, positive definite by construction.
-    let i_kh = Matrix3::identity() - gain * h;
+    let i_kh = SMatrix::<f64, N, N>::identity() - gain * h;
     let p_post = symmetrize(i_kh * p_prior * i_kh.transpose() + gain * model.r * gain.transpose());
     let p_prior_inv = p_prior
         .cholesky()

@@ -39,6 +39,9 @@ pub trait StateModel<const N: usize, const M: usize> {
     const STATES: [Variable; N];
     /// The measurement's components, in measurement order.
     const MEASUREMENTS: [Variable; M];
+    /// Whether Φ(t, τ) and Q(t, τ) do not depend on t, so that a filter may compute one step
+    /// once and reuse it.
+    const TIME_INVARIANT: bool = false;
 
     /// Transition Φ(t, τ) of the state over [t, t + τ].
     fn transition(&self, t_s: f64, tau_s: f64) -> SMatrix<f64, N, N>;
@@ -85,6 +88,45 @@ pub type MeasVector = SVector<f64, { ErrorState::MEAS }>;
 /// A measurement-space matrix: R, S.
 pub type MeasMatrix = SMatrix<f64, { ErrorState::MEAS }, { ErrorState::MEAS }>;
 
+/// Transition Φ(τ) of the error state over τ seconds, eq. (5) composed over τ/Δt steps.
+///
+/// # Formula
+/// ```text
+/// Φ(τ) = [1  τ  −τ²/2]
+///        [0  1  −τ   ]
+///        [0  0   1   ]
+/// ```
+/// Φ is unipotent (Φ − I is nilpotent), so Φ(Δt)ⁿ = Φ(n·Δt) exactly.
+///
+/// # Examples
+/// ```
+/// use accelcal::state::transition;
+/// let phi = transition(0.005);
+/// let phi40 = transition(0.2);
+/// assert!((phi.pow(40) - phi40).norm() < 1e-12);
+/// ```
+pub fn transition(tau_s: f64) -> StateMatrix {
+    let mut phi = StateMatrix::identity();
+    // eq. (5): velocity error moves position, the bias enters velocity with −τ and position
+    // with −τ²/2.
+    phi[(ErrorState::POSITION, ErrorState::VELOCITY)] = tau_s;
+    phi[(ErrorState::POSITION, ErrorState::BIAS)] = -0.5 * tau_s * tau_s;
+    phi[(ErrorState::VELOCITY, ErrorState::BIAS)] = -tau_s;
+    phi
+}
+
+/// Process noise covariance Q(τ) = Γ·W·Γᵀ of one accelerometer step of τ seconds, (m, m/s, m/s²)².
+///
+/// # Formula
+/// Γ = −(τ²/2, τ, 0)ᵀ (eq. 5: the noise enters position with −τ²/2 and velocity with −τ), W the
+/// accelerometer's white-noise variance `accel_noise_var_m2_s4`.
+pub fn process_noise(tau_s: f64, accel_noise_var_m2_s4: f64) -> StateMatrix {
+    let mut gamma = StateVector::zeros();
+    gamma[ErrorState::POSITION] = -0.5 * tau_s * tau_s;
+    gamma[ErrorState::VELOCITY] = -tau_s;
+    gamma * gamma.transpose() * accel_noise_var_m2_s4
+}
+
 impl StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }> for ErrorState {
     const STATES: [Variable; ErrorState::DIM] = [
         Variable {
@@ -121,34 +163,16 @@ impl StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }> for ErrorState {
         },
     ];
 
-    /// # Formula
-    /// ```text
-    /// Φ(τ) = [1  τ  −τ²/2]
-    ///        [0  1  −τ   ]
-    ///        [0  0   1   ]
-    /// ```
-    /// eq. (5) composed over τ/Δt steps: Φ is unipotent, so Φ(Δt)ⁿ = Φ(n·Δt) exactly.
+    const TIME_INVARIANT: bool = true;
+
+    /// See [`transition`].
     fn transition(&self, _t_s: f64, tau_s: f64) -> StateMatrix {
-        StateMatrix::new(
-            1.0,
-            tau_s,
-            -0.5 * tau_s * tau_s,
-            0.0,
-            1.0,
-            -tau_s,
-            0.0,
-            0.0,
-            1.0,
-        )
+        transition(tau_s)
     }
 
-    /// # Formula
-    /// Q(τ) = Γ·W·Γᵀ with Γ = −(τ²/2, τ, 0)ᵀ (eq. 5: the noise enters position with −τ²/2 and
-    /// velocity with −τ) and W the accelerometer's white-noise variance: the covariance of one
-    /// accelerometer step of length τ.
+    /// See [`process_noise`].
     fn process_noise(&self, _t_s: f64, tau_s: f64) -> StateMatrix {
-        let gamma = StateVector::new(-0.5 * tau_s * tau_s, -tau_s, 0.0);
-        gamma * gamma.transpose() * self.stats.accel_noise_var_m2_s4
+        process_noise(tau_s, self.stats.accel_noise_var_m2_s4)
     }
 
     /// GPS sees the position and velocity errors.
@@ -181,10 +205,12 @@ impl StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }> for ErrorState {
 mod tests {
     use super::*;
     use crate::config::Config;
-    use crate::filter::{ErrorStateModel, process_noise, transition};
+    use crate::filter::ErrorStateModel;
     use crate::model::Model;
 
-    /// The model's matrices are the filter's, bit for bit.
+    type Matrix2x3Lit = SMatrix<f64, 2, 3>;
+
+    /// The model's matrices are the problem statement's, bit for bit.
     #[test]
     fn matrices_equal_the_filters() {
         let m = Model::new(&Config::default()).unwrap();
@@ -193,12 +219,15 @@ mod tests {
         };
         let filter = ErrorStateModel::new(m.timeline.dt_s, &m.filter_stats);
         let dt = m.timeline.dt_s;
-        assert_eq!(model.transition(0.0, dt), transition(dt));
-        assert_eq!(
-            model.process_noise(0.0, dt),
-            process_noise(dt, m.filter_stats.accel_noise_var_m2_s4)
-        );
-        assert_eq!(model.observation(), filter.h);
+        // eq. (5) written out.
+        let phi = StateMatrix::new(1.0, dt, -0.5 * dt * dt, 0.0, 1.0, -dt, 0.0, 0.0, 1.0);
+        assert_eq!(model.transition(0.0, dt), phi);
+        let gamma = StateVector::new(-0.5 * dt * dt, -dt, 0.0);
+        let q = gamma * gamma.transpose() * m.filter_stats.accel_noise_var_m2_s4;
+        assert_eq!(model.process_noise(0.0, dt), q);
+        assert_eq!(filter.phi, phi);
+        assert_eq!(filter.q, q);
+        assert_eq!(filter.h, Matrix2x3Lit::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0));
         assert_eq!(model.measurement_noise(), filter.r);
         assert_eq!(model.initial_covariance(), filter.p0);
     }

@@ -2,8 +2,9 @@
 //! filter, one sample at a time, with the step of each pair of time stamps.
 
 use crate::error::FilterError;
-use crate::filter::{ErrorStateModel, Matrix2, Matrix3, Vector2, Vector3, transition};
+use crate::filter::{ErrorStateModel, Matrix2, Matrix3, Vector2, Vector3, propagate_over};
 use crate::logs::GpsFix;
+use crate::state::{ErrorState, StateModel, transition};
 
 use super::StepMode;
 
@@ -43,6 +44,8 @@ pub struct FilteredFix {
 /// The integration and the filter at the current sample.
 pub(super) struct Forward<'m> {
     model: &'m ErrorStateModel,
+    /// The error state the filter assumes, for steps of their own length.
+    state: ErrorState,
     mode: StepMode,
     /// Δt²/2 of the nominal step, s², written as in the simulation so that the bits agree.
     half_dt2_s2: f64,
@@ -66,6 +69,7 @@ impl<'m> Forward<'m> {
     /// The start of the log at `t0_s`: eq. (3) from the prior means, δx̂ = 0, P = P(0).
     pub fn new(
         model: &'m ErrorStateModel,
+        state: ErrorState,
         mode: StepMode,
         position_mean_m: f64,
         velocity_mean_m_s: f64,
@@ -74,6 +78,7 @@ impl<'m> Forward<'m> {
         let dt = model.dt_s;
         Self {
             model,
+            state,
             mode,
             half_dt2_s2: 0.5 * dt * dt,
             k: 0,
@@ -105,8 +110,8 @@ impl<'m> Forward<'m> {
                 // eq. (3) with this step's Δt_j; Φ(Δt_j) and Q(Δt_j) for eq. (5).
                 self.pc_m += self.vc_m_s * dt + a * half_dt2;
                 self.vc_m_s += a * dt;
-                self.x = transition(dt) * self.x;
-                self.p = self.model.propagate_over(&self.p, dt);
+                self.x = self.state.transition(self.t_s, dt) * self.x;
+                self.p = propagate_over(&self.state, &self.p, self.t_s, dt);
             }
         }
         self.k += 1;
@@ -138,7 +143,10 @@ impl<'m> Forward<'m> {
         let cov = self.model.update_covariance(&self.p, self.t_s, phi)?;
         let z = Vector2::new(fix.position_m, fix.velocity_m_s);
         // eq. (6): δz = z − (p_c, v_c).
-        let dz = Vector2::new(z[0] - self.pc_m, z[1] - self.vc_m_s);
+        let dz = Vector2::new(
+            z[ErrorState::GPS_POSITION] - self.pc_m,
+            z[ErrorState::GPS_VELOCITY] - self.vc_m_s,
+        );
         let (post, residual) = self.model.update_estimate(&cov, &prior, &dz);
         self.x = post;
         self.p = cov.p_post;

@@ -31,6 +31,7 @@ use crate::filter::{ErrorStateModel, Matrix3, Vector3};
 use crate::logs::read::{AccelReader, LogSource};
 use crate::logs::{LogError, LogProblem};
 use crate::model::{Model, NoiseStats};
+use crate::state::ErrorState;
 use forward::FilteredFix;
 pub use nis::{NisTest, nis_test};
 pub use scan::NOMINAL_TOLERANCE;
@@ -174,6 +175,9 @@ impl Prepared<'_> {
         let s = &self.settings;
         let mut fw = forward::Forward::new(
             &self.model,
+            ErrorState {
+                stats: self.settings.filter_stats,
+            },
             self.scan.mode,
             s.position_mean_m,
             s.velocity_mean_m_s,
