@@ -310,7 +310,7 @@ pub fn evaluate(stats: &EnsembleStats, budget: &Budget) -> Verdicts {
         std::array::from_fn(|k| {
             members::z_score(
                 stats.realizations,
-                stats.pair_moments[2 * j + k],
+                stats.pair_moments[(j, k)],
                 diagonal(2 * i + j),
                 diagonal(2 * m + k),
             )
@@ -334,7 +334,7 @@ pub fn evaluate(stats: &EnsembleStats, budget: &Budget) -> Verdicts {
             t_m_s: stats.fixes[m].time_s,
             t_i_s: stats.fixes[i].time_s,
             mean_product: std::array::from_fn(|j| {
-                std::array::from_fn(|k| stats.pair_moments[2 * j + k])
+                std::array::from_fn(|k| stats.pair_moments[(j, k)])
             }),
             z,
             bound,

@@ -252,8 +252,10 @@ fn sum_groups<G: LaneGroup>(
     }
     for q in 0..count {
         let [at_i, at_m] = &pair[q / LANES];
-        for (c, p) in acc.pair_products.iter_mut().enumerate() {
-            *p += at_i[c / 2].0[q % LANES] * at_m[c % 2].0[q % LANES];
+        for (j, r_i) in at_i.iter().enumerate() {
+            for (k, r_m) in at_m.iter().enumerate() {
+                acc.pair_products[(j, k)] += r_i.0[q % LANES] * r_m.0[q % LANES];
+            }
         }
     }
 }

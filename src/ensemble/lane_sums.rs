@@ -77,9 +77,12 @@ impl LaneStage {
             s.xx[k] += self.xx[k].sum();
         }
         let mut nees = 0.0;
-        for k in 0..6 {
+        for (k, &(r, c)) in UPPER.iter().enumerate() {
             let ee = self.ee[k].sum();
-            s.ee[k] += ee;
+            s.ee[(r, c)] += ee;
+            if r != c {
+                s.ee[(c, r)] += ee;
+            }
             nees += w[k] * ee;
         }
         s.nees += nees;

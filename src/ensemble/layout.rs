@@ -1,36 +1,54 @@
-//! Which second moments of the stacked residuals ρ = (r_p(t_0), r_v(t_0), r_p(t_1), …) an
+//! Which second moments of the stacked residuals ρ = (r(t_0), r(t_1), …) an
 //! ensemble keeps: every pair of components (a packed lower triangle, O(fixes²)), or the pairs
 //! whose fixes are at most `max_lag` fixes apart (a band, O(fixes·lag)).
 //!
 //! Either way row a of the lower triangle keeps a contiguous run of columns ending at the
 //! diagonal, [first_col(a), a], stored row after row.
 
-/// The stored part of the lower triangle of Σ ρ·ρᵀ.
+use crate::state::ErrorState;
+
+/// The stored part of the lower triangle of Σ ρ·ρᵀ; component a of ρ is component a mod w of
+/// the residual at fix ⌊a / w⌋, w the residual's width.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ResidualLayout {
     fixes: usize,
+    /// Components of one residual, w.
+    width: usize,
     max_lag: Option<usize>,
     /// Start of every row in the packed storage, and the total length last.
     row_start: Vec<usize>,
 }
 
 impl ResidualLayout {
-    /// The layout for `fixes` fixes keeping pairs at most `max_lag` fixes apart (`None`: all).
+    /// The layout of the error state's GPS residuals for `fixes` fixes keeping pairs at most
+    /// `max_lag` fixes apart (`None`: all).
     pub fn new(fixes: usize, max_lag: Option<usize>) -> Self {
+        Self::with_width(fixes, ErrorState::MEAS, max_lag)
+    }
+
+    /// The layout for `fixes` residuals of `width` components each, keeping pairs at most
+    /// `max_lag` fixes apart (`None`: all).
+    pub fn with_width(fixes: usize, width: usize, max_lag: Option<usize>) -> Self {
         // A lag that reaches every pair is no band at all.
         let max_lag = max_lag.filter(|&l| l + 1 < fixes);
-        let mut row_start = Vec::with_capacity(2 * fixes + 1);
+        let mut row_start = Vec::with_capacity(width * fixes + 1);
         let mut start = 0;
-        for a in 0..2 * fixes {
+        for a in 0..width * fixes {
             row_start.push(start);
-            start += a + 1 - first_col(a, max_lag);
+            start += a + 1 - first_col(a, width, max_lag);
         }
         row_start.push(start);
         Self {
             fixes,
+            width,
             max_lag,
             row_start,
         }
+    }
+
+    /// Components of one residual.
+    pub fn width(&self) -> usize {
+        self.width
     }
 
     /// Number of fixes.
@@ -46,7 +64,7 @@ impl ResidualLayout {
     /// The first column kept in row a.
     #[inline]
     pub fn first_col(&self, a: usize) -> usize {
-        first_col(a, self.max_lag)
+        first_col(a, self.width, self.max_lag)
     }
 
     /// Number of stored products.
@@ -73,7 +91,7 @@ impl ResidualLayout {
     pub fn index(&self, a: usize, b: usize) -> Option<usize> {
         let (hi, lo) = if a >= b { (a, b) } else { (b, a) };
         let first = self.first_col(hi);
-        (hi < 2 * self.fixes && lo >= first).then(|| self.row_start[hi] + lo - first)
+        (hi < self.width * self.fixes && lo >= first).then(|| self.row_start[hi] + lo - first)
     }
 
     /// Whether fixes `later` and `earlier` are a kept pair.
@@ -83,10 +101,10 @@ impl ResidualLayout {
 }
 
 #[inline]
-fn first_col(a: usize, max_lag: Option<usize>) -> usize {
+fn first_col(a: usize, width: usize, max_lag: Option<usize>) -> usize {
     match max_lag {
         None => 0,
-        Some(l) => 2 * (a / 2).saturating_sub(l),
+        Some(l) => width * (a / width).saturating_sub(l),
     }
 }
 

@@ -14,6 +14,11 @@ use super::Engine;
 use super::layout::ResidualLayout;
 use super::sums::{Accumulator, FixSums, StageSums};
 use crate::config::Config;
+use crate::state::{ErrorState, StateMatrix, StateVector};
+use nalgebra::SMatrix;
+
+const DIM: usize = ErrorState::DIM;
+const MEAS: usize = ErrorState::MEAS;
 
 /// The first line of every partial file.
 pub const MAGIC: &str = "accelcal-partial 1\n";
@@ -74,14 +79,14 @@ pub enum PartialError {
     },
 }
 
-/// Floats of one stage's sums.
-const STAGE_LEN: usize = 25;
+/// Floats of one stage's sums: Σ e, the upper triangle of Σ e·eᵀ, Σ e·δx̂ᵀ, Σ δx̂, Σ δx̂², NEES.
+const STAGE_LEN: usize = DIM + DIM * (DIM + 1) / 2 + DIM * DIM + DIM + DIM + 1;
 /// Floats of one fix's sums.
 const FIX_LEN: usize = 2 * STAGE_LEN + 1;
 
 fn stage_floats(s: &StageSums, out: &mut Vec<f64>) {
     out.extend(s.e.iter());
-    out.extend(s.ee.iter());
+    out.extend(s.ee_upper());
     out.extend(s.ex.iter());
     out.extend(s.x.iter());
     out.extend(s.xx.iter());
@@ -89,14 +94,28 @@ fn stage_floats(s: &StageSums, out: &mut Vec<f64>) {
 }
 
 fn stage_from(v: &[f64]) -> StageSums {
-    StageSums {
-        e: crate::filter::Vector3::from_column_slice(&v[0..3]),
-        ee: std::array::from_fn(|k| v[3 + k]),
-        ex: crate::filter::Matrix3::from_column_slice(&v[9..18]),
-        x: crate::filter::Vector3::from_column_slice(&v[18..21]),
-        xx: crate::filter::Vector3::from_column_slice(&v[21..24]),
-        nees: v[24],
-    }
+    // The fields in [`stage_floats`] order.
+    let mut rest = v;
+    let mut take = |len: usize| {
+        let (head, tail) = rest.split_at(len);
+        rest = tail;
+        head
+    };
+    let e = StateVector::from_column_slice(take(DIM));
+    let ee = take(DIM * (DIM + 1) / 2);
+    let ex = StateMatrix::from_column_slice(take(DIM * DIM));
+    let x = StateVector::from_column_slice(take(DIM));
+    let xx = StateVector::from_column_slice(take(DIM));
+    let mut s = StageSums {
+        e,
+        ex,
+        x,
+        xx,
+        nees: take(1)[0],
+        ..StageSums::default()
+    };
+    s.set_ee_upper(ee);
+    s
 }
 
 /// Writes the header of a partial file.
@@ -116,14 +135,15 @@ pub fn write_header(w: &mut impl Write, header: &PartialHeader) -> std::io::Resu
 /// The writer's error.
 pub fn write_block(w: &mut impl Write, index: u64, acc: &Accumulator) -> std::io::Result<()> {
     let mut floats =
-        Vec::with_capacity(acc.fixes.len() * FIX_LEN + acc.residual_products.len() + 4);
+        Vec::with_capacity(acc.fixes.len() * FIX_LEN + acc.residual_products.len() + MEAS * MEAS);
     for f in &acc.fixes {
         stage_floats(&f.prior, &mut floats);
         stage_floats(&f.post, &mut floats);
         floats.push(f.nis);
     }
     floats.extend(&acc.residual_products);
-    floats.extend(acc.pair_products);
+    // Row-major (j, k).
+    floats.extend(acc.pair_products.transpose().iter());
     w.write_all(&index.to_le_bytes())?;
     w.write_all(&acc.count.to_le_bytes())?;
     let mut bytes = Vec::with_capacity(8 * floats.len());
@@ -205,7 +225,8 @@ pub fn read_block(
     let products = header.fixes * FIX_LEN;
     acc.residual_products
         .copy_from_slice(&floats[products..products + layout.len()]);
-    acc.pair_products = std::array::from_fn(|k| floats[products + layout.len() + k]);
+    let pair = &floats[products + layout.len()..];
+    acc.pair_products = SMatrix::from_row_slice(&pair[..MEAS * MEAS]);
     Ok(Some((index, acc)))
 }
 

@@ -1,33 +1,50 @@
 //! Ensemble statistics: the sums turned into means, covariances, correlations and the averages
 //! the checks test.
 
+use nalgebra::SMatrix;
 use serde::{Serialize, Serializer};
 
 use super::layout::ResidualLayout;
 use super::sums::{Accumulator, StageSums};
-use crate::filter::{FilterSchedule, Matrix3, Stage, rows};
+use crate::filter::{FilterSchedule, Stage, rows};
+use crate::state::ErrorState;
 
-/// Ensemble statistics of one stage (a priori or a posteriori) at one fix.
+/// Ensemble statistics of one stage (a priori or a posteriori) at one fix, for a state of `N`
+/// variables.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct StageStats {
+pub struct StageStats<const N: usize = { ErrorState::DIM }> {
     /// Ensemble mean error e_ave = (1/N) Σ e.
-    pub mean_error: [f64; 3],
+    #[serde(serialize_with = "vector")]
+    pub mean_error: [f64; N],
     /// Unbiased ensemble covariance P_ave = (1/(N−1)) Σ (e − e_ave)(e − e_ave)ᵀ, row-major.
-    pub ensemble_cov: [[f64; 3]; 3],
+    #[serde(serialize_with = "matrix")]
+    pub ensemble_cov: [[f64; N]; N],
     /// The filter's covariance P, row-major.
-    pub filter_cov: [[f64; 3]; 3],
+    #[serde(serialize_with = "matrix")]
+    pub filter_cov: [[f64; N]; N],
     /// Orthogonality matrix (1/N) Σ (e − e_ave)·δx̂ᵀ, row-major.
-    pub orthogonality: [[f64; 3]; 3],
+    #[serde(serialize_with = "matrix")]
+    pub orthogonality: [[f64; N]; N],
     /// The same, normalized to a correlation: entry (j, k) divided by σ(e_j)·σ(δx̂_k); NaN where
     /// the estimate does not vary over the ensemble.
     #[serde(serialize_with = "nan_as_null")]
-    pub orthogonality_corr: [[f64; 3]; 3],
+    pub orthogonality_corr: [[f64; N]; N],
     /// Average normalized estimation error squared (1/N) Σ eᵀ·P⁻¹·e.
     pub nees_avg: f64,
 }
 
+/// Serializes a vector of any length as a JSON array.
+fn vector<S: Serializer, const N: usize>(v: &[f64; N], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(v)
+}
+
+/// Serializes a matrix of any size as an array of rows.
+fn matrix<S: Serializer, const N: usize>(m: &[[f64; N]; N], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(m.iter().map(|row| row.as_slice()))
+}
+
 /// Serializes a matrix with NaN entries as `null` (JSON has no NaN).
-fn nan_as_null<S: Serializer>(m: &[[f64; 3]; 3], s: S) -> Result<S::Ok, S::Error> {
+fn nan_as_null<S: Serializer, const N: usize>(m: &[[f64; N]; N], s: S) -> Result<S::Ok, S::Error> {
     let rows: Vec<Vec<Option<f64>>> = m
         .iter()
         .map(|row| row.iter().map(|x| x.is_finite().then_some(*x)).collect())
@@ -37,20 +54,20 @@ fn nan_as_null<S: Serializer>(m: &[[f64; 3]; 3], s: S) -> Result<S::Ok, S::Error
 
 /// Ensemble statistics at one fix.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct FixStats {
+pub struct FixStats<const N: usize = { ErrorState::DIM }> {
     /// Time of the fix, s.
     pub time_s: f64,
     /// A priori statistics, t_i⁻.
-    pub prior: StageStats,
+    pub prior: StageStats<N>,
     /// A posteriori statistics, t_i⁺.
-    pub post: StageStats,
+    pub post: StageStats<N>,
     /// Average normalized innovation squared (1/N) Σ rᵀ·S⁻¹·r.
     pub nis_avg: f64,
 }
 
-impl FixStats {
+impl<const N: usize> FixStats<N> {
     /// The statistics of `stage`.
-    pub fn stage(&self, stage: Stage) -> &StageStats {
+    pub fn stage(&self, stage: Stage) -> &StageStats<N> {
         match stage {
             Stage::Prior => &self.prior,
             Stage::Posterior => &self.post,
@@ -60,24 +77,27 @@ impl FixStats {
 
 /// Everything the ensemble measured, ready for the checks and the report.
 #[derive(Clone, Debug, PartialEq)]
-pub struct EnsembleStats {
+pub struct EnsembleStats<
+    const N: usize = { ErrorState::DIM },
+    const M: usize = { ErrorState::MEAS },
+> {
     /// Number of realizations N.
     pub realizations: u64,
     /// One entry per fix.
-    pub fixes: Vec<FixStats>,
+    pub fixes: Vec<FixStats<N>>,
     /// Which second moments of the stacked residuals are kept.
     pub residual_layout: ResidualLayout,
     /// Second moments (1/N) Σ ρ·ρᵀ of the stacked residuals, in `residual_layout`.
     pub residual_moments: Vec<f64>,
     /// The fix indices [m, i] of the statement's single residual pair.
     pub pair: [usize; 2],
-    /// (1/N) Σ r_j(t_i)·r_k(t_m) of the single pair, row-major (j, k).
-    pub pair_moments: [f64; 4],
+    /// (1/N) Σ r_j(t_i)·r_k(t_m) of the single pair, entry (j, k).
+    pub pair_moments: SMatrix<f64, M, M>,
 }
 
-impl EnsembleStats {
+impl<const N: usize, const M: usize> EnsembleStats<N, M> {
     /// Turns sums into statistics.
-    pub fn from_sums(acc: &Accumulator, schedule: &FilterSchedule) -> Self {
+    pub fn from_sums(acc: &Accumulator<N, M>, schedule: &FilterSchedule<N, M>) -> Self {
         let n = acc.count as f64;
         let fixes = acc
             .fixes
@@ -96,12 +116,12 @@ impl EnsembleStats {
             residual_layout: acc.layout.clone(),
             residual_moments: acc.residual_products.iter().map(|x| x / n).collect(),
             pair: acc.pair,
-            pair_moments: acc.pair_products.map(|x| x / n),
+            pair_moments: acc.pair_products / n,
         }
     }
 
-    /// (1/N) Σ r_a·r_b for stacked residual components a, b (component 2i is position at fix i,
-    /// 2i + 1 velocity), when the layout keeps it.
+    /// (1/N) Σ r_a·r_b for stacked residual components a, b (component M·i + j is component j
+    /// of the residual at fix i), when the layout keeps it.
     pub fn residual_moment(&self, a: usize, b: usize) -> Option<f64> {
         self.residual_layout
             .index(a, b)
@@ -109,16 +129,16 @@ impl EnsembleStats {
     }
 }
 
-fn stage_stats(s: &StageSums, p: &Matrix3, n: f64) -> StageStats {
+fn stage_stats<const N: usize>(s: &StageSums<N>, p: &SMatrix<f64, N, N>, n: f64) -> StageStats<N> {
     let mean_e = s.e / n;
     let mean_x = s.x / n;
-    let ee = s.ee_matrix();
+    let ee = s.ee;
     let cov = (ee - mean_e * s.e.transpose()) / (n - 1.0);
     // (1/N) Σ (e − ē) x̂ᵀ = (1/N) Σ e x̂ᵀ − ē x̂̄ᵀ.
     let ortho = s.ex / n - mean_e * mean_x.transpose();
     let var_e = (ee / n - mean_e * mean_e.transpose()).diagonal();
     let var_x = s.xx / n - mean_x.component_mul(&mean_x);
-    let corr = Matrix3::from_fn(|j, k| {
+    let corr = SMatrix::<f64, N, N>::from_fn(|j, k| {
         let d = var_e[j] * var_x[k];
         // An estimate component that does not vary (e.g. the a priori estimate at a fix at t = 0)
         // has no correlation to speak of; relative tolerance because of rounding in the sums.

@@ -1,45 +1,73 @@
 //! Running sums of an ensemble: everything the statistics need, added one realization at a time
 //! and merged chunk by chunk, with no per-realization storage.
 
-use super::layout::ResidualLayout;
-use crate::filter::{Matrix3, Vector3};
+use nalgebra::{SMatrix, SVector};
 
-/// Running sums over realizations of one estimate stage (a priori or a posteriori) at one fix.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct StageSums {
+use super::layout::ResidualLayout;
+use crate::state::ErrorState;
+
+/// Running sums over realizations of one estimate stage (a priori or a posteriori) at one fix,
+/// for a state of `N` variables.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StageSums<const N: usize = { ErrorState::DIM }> {
     /// Σ e, e = δx − δx̂.
-    pub e: Vector3,
-    /// Σ e·eᵀ, upper triangle in the order (00, 01, 02, 11, 12, 22).
-    pub ee: [f64; 6],
+    pub e: SVector<f64, N>,
+    /// Σ e·eᵀ, symmetric: entry (r, c) and (c, r) hold the same sum.
+    pub ee: SMatrix<f64, N, N>,
     /// Σ e·δx̂ᵀ.
-    pub ex: Matrix3,
+    pub ex: SMatrix<f64, N, N>,
     /// Σ δx̂.
-    pub x: Vector3,
+    pub x: SVector<f64, N>,
     /// Σ δx̂_k², the diagonal of Σ δx̂·δx̂ᵀ.
-    pub xx: Vector3,
+    pub xx: SVector<f64, N>,
     /// Σ eᵀ·P⁻¹·e (the normalized estimation error squared).
     pub nees: f64,
 }
 
-/// Upper-triangle index pairs of a symmetric 3×3 matrix, in [`StageSums::ee`] order.
-const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
-
-impl StageSums {
-    /// Σ e·eᵀ as a full matrix.
-    pub fn ee_matrix(&self) -> Matrix3 {
-        let mut m = Matrix3::zeros();
-        for (v, &(r, c)) in self.ee.iter().zip(&UPPER) {
-            m[(r, c)] = *v;
-            m[(c, r)] = *v;
+impl<const N: usize> Default for StageSums<N> {
+    fn default() -> Self {
+        Self {
+            e: SVector::zeros(),
+            ee: SMatrix::zeros(),
+            ex: SMatrix::zeros(),
+            x: SVector::zeros(),
+            xx: SVector::zeros(),
+            nees: 0.0,
         }
-        m
+    }
+}
+
+impl<const N: usize> StageSums<N> {
+    /// Adds one realization's error `e` = δx − δx̂ and estimate `x` = δx̂, with (P)⁻¹ `p_inv`.
+    pub fn add(&mut self, e: &SVector<f64, N>, x: &SVector<f64, N>, p_inv: &SMatrix<f64, N, N>) {
+        self.e += e;
+        self.ee += e * e.transpose();
+        self.ex += e * x.transpose();
+        self.x += x;
+        self.xx += x.component_mul(x);
+        self.nees += (e.transpose() * p_inv * e)[0];
+    }
+
+    /// The upper triangle of Σ e·eᵀ, row by row: (00, 01, …, 0N, 11, …): the stored form.
+    pub fn ee_upper(&self) -> impl Iterator<Item = f64> + '_ {
+        (0..N).flat_map(move |r| (r..N).map(move |c| self.ee[(r, c)]))
+    }
+
+    /// Sets Σ e·eᵀ from its upper triangle in [`StageSums::ee_upper`] order.
+    pub fn set_ee_upper(&mut self, upper: &[f64]) {
+        let mut k = 0;
+        for r in 0..N {
+            for c in r..N {
+                self.ee[(r, c)] = upper[k];
+                self.ee[(c, r)] = upper[k];
+                k += 1;
+            }
+        }
     }
 
     fn merge(&mut self, o: &Self) {
         self.e += o.e;
-        for (a, b) in self.ee.iter_mut().zip(&o.ee) {
-            *a += b;
-        }
+        self.ee += o.ee;
         self.ex += o.ex;
         self.x += o.x;
         self.xx += o.xx;
@@ -49,22 +77,24 @@ impl StageSums {
 
 /// Running sums at one fix.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct FixSums {
+pub struct FixSums<const N: usize = { ErrorState::DIM }> {
     /// Sums of the a priori stage.
-    pub prior: StageSums,
+    pub prior: StageSums<N>,
     /// Sums of the a posteriori stage.
-    pub post: StageSums,
+    pub post: StageSums<N>,
     /// Σ rᵀ·S⁻¹·r (the normalized innovation squared).
     pub nis: f64,
 }
 
-/// Running sums of an ensemble, or of part of one.
+/// Running sums of an ensemble, or of part of one, for a state of `N` variables and a
+/// measurement of `M` components.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Accumulator {
+pub struct Accumulator<const N: usize = { ErrorState::DIM }, const M: usize = { ErrorState::MEAS }>
+{
     /// Realizations summed.
     pub count: u64,
     /// One entry per fix.
-    pub fixes: Vec<FixSums>,
+    pub fixes: Vec<FixSums<N>>,
     /// Which residual products are kept.
     pub layout: ResidualLayout,
     /// Σ ρ·ρᵀ over realizations, where ρ = (r(t_0), r(t_1), …) stacks every residual: the kept
@@ -72,11 +102,11 @@ pub struct Accumulator {
     pub residual_products: Vec<f64>,
     /// The fix indices [m, i] of the statement's single residual pair.
     pub pair: [usize; 2],
-    /// Σ r_j(t_i)·r_k(t_m) of the single pair, row-major (j, k), kept whatever the layout.
-    pub pair_products: [f64; 4],
+    /// Σ r_j(t_i)·r_k(t_m) of the single pair, entry (j, k), kept whatever the layout.
+    pub pair_products: SMatrix<f64, M, M>,
 }
 
-impl Accumulator {
+impl<const N: usize, const M: usize> Accumulator<N, M> {
     /// Empty sums with the residual products of `layout` and the single pair `pair`.
     pub fn new(layout: &ResidualLayout, pair: [usize; 2]) -> Self {
         Self {
@@ -85,7 +115,7 @@ impl Accumulator {
             residual_products: vec![0.0; layout.len()],
             layout: layout.clone(),
             pair,
-            pair_products: [0.0; 4],
+            pair_products: SMatrix::zeros(),
         }
     }
 
@@ -99,9 +129,7 @@ impl Accumulator {
             "sums of different ensembles"
         );
         self.count += other.count;
-        for (a, b) in self.pair_products.iter_mut().zip(&other.pair_products) {
-            *a += b;
-        }
+        self.pair_products += other.pair_products;
         for (a, b) in self.fixes.iter_mut().zip(&other.fixes) {
             a.prior.merge(&b.prior);
             a.post.merge(&b.post);
@@ -121,6 +149,6 @@ impl Accumulator {
     pub(super) fn clear_but_products(&mut self) {
         self.count = 0;
         self.fixes.fill(FixSums::default());
-        self.pair_products = [0.0; 4];
+        self.pair_products = SMatrix::zeros();
     }
 }

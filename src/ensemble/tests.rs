@@ -116,7 +116,7 @@ fn streaming_moments_match_a_two_pass_computation() {
     // The statement's single pair is kept in double precision.
     let [later, earlier] = m.residual_pair;
     let pair = moment(2 * earlier, 2 * later + 1);
-    approx::assert_relative_eq!(stats.pair_moments[1], pair, max_relative = 1e-9);
+    approx::assert_relative_eq!(stats.pair_moments[(0, 1)], pair, max_relative = 1e-9);
 }
 
 /// A panic in one block (here in the caller's `on_block`) reaches the caller instead of leaving

@@ -138,9 +138,9 @@ impl Sampler {
         let n_real = self.realizations as f64;
         let n = self.realizations - 1;
         let sqrt_n = n_real.sqrt();
-        let mut acc = Accumulator::new(&self.layout, self.pair);
+        let mut acc: Accumulator = Accumulator::new(&self.layout, self.pair);
         acc.count = self.realizations;
-        acc.pair_products = [f64::NAN; 4];
+        acc.pair_products.fill(f64::NAN);
 
         // Start: e ~ N(0, P(0)), δx̂ = 0.
         let mut scatter = M6::zeros();
@@ -259,17 +259,11 @@ fn mix(seed: u64, k: u64) -> u64 {
 /// The raw sums Σ e, Σ e·eᵀ, … of one stage from the scatter and the mean of z = (e, δx̂).
 fn stage_sums(scatter: &M6, mean: &V6, n: f64, p_inv: &Matrix3) -> StageSums {
     let raw = scatter + mean * mean.transpose() * n;
-    let ee: Matrix3 = raw.fixed_view::<3, 3>(0, 0).into_owned();
+    // Σ e·eᵀ from its upper triangle, exactly symmetric.
+    let ee = Matrix3::from_fn(|r, c| raw[(r.min(c), r.max(c))]);
     StageSums {
         e: mean.fixed_rows::<3>(0) * n,
-        ee: [
-            ee[(0, 0)],
-            ee[(0, 1)],
-            ee[(0, 2)],
-            ee[(1, 1)],
-            ee[(1, 2)],
-            ee[(2, 2)],
-        ],
+        ee,
         ex: raw.fixed_view::<3, 3>(0, 3).into_owned(),
         x: mean.fixed_rows::<3>(3) * n,
         xx: raw.fixed_view::<3, 3>(3, 3).diagonal(),
