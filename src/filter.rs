@@ -243,7 +243,8 @@ impl FilterSchedule {
 impl<const N: usize, const M: usize> FilterSchedule<N, M> {
     /// Runs the covariance recursion of `model` over `timeline`: P ← Φ(t_j, Δt)·P·Φᵀ + Q(t_j, Δt)
     /// at every accelerometer sample, a Joseph-form update at every fix. The estimate's transition
-    /// between fixes is the model's Φ over the whole interval.
+    /// between fixes is the product of the steps' Φ (the model's Φ over the whole interval when it
+    /// does not depend on time).
     ///
     /// # Errors
     /// [`FilterError`] when S or P stops being positive definite.
@@ -253,9 +254,18 @@ impl<const N: usize, const M: usize> FilterSchedule<N, M> {
         let mut j = 0;
         let mut fixes = Vec::with_capacity(timeline.fixes());
         for &jf in &timeline.fix_steps {
-            let t_from = timeline.time_s(j);
-            let phi_from_previous = model.transition(t_from, (jf - j) as f64 * timeline.dt_s);
+            // A time-invariant model's transition over the interval in one piece (exact for the
+            // error state, whose Φ is unipotent); otherwise the product of the steps.
+            let mut phi_from_previous = if S::TIME_INVARIANT {
+                model.transition(timeline.time_s(j), (jf - j) as f64 * timeline.dt_s)
+            } else {
+                SMatrix::identity()
+            };
             while j < jf {
+                if !S::TIME_INVARIANT {
+                    phi_from_previous =
+                        model.transition(timeline.time_s(j), timeline.dt_s) * phi_from_previous;
+                }
                 p = propagate_at(model, &system, &p, timeline.time_s(j));
                 j += 1;
             }

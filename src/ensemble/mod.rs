@@ -11,6 +11,7 @@ pub mod epoch;
 pub mod kernel;
 mod lane_sums;
 mod layout;
+pub mod linear;
 pub mod partial;
 mod stats;
 mod sums;
