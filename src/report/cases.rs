@@ -3,7 +3,7 @@
 
 use super::prose::{and_list, case_title, failure_sentence, letter};
 use super::rich::rich;
-use super::view::{CaseView, CheckRow, FigureView, PairView, SummaryCell, SummaryRow};
+use super::view::{CaseView, CheckRow, FigureView, PairView, SummaryCell, SummaryRow, VerdictView};
 use crate::checks::{Check, CheckId, Untestable, Verdict};
 use crate::format::{count, fixed, sig};
 use crate::study::CaseOutcome;
@@ -40,8 +40,8 @@ pub fn check_row(c: &Check, n: u64, fix_times_s: &[f64]) -> CheckRow {
     let (worst, band) = worst_and_band(c);
     CheckRow {
         id: c.id.name().to_string(),
-        what: c.id.hypothesis().to_string(),
-        statistic: c.id.statistic().to_string(),
+        what: c.definition.hypothesis.to_string(),
+        statistic: c.definition.statistic.to_string(),
         members: count(c.members as u64),
         worst,
         worst_at: c
@@ -49,25 +49,30 @@ pub fn check_row(c: &Check, n: u64, fix_times_s: &[f64]) -> CheckRow {
             .map_or_else(String::new, |w| w.member.describe(fix_times_s)),
         band,
         outside: count(c.failures as u64),
-        verdict: c.verdict.name().to_string(),
+        verdict: VerdictView::of(c.verdict),
         verdict_words: verdict_words(c.verdict, n),
     }
 }
 
-/// The verdict summary: one row per check, one cell per case.
+/// The verdict summary: one row per check the cases ran, one cell per case.
 pub fn summary(cases: &[CaseOutcome]) -> Vec<SummaryRow> {
-    CheckId::ALL
+    let Some(first) = cases.first() else {
+        return Vec::new();
+    };
+    first
+        .verdicts
+        .checks
         .iter()
-        .map(|&id| SummaryRow {
-            id: id.name().to_string(),
-            title: id.title().to_string(),
+        .map(|check| SummaryRow {
+            id: check.id.name().to_string(),
+            title: check.definition.title.to_string(),
             cells: cases
                 .iter()
                 .map(|o| {
-                    let c = o.verdicts.get(id);
+                    let c = o.verdicts.get(check.id);
                     let (worst, band) = worst_and_band(c);
                     SummaryCell {
-                        verdict: c.verdict.name().to_string(),
+                        verdict: VerdictView::of(c.verdict),
                         detail: match (c.is_normal(), c.failures > 0) {
                             (true, false) => format!("{worst} ≤ {}", fixed(c.upper, 2)),
                             (true, true) => format!("{worst} > {}", fixed(c.upper, 2)),
@@ -103,7 +108,7 @@ fn pair_view(o: &CaseOutcome) -> PairView {
             })
             .collect(),
         bound: fixed(p.bound, 2),
-        verdict: p.verdict.name().to_string(),
+        verdict: VerdictView::of(p.verdict),
     }
 }
 
@@ -118,12 +123,12 @@ pub fn case_view(
     let v = &o.verdicts;
     let n = o.run.stats.realizations;
     let fix_times_s: Vec<f64> = o.run.stats.fixes.iter().map(|f| f.time_s).collect();
-    let failed: Vec<String> = v.failed().map(|c| c.id.title().to_string()).collect();
+    let failed: Vec<String> = v.failed().map(|c| c.definition.title.to_string()).collect();
     let untestable: Vec<String> = v
         .checks
         .iter()
         .filter(|c| matches!(c.verdict, Verdict::Untestable(_)))
-        .map(|c| c.id.title().to_string())
+        .map(|c| c.definition.title.to_string())
         .collect();
     let verdict = match (failed.is_empty(), untestable.is_empty()) {
         (true, true) => "every check passes".to_string(),
@@ -136,7 +141,7 @@ pub fn case_view(
         ),
     };
     let achieved = o.achieved_rms_final();
-    let mean = v.get(CheckId::MeanError);
+    let mean = v.get(CheckId::MEAN_ERROR);
     CaseView {
         id: o.case.id().replace('_', "-"),
         letter: letter(index),

@@ -56,16 +56,17 @@ impl CheckFigure {
         CheckFigure::Consistency,
     ];
 
-    /// The figure that shows check `id`.
-    pub fn of(id: CheckId) -> Self {
-        match id {
-            CheckId::MeanError => CheckFigure::MeanError,
+    /// The figure that shows check `id`; `None` for a check that has no figure of its own.
+    pub fn of(id: CheckId) -> Option<Self> {
+        Some(match id {
+            CheckId::MEAN_ERROR => CheckFigure::MeanError,
             // The correlations are the off-diagonal terms of the covariance the figure compares.
-            CheckId::CovarianceMatch | CheckId::CovarianceCorrelation => CheckFigure::Covariance,
-            CheckId::Orthogonality => CheckFigure::Orthogonality,
-            CheckId::ResidualWhiteness => CheckFigure::Whiteness,
-            CheckId::Nees | CheckId::Nis => CheckFigure::Consistency,
-        }
+            CheckId::COVARIANCE_MATCH | CheckId::COVARIANCE_CORRELATION => CheckFigure::Covariance,
+            CheckId::ORTHOGONALITY => CheckFigure::Orthogonality,
+            CheckId::RESIDUAL_WHITENESS => CheckFigure::Whiteness,
+            CheckId::NEES | CheckId::NIS => CheckFigure::Consistency,
+            _ => return None,
+        })
     }
 
     fn id(self) -> &'static str {
@@ -116,7 +117,7 @@ fn check_figure(
     let v: &Verdicts = &o.verdicts;
     let get = |id| v.get(id);
     let case = case_title(o.case);
-    let share = percent(get(CheckId::MeanError).false_alarm_rate);
+    let share = percent(get(CheckId::MEAN_ERROR).false_alarm_rate);
     let id = format!("{}-{id_stem}", which.id());
     match which {
         CheckFigure::MeanError => figure(
@@ -126,10 +127,10 @@ fn check_figure(
             &format!(
                 "The a priori and a posteriori ensemble mean error e^{{ave}} of each state at every GPS fix ({case}, N = {}), against the band ±{}·σ/√N, where σ is the filter's standard deviation and {} the Bonferroni bound of the check's share α_{{c}} = {share}. Thin lines: the mean error predicted by one noise-free pass of the filter over the truth's deterministic part (a posteriori black, a priori grey).",
                 count(s.realizations),
-                fixed(get(CheckId::MeanError).upper, 2),
-                fixed(get(CheckId::MeanError).upper, 2),
+                fixed(get(CheckId::MEAN_ERROR).upper, 2),
+                fixed(get(CheckId::MEAN_ERROR).upper, 2),
             ),
-            plot::mean_error(s, get(CheckId::MeanError), &o.prediction.fixes),
+            plot::mean_error(s, get(CheckId::MEAN_ERROR), &o.prediction.fixes),
         ),
         CheckFigure::Covariance => figure(
             &id,
@@ -137,10 +138,10 @@ fn check_figure(
             "Ensemble variance against the filter's covariance",
             &format!(
                 "Left: the ensemble variance P^{{ave}} (N − 1 normalization) and the filter's P, a priori and a posteriori, on a logarithmic axis ({case}). Right: their ratio, with the χ² band [{}, {}] that holds the check's share α_{{c}} = {share}.",
-                sig(get(CheckId::CovarianceMatch).lower, 4),
-                sig(get(CheckId::CovarianceMatch).upper, 4)
+                sig(get(CheckId::COVARIANCE_MATCH).lower, 4),
+                sig(get(CheckId::COVARIANCE_MATCH).upper, 4)
             ),
-            plot::covariance(s, get(CheckId::CovarianceMatch)),
+            plot::covariance(s, get(CheckId::COVARIANCE_MATCH)),
         ),
         CheckFigure::Orthogonality => figure(
             &id,
@@ -148,9 +149,9 @@ fn check_figure(
             "Orthogonality of error and estimate",
             &format!(
                 "The normalized correlation √N·corr(e − e^{{ave}}, δx̂) of every error component with every estimate component, a priori and a posteriori, at every fix ({case}), against ±{}.",
-                fixed(get(CheckId::Orthogonality).upper, 2)
+                fixed(get(CheckId::ORTHOGONALITY).upper, 2)
             ),
-            plot::orthogonality(s, get(CheckId::Orthogonality)),
+            plot::orthogonality(s, get(CheckId::ORTHOGONALITY)),
         ),
         CheckFigure::Whiteness => figure(
             &id,
@@ -162,12 +163,12 @@ fn check_figure(
                     None => "every pair of fixes".to_string(),
                     Some(l) => format!("the pairs of fixes at most {l} fixes apart"),
                 },
-                fixed(get(CheckId::ResidualWhiteness).upper, 2),
+                fixed(get(CheckId::RESIDUAL_WHITENESS).upper, 2),
                 fixed(v.residual_pair.t_m_s, 1),
                 fixed(v.residual_pair.t_i_s, 1),
                 fixed(v.residual_pair.bound, 2)
             ),
-            plot::residual_whiteness(s, get(CheckId::ResidualWhiteness), &v.residual_pair),
+            plot::residual_whiteness(s, get(CheckId::RESIDUAL_WHITENESS), &v.residual_pair),
         ),
         CheckFigure::Consistency => figure(
             &id,
@@ -176,7 +177,7 @@ fn check_figure(
             &format!(
                 "The ensemble average of the normalized estimation error squared (expected 3) and of the normalized innovation squared (expected 2) at every fix ({case}), with their χ² bounds."
             ),
-            plot::consistency(s, get(CheckId::Nees), get(CheckId::Nis)),
+            plot::consistency(s, get(CheckId::NEES), get(CheckId::NIS)),
         ),
     }
 }
@@ -255,7 +256,7 @@ pub fn comparison_figures(
         "The achieved RMS a posteriori error √(mean² + variance) of each state over the ensemble, divided by the filter's σ, at every fix, for every case. A consistent filter stays at 1, within the sampling scatter; a ratio above 1 is accuracy the filter claims but does not reach.",
         plot::accuracy_ratio(&cases),
     )?;
-    let bound = study.cases[0].verdicts.get(CheckId::MeanError).upper;
+    let bound = study.cases[0].verdicts.get(CheckId::MEAN_ERROR).upper;
     let mean_error = figure(
         "fig-mean-error-cases",
         numbers.figure(),

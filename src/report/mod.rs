@@ -19,7 +19,6 @@ pub mod view;
 use askama::Template;
 use base64::Engine;
 
-use crate::checks::CheckId;
 use crate::format::{count, fixed, percent, short, sig};
 use crate::study::Study;
 use equations::Equations;
@@ -105,19 +104,22 @@ fn bias_sigma_progress(study: &Study) -> String {
     }
 }
 
-/// The check catalogue as the theory section shows it.
-fn catalogue(math: &Math) -> Vec<CatalogueEntry> {
-    CheckId::ALL
+/// The checks the study ran, as the theory section shows them.
+fn catalogue(study: &Study, math: &Math) -> Vec<CatalogueEntry> {
+    let capital = |s: &str| format!("{}{}", s[..1].to_uppercase(), &s[1..]);
+    study.cases[0]
+        .verdicts
+        .checks
         .iter()
-        .map(|&id| {
-            let h = id.hypothesis();
+        .map(|c| {
+            let d = c.definition;
             CatalogueEntry {
-                id: id.name().to_string(),
-                title: format!("{}{}", id.title()[..1].to_uppercase(), &id.title()[1..]),
-                hypothesis: format!("{}{}.", h[..1].to_uppercase(), &h[1..]),
-                rationale: id.rationale().to_string(),
-                members: id.members().to_string(),
-                formula: math.block(id.formula()),
+                id: d.id.name().to_string(),
+                title: capital(d.title),
+                hypothesis: format!("{}.", capital(d.hypothesis)),
+                rationale: d.rationale.to_string(),
+                members: d.members.to_string(),
+                formula: math.block(d.formula),
             }
         })
         .collect()
@@ -195,7 +197,16 @@ pub fn build(study: &Study, command: &str, math: &Math) -> Result<ReportView, Re
         steps_per_fix: tl.steps_per_fix.to_string(),
         first_fix: fixed(tl.fix_time_s(0), 2),
         false_alarm: percent(c.checks.false_alarm_rate),
-        false_alarm_share: prose::share_words(c.checks.false_alarm_rate),
+        false_alarm_share: prose::share_words(c.checks.false_alarm_rate, prose::checks_run(study)),
+        check_count: prose::checks_run(study).to_string(),
+        check_titles: prose::and_list(
+            &study.cases[0]
+                .verdicts
+                .checks
+                .iter()
+                .map(|c| c.definition.title.to_string())
+                .collect::<Vec<_>>(),
+        ),
         seed: c.ensemble.seed.to_string(),
         filter_matches_truth: differences.is_empty(),
         params: params::params(study),
@@ -203,7 +214,7 @@ pub fn build(study: &Study, command: &str, math: &Math) -> Result<ReportView, Re
             .iter()
             .map(|c| rich::rich(c))
             .collect(),
-        catalogue: catalogue(math),
+        catalogue: catalogue(study, math),
         summary: cases::summary(&study.cases),
         realization_case: {
             let i = study

@@ -5,7 +5,49 @@
 //! superscripts); the rest are plain text. The whole view is also written as `view.json` beside
 //! the page, so that a test or a person can read what the page shows.
 
+use std::fmt;
+
 use serde::Serialize;
+
+use crate::checks::Verdict;
+
+/// A verdict as the page shows it: its word is also its CSS class.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum VerdictView {
+    /// Every member in its band.
+    Pass,
+    /// Some member outside its band.
+    Fail,
+    /// The check cannot fail at this N.
+    Untestable,
+}
+
+impl VerdictView {
+    /// The view of `verdict`.
+    pub fn of(verdict: Verdict) -> Self {
+        match verdict {
+            Verdict::Pass => VerdictView::Pass,
+            Verdict::Fail => VerdictView::Fail,
+            Verdict::Untestable(_) => VerdictView::Untestable,
+        }
+    }
+
+    /// Whether the check could not be tested (its row then says why).
+    pub fn is_untestable(&self) -> bool {
+        *self == VerdictView::Untestable
+    }
+}
+
+impl fmt::Display for VerdictView {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            VerdictView::Pass => "pass",
+            VerdictView::Fail => "fail",
+            VerdictView::Untestable => "untestable",
+        })
+    }
+}
 
 /// A figure: number, title, caption and the SVG itself.
 #[derive(Clone, Debug, Serialize)]
@@ -68,8 +110,8 @@ pub struct CheckRow {
     pub band: String,
     /// Members outside the band.
     pub outside: String,
-    /// "pass", "fail" or "untestable" (also the CSS class).
-    pub verdict: String,
+    /// Pass, fail or untestable (its word is also the CSS class).
+    pub verdict: VerdictView,
     /// The verdict in words ("untestable at N = 10, needs N ≥ 22").
     pub verdict_words: String,
 }
@@ -77,8 +119,8 @@ pub struct CheckRow {
 /// One cell of the verdict summary: a check on a case.
 #[derive(Clone, Debug, Serialize)]
 pub struct SummaryCell {
-    /// "pass", "fail" or "untestable".
-    pub verdict: String,
+    /// Pass, fail or untestable.
+    pub verdict: VerdictView,
     /// Worst against bound, e.g. "|z| = 1.92 ≤ 4.76".
     pub detail: String,
 }
@@ -105,8 +147,8 @@ pub struct PairView {
     pub rows: Vec<[String; 3]>,
     /// Bound on |z|.
     pub bound: String,
-    /// "pass", "fail" or "untestable".
-    pub verdict: String,
+    /// Pass, fail or untestable.
+    pub verdict: VerdictView,
 }
 
 /// One case: its verdicts, accuracy, prediction and figures.
@@ -231,6 +273,10 @@ pub struct ReportView {
     pub false_alarm: String,
     /// Each check's share of it.
     pub false_alarm_share: String,
+    /// Number of checks each case runs.
+    pub check_count: String,
+    /// Their titles, "mean error, variance, … and NIS".
+    pub check_titles: String,
     /// Seed.
     pub seed: String,
     /// Whether the filter assumes the truth's statistics.
