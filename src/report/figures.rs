@@ -1,7 +1,8 @@
-//! The report's figures: which plot shows which check, their captions, and their numbers. Figure
-//! and table numbers are handed out here, in the order the page shows them.
+//! The report's figures: which plot shows which check and their captions; their numbers come
+//! from the [`super::outline`].
 
 use super::RenderError;
+use super::outline::{Figure, Numbers};
 use super::prose::{case_title, letter};
 use super::rich::rich;
 use super::view::FigureView;
@@ -10,29 +11,8 @@ use crate::format::{count, fixed, percent, sig};
 use crate::plot;
 use crate::study::{CaseOutcome, Study};
 
-/// Hands out figure and table numbers in reading order.
-#[derive(Debug, Default)]
-pub struct Numbering {
-    figures: usize,
-    tables: usize,
-}
-
-impl Numbering {
-    /// The next figure's number.
-    pub fn figure(&mut self) -> usize {
-        self.figures += 1;
-        self.figures
-    }
-
-    /// The next table's number.
-    pub fn table(&mut self) -> usize {
-        self.tables += 1;
-        self.tables
-    }
-}
-
 /// A figure that shows the members of one or more checks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum CheckFigure {
     /// The ensemble mean error.
     MeanError,
@@ -182,15 +162,19 @@ fn check_figure(
     }
 }
 
-/// The check figures of case `o`, numbered from `numbers`.
+/// The check figures of case `o`, the `index`-th, numbered by `numbers`.
 pub fn check_figures(
     o: &CaseOutcome,
-    numbers: &mut Numbering,
+    index: usize,
+    numbers: &Numbers,
 ) -> Result<Vec<FigureView>, RenderError> {
     let stem = o.case.id().replace('_', "-");
     CheckFigure::ALL
         .iter()
-        .map(|&which| check_figure(which, o, numbers.figure(), &stem))
+        .map(|&which| {
+            let number = numbers.figure(Figure::Check(index, which));
+            check_figure(which, o, number, &stem)
+        })
         .collect()
 }
 
@@ -208,27 +192,30 @@ fn series(study: &Study) -> Vec<plot::CaseSeries<'_>> {
         .collect()
 }
 
-/// The realization figures (trajectory and errors).
-pub fn realization_figures(
-    study: &Study,
-    numbers: &mut Numbering,
-) -> Result<(FigureView, FigureView), RenderError> {
+/// The trajectory of the recorded realization, numbered by `numbers`.
+pub fn trajectory_figure(study: &Study, numbers: &Numbers) -> Result<FigureView, RenderError> {
     let r = &study.realization;
     let case = case_title(study.realization_case);
-    let consistent = study.case(study.realization_case).verdicts.all_passed();
-    let trajectory = figure(
+    figure(
         "fig-trajectory",
-        numbers.figure(),
+        numbers.figure(Figure::Trajectory),
         "Acceleration profile and true trajectory",
         &format!(
             "Left: the true acceleration a(t), velocity and position of realization {} (seed {}, {case}), with the accelerometer's integration from the prior means. Right: the realization's bias, velocity drift δv = v − v_{{c}} and position drift δp = p − p_{{c}}, with the filter's estimates of each.",
             r.index, r.seed,
         ),
         plot::trajectory(r),
-    )?;
-    let realization = figure(
+    )
+}
+
+/// The estimation error of the recorded realization, numbered by `numbers`.
+pub fn realization_figure(study: &Study, numbers: &Numbers) -> Result<FigureView, RenderError> {
+    let r = &study.realization;
+    let case = case_title(study.realization_case);
+    let consistent = study.case(study.realization_case).verdicts.all_passed();
+    figure(
         "fig-realization",
-        numbers.figure(),
+        numbers.figure(Figure::Realization),
         "Estimation error of one realization",
         &format!(
             "The error δx − δx̂ of position, velocity and bias at every accelerometer sample ({case}{}), with the filter's ±1σ. Left: the whole run; right: the filter's σ over a short window, growing between fixes and dropping at each fix (open circles before the update, dots after); the bias σ is a staircase, constant between fixes.",
@@ -239,19 +226,18 @@ pub fn realization_figures(
             }
         ),
         plot::realization_errors(r),
-    )?;
-    Ok((trajectory, realization))
+    )
 }
 
 /// The figures that compare the cases.
 pub fn comparison_figures(
     study: &Study,
-    numbers: &mut Numbering,
+    numbers: &Numbers,
 ) -> Result<(FigureView, FigureView), RenderError> {
     let cases = series(study);
     let accuracy = figure(
         "fig-accuracy",
-        numbers.figure(),
+        numbers.figure(Figure::Accuracy),
         "Achieved accuracy against the filter's claim",
         "The achieved RMS a posteriori error √(mean² + variance) of each state over the ensemble, divided by the filter's σ, at every fix, for every case. A consistent filter stays at 1, within the sampling scatter; a ratio above 1 is accuracy the filter claims but does not reach.",
         plot::accuracy_ratio(&cases),
@@ -259,7 +245,7 @@ pub fn comparison_figures(
     let bound = study.cases[0].verdicts.get(CheckId::MEAN_ERROR).upper;
     let mean_error = figure(
         "fig-mean-error-cases",
-        numbers.figure(),
+        numbers.figure(Figure::MeanErrorCases),
         "Mean error of every case, in units of the filter's σ",
         &format!(
             "The a posteriori |e^{{ave}}| / σ of each state at every fix on a logarithmic axis, for every case, with the mean-error check's bound {}/√N in the same units (black). Sampling noise alone stays below the bound; a systematic error stands decades above it.",
