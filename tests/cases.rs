@@ -48,10 +48,10 @@ fn interval_means_make_the_closed_form_truth_consistent_at_20000_realizations() 
 #[test]
 fn point_samples_under_the_closed_form_truth_fail_the_mean_error_as_before() {
     let o = study().case(POINT_SAMPLES);
-    assert_eq!(o.verdicts.get(CheckId::MeanError).verdict, Verdict::Fail);
+    assert_eq!(o.verdicts.get(CheckId::MEAN_ERROR).verdict, Verdict::Fail);
     // The spread is unaffected.
     assert_eq!(
-        o.verdicts.get(CheckId::CovarianceMatch).verdict,
+        o.verdicts.get(CheckId::COVARIANCE_MATCH).verdict,
         Verdict::Pass
     );
 }
@@ -59,7 +59,7 @@ fn point_samples_under_the_closed_form_truth_fail_the_mean_error_as_before() {
 #[test]
 fn the_prediction_explains_every_case_mean_error_within_the_check_bound() {
     for o in &study().cases {
-        let bound = o.verdicts.get(CheckId::MeanError).upper;
+        let bound = o.verdicts.get(CheckId::MEAN_ERROR).upper;
         assert!(
             o.prediction.worst_se <= bound,
             "{}: worst |e_ave − m| = {} standard errors, bound {bound}",
@@ -69,7 +69,7 @@ fn the_prediction_explains_every_case_mean_error_within_the_check_bound() {
     }
     // Without the prediction the point-sample mean error is hundreds of standard errors off.
     let b = study().case(POINT_SAMPLES);
-    assert!(b.verdicts.get(CheckId::MeanError).worst_value() > 100.0);
+    assert!(b.verdicts.get(CheckId::MEAN_ERROR).worst_value() > 100.0);
     // In the model world the noise-free pass has no error at all.
     let a = study().case(MODEL_WORLD);
     assert!(

@@ -67,9 +67,12 @@ fn committed_page_matches_the_code() {
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/report/index.html"))
             .expect("report/index.html is committed");
     let study = default_study();
-    let now = accelcal::report::render(study, "accelcal report")
-        .unwrap()
-        .html;
+    let input = accelcal::report::ReportInput {
+        study,
+        command: "accelcal report",
+        threads: 1,
+    };
+    let now = accelcal::report::render(&input).unwrap().html;
     let (a, b) = (without_timing(&committed), without_timing(&now));
     if a != b {
         let line = a

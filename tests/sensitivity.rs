@@ -219,8 +219,8 @@ fn predicted_detection_agrees_with_the_measured_by_a_two_sample_test() {
     let k = 300;
     let d = 4000;
     let cases = [
-        (AssumedStatistic::GpsVelocity, 0.5, CheckId::MeanError),
-        (AssumedStatistic::GpsPosition, 1.25, CheckId::Nees),
+        (AssumedStatistic::GpsVelocity, 0.5, CheckId::MEAN_ERROR),
+        (AssumedStatistic::GpsPosition, 1.25, CheckId::NEES),
     ];
     let runs: Vec<_> = cases
         .iter()
@@ -244,7 +244,7 @@ fn predicted_detection_agrees_with_the_measured_by_a_two_sample_test() {
     for c in &runs {
         let measured = c.detected.as_ref().unwrap();
         for id in CheckId::ALL {
-            if id == CheckId::ResidualWhiteness {
+            if id == CheckId::RESIDUAL_WHITENESS {
                 assert_eq!(c.predicted[id.index()], None);
                 continue;
             }

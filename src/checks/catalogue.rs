@@ -1,54 +1,104 @@
-//! The catalogue of checks: for each of the seven, the hypothesis it tests, its member statistic,
-//! the distribution of that statistic under a consistent filter, its formula, and the smallest
-//! ensemble that can test it. This is the one place that describes a check; everything else
-//! matches on [`CheckId`] exhaustively, so a new check cannot be half added.
+//! The catalogue of checks: the one list of [`Definition`]s, each in its own file under
+//! `src/checks/`, that says for a check the hypothesis it tests, its member statistic, the
+//! distribution of that statistic under a consistent filter, its formula, the smallest ensemble
+//! that can test it, how its members are computed and how a failure reads. Nothing else describes
+//! a check: the verdicts, the budget, the JSON, the sensitivity study and the report iterate over
+//! [`CATALOGUE`], so a check is added by its file and one line here.
+
+use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
+use super::{Check, covariance_correlation, covariance_match, mean_error, nees, nis};
+use super::{orthogonality, residual_whiteness};
+use crate::ensemble::EnsembleStats;
 use crate::filter::{Component, Stage};
 use crate::stats::normal_bound;
 
-/// One of the seven consistency checks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CheckId {
-    /// The ensemble mean error is zero.
-    ///
-    /// # Formula
-    /// z = e_ave,k(tᵢ) / √(P_kk(tᵢ)/N) ~ N(0, 1), for each state k, fix i and stage.
-    MeanError,
-    /// The ensemble variance equals the filter's.
-    ///
-    /// # Formula
-    /// (N − 1)·P_ave,kk / P_kk ~ χ²(N − 1), for each state k, fix i and stage.
-    CovarianceMatch,
-    /// The correlations between error components equal those of the filter's P.
-    ///
-    /// # Formula
-    /// z = √(N − 3)·(atanh r_jk − atanh ρ_jk) ≈ N(0, 1), r from P_ave and ρ from P, for each
-    /// pair j < k, fix and stage (Fisher's transformation).
-    CovarianceCorrelation,
-    /// The error is uncorrelated with the estimate.
-    ///
-    /// # Formula
-    /// z = √N·corr(e_j − e_ave,j, δx̂_k) ≈ N(0, 1), for each j, k, fix and stage; |z| ≤ √N.
-    Orthogonality,
-    /// Residuals at different fixes are uncorrelated.
-    ///
-    /// # Formula
-    /// z = √N·Σ r_j(tᵢ)·r_k(tₘ) / √(Σ r_j(tᵢ)²·Σ r_k(tₘ)²) ≈ N(0, 1), for each pair tₘ < tᵢ
-    /// and components j, k; |z| ≤ √N.
-    ResidualWhiteness,
-    /// The average normalized estimation error squared is the state dimension.
-    ///
-    /// # Formula
-    /// N·ε̄ = Σ eᵀP⁻¹e ~ χ²(3N), for each fix and stage.
-    Nees,
-    /// The average normalized innovation squared is the measurement dimension.
-    ///
-    /// # Formula
-    /// N·ν̄ = Σ rᵀS⁻¹r ~ χ²(2N), for each fix.
-    Nis,
+/// Every check, in the order the report and the JSON present them: the one registration list.
+pub const CATALOGUE: &[&Definition] = &[
+    &mean_error::CHECK,
+    &covariance_match::CHECK,
+    &covariance_correlation::CHECK,
+    &orthogonality::CHECK,
+    &residual_whiteness::CHECK,
+    &nees::CHECK,
+    &nis::CHECK,
+];
+
+/// The stable identifier of a check, used in JSON and on the command line (`"mean_error"`).
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct CheckId(&'static str);
+
+/// How the words of a failed check are put together: the pieces every failure sentence uses.
+#[derive(Clone, Debug)]
+pub struct FailureWords {
+    /// "3 of 1,200 members".
+    pub outside: String,
+    /// The band, "[0.91, 1.09]".
+    pub band: String,
+    /// Where the worst member is, "a posteriori velocity at 12.4 s".
+    pub at: String,
+}
+
+/// One check: everything that describes it, in one place.
+#[derive(Clone, Copy)]
+pub struct Definition {
+    /// Its identifier.
+    pub id: CheckId,
+    /// A short title for tables and figure legends.
+    pub title: &'static str,
+    /// The hypothesis a consistent filter satisfies.
+    pub hypothesis: &'static str,
+    /// The member statistic, in plain Unicode.
+    pub statistic: &'static str,
+    /// What one member is.
+    pub members: &'static str,
+    /// Why the statistic has its distribution, in one or two sentences.
+    pub rationale: &'static str,
+    /// The check's equations, as LaTeX (the report renders them; macros `\dx`, `\dxhat`, `\T`).
+    pub formula: &'static str,
+    /// The distribution of a member under a consistent filter, for N realizations.
+    pub null: fn(n: f64) -> Null,
+    /// Calls `f(value, member)` for every member, in fix order.
+    pub for_each_member: fn(&EnsembleStats, &mut dyn FnMut(f64, MemberId)),
+    /// What a failure means, in one or two sentences.
+    pub failure: fn(&Check, &FailureWords) -> String,
+}
+
+impl fmt::Debug for Definition {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_tuple("Definition").field(&self.id).finish()
+    }
+}
+
+impl PartialEq for Definition {
+    fn eq(&self, other: &Self) -> bool {
+        self.id == other.id
+    }
+}
+
+impl Definition {
+    /// The smallest N at which the check can fail when each member is tested two-sided at rate
+    /// `p_member`: its approximation must hold (Fisher's z needs N > 3), and a score bounded by
+    /// √N must be able to pass its bound b (N > b²).
+    pub fn min_realizations(&self, p_member: f64) -> u64 {
+        match (self.null)(2.0) {
+            Null::Normal | Null::ChiSquared { .. } => 2,
+            Null::Fisher => 4,
+            Null::CorrelationScore => {
+                let b = normal_bound(p_member.min(1.0));
+                ((b * b).floor() as u64 + 1).max(2)
+            }
+        }
+    }
+
+    /// Number of members on `stats`.
+    pub fn count(&self, stats: &EnsembleStats) -> usize {
+        let mut m = 0;
+        (self.for_each_member)(stats, &mut |_, _| m += 1);
+        m
+    }
 }
 
 /// How a member statistic is distributed when the filter is consistent.
@@ -70,191 +120,109 @@ pub enum Null {
 }
 
 impl CheckId {
-    /// Every check, in the order the report and the JSON present them.
-    pub const ALL: [CheckId; 7] = [
-        CheckId::MeanError,
-        CheckId::CovarianceMatch,
-        CheckId::CovarianceCorrelation,
-        CheckId::Orthogonality,
-        CheckId::ResidualWhiteness,
-        CheckId::Nees,
-        CheckId::Nis,
-    ];
+    /// The ensemble mean error is zero.
+    pub const MEAN_ERROR: CheckId = CheckId("mean_error");
+    /// The ensemble variance equals the filter's.
+    pub const COVARIANCE_MATCH: CheckId = CheckId("covariance_match");
+    /// The correlations between error components equal those of the filter's P.
+    pub const COVARIANCE_CORRELATION: CheckId = CheckId("covariance_correlation");
+    /// The error is uncorrelated with the estimate.
+    pub const ORTHOGONALITY: CheckId = CheckId("orthogonality");
+    /// Residuals at different fixes are uncorrelated.
+    pub const RESIDUAL_WHITENESS: CheckId = CheckId("residual_whiteness");
+    /// The average normalized estimation error squared is the state dimension.
+    pub const NEES: CheckId = CheckId("nees");
+    /// The average normalized innovation squared is the measurement dimension.
+    pub const NIS: CheckId = CheckId("nis");
+
+    /// Every check, in [`CATALOGUE`] order.
+    pub const ALL: [CheckId; CATALOGUE.len()] = {
+        let mut all = [CheckId(""); CATALOGUE.len()];
+        let mut i = 0;
+        while i < all.len() {
+            all[i] = CATALOGUE[i].id;
+            i += 1;
+        }
+        all
+    };
+
+    /// A check's identifier; `name` is its stable JSON name.
+    pub const fn new(name: &'static str) -> Self {
+        CheckId(name)
+    }
+
+    /// The registered check called `name`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        CheckId::ALL.into_iter().find(|id| id.0 == name)
+    }
 
     /// Position in [`CheckId::ALL`].
+    ///
+    /// # Panics
+    /// When the check is not in [`CATALOGUE`].
     pub fn index(self) -> usize {
-        self as usize
+        CheckId::ALL
+            .iter()
+            .position(|&id| id == self)
+            .expect("a registered check")
+    }
+
+    /// Its definition in [`CATALOGUE`].
+    ///
+    /// # Panics
+    /// When the check is not in [`CATALOGUE`].
+    pub fn definition(self) -> &'static Definition {
+        CATALOGUE[self.index()]
     }
 
     /// The stable identifier used in JSON and on the command line.
     pub fn name(self) -> &'static str {
-        match self {
-            CheckId::MeanError => "mean_error",
-            CheckId::CovarianceMatch => "covariance_match",
-            CheckId::CovarianceCorrelation => "covariance_correlation",
-            CheckId::Orthogonality => "orthogonality",
-            CheckId::ResidualWhiteness => "residual_whiteness",
-            CheckId::Nees => "nees",
-            CheckId::Nis => "nis",
-        }
+        self.0
     }
 
     /// A short title for tables and figure legends.
     pub fn title(self) -> &'static str {
-        match self {
-            CheckId::MeanError => "mean error",
-            CheckId::CovarianceMatch => "variance",
-            CheckId::CovarianceCorrelation => "correlation",
-            CheckId::Orthogonality => "orthogonality",
-            CheckId::ResidualWhiteness => "residual whiteness",
-            CheckId::Nees => "NEES",
-            CheckId::Nis => "NIS",
-        }
+        self.definition().title
     }
 
     /// The hypothesis a consistent filter satisfies.
     pub fn hypothesis(self) -> &'static str {
-        match self {
-            CheckId::MeanError => "the ensemble mean error is zero",
-            CheckId::CovarianceMatch => "the ensemble variance equals the filter's P",
-            CheckId::CovarianceCorrelation => "the ensemble correlations equal those of P",
-            CheckId::Orthogonality => "the error is orthogonal to the estimate",
-            CheckId::ResidualWhiteness => "residuals at different fixes are uncorrelated",
-            CheckId::Nees => "the average NEES is 3, the state dimension",
-            CheckId::Nis => "the average NIS is 2, the measurement dimension",
-        }
+        self.definition().hypothesis
     }
 
     /// The member statistic, in plain Unicode.
     pub fn statistic(self) -> &'static str {
-        match self {
-            CheckId::MeanError => "z = eᵃᵛᵉ / √(P/N)",
-            CheckId::CovarianceMatch => "Pᵃᵛᵉ / P (diagonal)",
-            CheckId::CovarianceCorrelation => "z = √(N−3)·(atanh r − atanh ρ)",
-            CheckId::Orthogonality => "z = √N · corr(e, δx̂)",
-            CheckId::ResidualWhiteness => "z = √N · corr(r(tᵢ), r(tₘ))",
-            CheckId::Nees => "(1/N) Σ eᵀP⁻¹e",
-            CheckId::Nis => "(1/N) Σ rᵀS⁻¹r",
-        }
-    }
-
-    /// What one member is.
-    pub fn members(self) -> &'static str {
-        match self {
-            CheckId::MeanError | CheckId::CovarianceMatch => {
-                "each state at each fix, a priori and a posteriori; the a priori bias, a copy of \
-                 the previous fix's a posteriori bias, is counted once"
-            }
-            CheckId::CovarianceCorrelation => {
-                "each pair of states at each fix, a priori and a posteriori"
-            }
-            CheckId::Orthogonality => {
-                "each error and estimate component at each fix, a priori and a posteriori; the a \
-                 priori bias pair, a copy of the previous fix's, is counted once"
-            }
-            CheckId::ResidualWhiteness => {
-                "each pair of fixes tₘ < tᵢ (in runs of more than 1000 fixes, or with \
-                 checks.residual_max_lag, those at most that lag apart) and pair of components"
-            }
-            CheckId::Nees => "each fix, a priori and a posteriori",
-            CheckId::Nis => "each fix",
-        }
-    }
-
-    /// Why the statistic has its distribution, in one or two sentences.
-    pub fn rationale(self) -> &'static str {
-        match self {
-            CheckId::MeanError => {
-                "Its standard error is σ/√N with σ from the filter's P, so each component of the \
-                 mean error divided by it is a standard normal score."
-            }
-            CheckId::CovarianceMatch => {
-                "For Gaussian errors each diagonal ratio of the unbiased ensemble covariance to \
-                 P is a scaled χ²(N−1) variable."
-            }
-            CheckId::CovarianceCorrelation => {
-                "The correlation r of each pair of error components in the ensemble is compared \
-                 with the correlation ρ that the filter's P implies, through Fisher's \
-                 transformation, whose normal approximation needs N\u{a0}>\u{a0}3."
-            }
-            CheckId::Orthogonality => {
-                "Each entry of the orthogonality matrix is normalized by the ensemble standard \
-                 deviations to a correlation, which for uncorrelated variables has standard \
-                 deviation 1/√N; the score cannot exceed √N, so small ensembles cannot fail it."
-            }
-            CheckId::ResidualWhiteness => {
-                "The residual correlation is computed for every tested pair of fixes and components and \
-                 normalized the same way; its score cannot exceed √N either."
-            }
-            CheckId::Nees => {
-                "Each realization's eᵀP⁻¹e is χ²(3) for Gaussian errors, so N times the average \
-                 is χ²(3N)."
-            }
-            CheckId::Nis => "Each realization's rᵀS⁻¹r is χ²(2), so N times the average is χ²(2N).",
-        }
-    }
-
-    /// The check's equations, as LaTeX (the report renders them; macros `\dx`, `\dxhat`, `\T`).
-    pub fn formula(self) -> &'static str {
-        match self {
-            CheckId::MeanError => {
-                r"e^{\mathrm{ave}}(t_i) = \frac{1}{N} \sum_{l=1}^{N} e^l(t_i), \qquad z = \frac{e^{\mathrm{ave}}_k(t_i)}{\sqrt{P_{kk}(t_i)/N}} \sim \mathcal{N}(0, 1)"
-            }
-            CheckId::CovarianceMatch => {
-                r"P^{\mathrm{ave}}(t_i) = \frac{1}{N-1} \sum_{l=1}^{N} \left(e^l - e^{\mathrm{ave}}\right)\left(e^l - e^{\mathrm{ave}}\right)\T, \qquad (N-1)\,\frac{P^{\mathrm{ave}}_{kk}}{P_{kk}} \sim \chi^2(N-1)"
-            }
-            CheckId::CovarianceCorrelation => {
-                r"r_{jk} = \frac{P^{\mathrm{ave}}_{jk}}{\sqrt{P^{\mathrm{ave}}_{jj} P^{\mathrm{ave}}_{kk}}}, \quad \rho_{jk} = \frac{P_{jk}}{\sqrt{P_{jj} P_{kk}}}, \qquad z = \sqrt{N-3}\,\left(\operatorname{atanh} r_{jk} - \operatorname{atanh} \rho_{jk}\right) \approx \mathcal{N}(0, 1)"
-            }
-            CheckId::Orthogonality => {
-                r"C(t_i) = \frac{1}{N} \sum_{l=1}^{N} \left(e^l(t_i) - e^{\mathrm{ave}}(t_i)\right) \dxhat^l(t_i)\T, \qquad z_{jk} = \sqrt{N}\, \frac{C_{jk}}{\sigma(e_j)\, \sigma(\widehat{\delta x}_k)} \approx \mathcal{N}(0, 1)"
-            }
-            CheckId::ResidualWhiteness => {
-                r"z_{jk} = \sqrt{N}\, \frac{\sum_l r^l_j(t_i)\, r^l_k(t_m)}{\sqrt{\sum_l r^l_j(t_i)^2 \sum_l r^l_k(t_m)^2}} \approx \mathcal{N}(0, 1), \quad t_m < t_i"
-            }
-            CheckId::Nees => {
-                r"\bar{\epsilon}(t_i) = \frac{1}{N} \sum_{l=1}^{N} e^l(t_i)\T P(t_i)^{-1} e^l(t_i), \qquad N \bar{\epsilon} \sim \chi^2(3N)"
-            }
-            CheckId::Nis => {
-                r"\bar{\nu}(t_i) = \frac{1}{N} \sum_{l=1}^{N} r^l(t_i)\T S(t_i)^{-1} r^l(t_i), \qquad N \bar{\nu} \sim \chi^2(2N)"
-            }
-        }
+        self.definition().statistic
     }
 
     /// The distribution of a member under a consistent filter, for `n` realizations.
     pub fn null(self, n: u64) -> Null {
-        let n = n as f64;
-        match self {
-            CheckId::MeanError => Null::Normal,
-            CheckId::CovarianceMatch => Null::ChiSquared {
-                dof: n - 1.0,
-                scale: n - 1.0,
-            },
-            CheckId::CovarianceCorrelation => Null::Fisher,
-            CheckId::Orthogonality | CheckId::ResidualWhiteness => Null::CorrelationScore,
-            CheckId::Nees => Null::ChiSquared {
-                dof: 3.0 * n,
-                scale: n,
-            },
-            CheckId::Nis => Null::ChiSquared {
-                dof: 2.0 * n,
-                scale: n,
-            },
-        }
+        (self.definition().null)(n as f64)
     }
 
-    /// The smallest N at which the check can fail when each member is tested two-sided at rate
-    /// `p_member`: its approximation must hold (Fisher's z needs N > 3), and a score bounded by
-    /// √N must be able to pass its bound b (N > b²).
+    /// See [`Definition::min_realizations`].
     pub fn min_realizations(self, p_member: f64) -> u64 {
-        match self.null(2) {
-            Null::Normal | Null::ChiSquared { .. } => 2,
-            Null::Fisher => 4,
-            Null::CorrelationScore => {
-                let b = normal_bound(p_member.min(1.0));
-                ((b * b).floor() as u64 + 1).max(2)
-            }
-        }
+        self.definition().min_realizations(p_member)
+    }
+}
+
+impl fmt::Debug for CheckId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.0)
+    }
+}
+
+impl Serialize for CheckId {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.0)
+    }
+}
+
+impl<'de> Deserialize<'de> for CheckId {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        CheckId::from_name(&name)
+            .ok_or_else(|| serde::de::Error::custom(format!("unknown check `{name}`")))
     }
 }
 
@@ -409,15 +377,17 @@ mod tests {
             assert_eq!(json, format!("\"{}\"", id.name()));
             assert_eq!(serde_json::from_str::<CheckId>(&json).unwrap(), id);
             assert_eq!(CheckId::ALL[id.index()], id);
+            assert_eq!(id.definition().id, id);
         }
+        assert!(serde_json::from_str::<CheckId>("\"no_such_check\"").is_err());
     }
 
     #[test]
     fn bounded_scores_need_n_above_the_square_of_their_bound() {
         // At p = 1e-5 the bound is 4.417: √N must exceed it, N ≥ 20.
-        assert_eq!(CheckId::Orthogonality.min_realizations(1e-5), 20);
-        assert_eq!(CheckId::ResidualWhiteness.min_realizations(1e-5), 20);
-        assert_eq!(CheckId::CovarianceCorrelation.min_realizations(1e-5), 4);
-        assert_eq!(CheckId::MeanError.min_realizations(1e-5), 2);
+        assert_eq!(CheckId::ORTHOGONALITY.min_realizations(1e-5), 20);
+        assert_eq!(CheckId::RESIDUAL_WHITENESS.min_realizations(1e-5), 20);
+        assert_eq!(CheckId::COVARIANCE_CORRELATION.min_realizations(1e-5), 4);
+        assert_eq!(CheckId::MEAN_ERROR.min_realizations(1e-5), 2);
     }
 }

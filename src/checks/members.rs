@@ -31,7 +31,7 @@ pub fn z_score(n: u64, m_ab: f64, m_aa: f64, m_bb: f64) -> f64 {
     (n as f64).sqrt() * m_ab / (m_aa * m_bb).sqrt()
 }
 
-/// Calls `f(value, member)` for every member of check `id`, in fix order.
+/// Calls `f(value, member)` for every member of the built-in check `id`, in fix order.
 pub fn for_each(id: CheckId, stats: &EnsembleStats, f: &mut dyn FnMut(f64, MemberId)) {
     let n = stats.realizations as f64;
     // For every fix and stage: `g(fix, stage, stats of the stage)`.
@@ -43,13 +43,13 @@ pub fn for_each(id: CheckId, stats: &EnsembleStats, f: &mut dyn FnMut(f64, Membe
         }
     };
     match id {
-        CheckId::MeanError | CheckId::CovarianceMatch => per_stage(&mut |i, stage, s| {
+        CheckId::MEAN_ERROR | CheckId::COVARIANCE_MATCH => per_stage(&mut |i, stage, s| {
             for state in Component::STATE {
                 if is_bias_copy(i, stage, state) {
                     continue;
                 }
                 let k = state.index();
-                let value = if id == CheckId::MeanError {
+                let value = if id == CheckId::MEAN_ERROR {
                     s.mean_error[k] / (s.filter_cov[k][k] / n).sqrt()
                 } else {
                     s.ensemble_cov[k][k] / s.filter_cov[k][k]
@@ -58,7 +58,7 @@ pub fn for_each(id: CheckId, stats: &EnsembleStats, f: &mut dyn FnMut(f64, Membe
                 f(value, MemberId::State { fix, stage, state });
             }
         }),
-        CheckId::CovarianceCorrelation => {
+        CheckId::COVARIANCE_CORRELATION => {
             // Fisher's transformation: for bivariate normal errors atanh(r) is close to normal
             // with mean atanh(ρ) and variance 1/(N − 3).
             let scale = (n - 3.0).max(1.0).sqrt();
@@ -77,7 +77,7 @@ pub fn for_each(id: CheckId, stats: &EnsembleStats, f: &mut dyn FnMut(f64, Membe
                 }
             })
         }
-        CheckId::Orthogonality => per_stage(&mut |i, stage, s| {
+        CheckId::ORTHOGONALITY => per_stage(&mut |i, stage, s| {
             for error in Component::STATE {
                 for estimate in Component::STATE {
                     let c = s.orthogonality_corr[error.index()][estimate.index()];
@@ -95,7 +95,7 @@ pub fn for_each(id: CheckId, stats: &EnsembleStats, f: &mut dyn FnMut(f64, Membe
                 }
             }
         }),
-        CheckId::ResidualWhiteness => {
+        CheckId::RESIDUAL_WHITENESS => {
             let layout = &stats.residual_layout;
             for later in 1..stats.fixes.len() {
                 for earlier in (0..later).filter(|&m| layout.keeps(later, m)) {
@@ -118,7 +118,7 @@ pub fn for_each(id: CheckId, stats: &EnsembleStats, f: &mut dyn FnMut(f64, Membe
                 }
             }
         }
-        CheckId::Nees => per_stage(&mut |i, stage, s| {
+        CheckId::NEES => per_stage(&mut |i, stage, s| {
             f(
                 s.nees_avg,
                 MemberId::Nees {
@@ -127,17 +127,12 @@ pub fn for_each(id: CheckId, stats: &EnsembleStats, f: &mut dyn FnMut(f64, Membe
                 },
             )
         }),
-        CheckId::Nis => {
+        CheckId::NIS => {
             for (i, fix) in stats.fixes.iter().enumerate() {
                 f(fix.nis_avg, MemberId::Nis { fix: i as u32 });
             }
         }
+        // A check defined outside this file computes its own members.
+        _ => {}
     }
-}
-
-/// Number of members of check `id`.
-pub fn count(id: CheckId, stats: &EnsembleStats) -> usize {
-    let mut m = 0;
-    for_each(id, stats, &mut |_, _| m += 1);
-    m
 }

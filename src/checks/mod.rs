@@ -2,7 +2,7 @@
 //!
 //! Each check of the [`catalogue`] is a family of hypothesis tests, one per distinct member (a
 //! fix, a stage, a component, a pair of fixes). The study-wide false-alarm rate α — the
-//! probability that a consistent filter gets any "fail" — is split evenly over the seven checks,
+//! probability that a consistent filter gets any "fail" — is split evenly over the checks,
 //! and each check's share α_c over its M members, each tested two-sided at α_c/M (Bonferroni, at
 //! both levels). A check whose statistic cannot pass its bound at this N, or whose approximation
 //! does not hold, is "untestable", never "pass".
@@ -10,13 +10,20 @@
 //! This module returns numbers and typed member ids; words are the catalogue's and the report's.
 
 pub mod catalogue;
+mod covariance_correlation;
+mod covariance_match;
+mod mean_error;
 mod members;
+mod nees;
+mod nis;
+mod orthogonality;
+mod residual_whiteness;
 
 use serde::Serialize;
 
 use crate::ensemble::EnsembleStats;
 use crate::stats::{chi_squared_band, chi_squared_median, normal_bound};
-pub use catalogue::{CheckId, MemberId, Null};
+pub use catalogue::{CATALOGUE, CheckId, Definition, FailureWords, MemberId, Null};
 pub use members::{is_bias_copy, residual_z};
 
 /// How the study-wide false-alarm rate is spent over the checks.
@@ -26,10 +33,15 @@ pub struct Budget {
 }
 
 impl Budget {
-    /// The study-wide rate `alpha` split evenly over the seven checks (Bonferroni).
+    /// The study-wide rate `alpha` split evenly over the checks of [`CATALOGUE`] (Bonferroni).
     pub fn study(alpha: f64) -> Self {
+        Self::over(alpha, CATALOGUE.len())
+    }
+
+    /// The study-wide rate `alpha` split evenly over `checks` checks.
+    pub fn over(alpha: f64, checks: usize) -> Self {
         Self {
-            per_check: alpha / CheckId::ALL.len() as f64,
+            per_check: alpha / checks as f64,
         }
     }
 
@@ -39,14 +51,14 @@ impl Budget {
         Self { per_check: share }
     }
 
-    /// The share of check `id` (the same for every check).
-    pub fn share(&self, _id: CheckId) -> f64 {
+    /// The share of each check (the same for every check).
+    pub fn share(&self) -> f64 {
         self.per_check
     }
 
-    /// The study-wide rate: the sum of the shares.
-    pub fn total(&self) -> f64 {
-        CheckId::ALL.iter().map(|&id| self.share(id)).sum()
+    /// The study-wide rate over `checks` checks: the sum of their shares.
+    pub fn total(&self, checks: usize) -> f64 {
+        self.per_check * checks as f64
     }
 }
 
@@ -99,6 +111,8 @@ pub struct Worst {
 pub struct Check {
     /// Which check.
     pub id: CheckId,
+    /// Its definition: words, distribution, members.
+    pub definition: &'static Definition,
     /// Distinct members tested, M.
     pub members: usize,
     /// This check's share α_c of the study-wide false-alarm rate.
@@ -127,7 +141,7 @@ impl Check {
 
     /// Whether the members are normal scores (else χ² statistics).
     pub fn is_normal(&self) -> bool {
-        match self.id.null(2) {
+        match (self.definition.null)(2.0) {
             Null::Normal | Null::CorrelationScore | Null::Fisher => true,
             Null::ChiSquared { .. } => false,
         }
@@ -209,8 +223,14 @@ impl Verdicts {
     }
 
     /// The verdict of check `id`.
+    ///
+    /// # Panics
+    /// When the check was not run.
     pub fn get(&self, id: CheckId) -> &Check {
-        &self.checks[id.index()]
+        self.checks
+            .iter()
+            .find(|c| c.id == id)
+            .expect("a check that was run")
     }
 
     /// The checks that failed.
@@ -219,11 +239,11 @@ impl Verdicts {
     }
 }
 
-/// The acceptance band (lower, upper, centre) of every member of check `id` at `n` realizations,
-/// each member tested two-sided at rate `p_member`.
-pub fn band(id: CheckId, n: u64, p_member: f64) -> (f64, f64, f64) {
+/// The acceptance band (lower, upper, centre) of every member of check `check` at `n`
+/// realizations, each member tested two-sided at rate `p_member`.
+pub fn band(check: &Definition, n: u64, p_member: f64) -> (f64, f64, f64) {
     let p = p_member.min(1.0);
-    match id.null(n) {
+    match (check.null)(n as f64) {
         Null::Normal | Null::CorrelationScore | Null::Fisher => {
             let b = normal_bound(p);
             (-b, b, 0.0)
@@ -243,20 +263,21 @@ pub fn fails_again(check: &Check, stats: &EnsembleStats) -> bool {
         return false;
     }
     let mut outside = false;
-    members::for_each(check.id, stats, &mut |value, _| {
+    (check.definition.for_each_member)(stats, &mut |value, _| {
         outside |= !(check.lower..=check.upper).contains(&value);
     });
     outside
 }
 
-/// Judges check `id` on `stats` at false-alarm share `share`.
-pub fn judge(id: CheckId, stats: &EnsembleStats, share: f64) -> Check {
+/// Judges check `definition` on `stats` at false-alarm share `share`.
+pub fn judge(definition: &'static Definition, stats: &EnsembleStats, share: f64) -> Check {
     let n = stats.realizations;
-    let m = members::count(id, stats);
+    let m = definition.count(stats);
     let p = (share / m.max(1) as f64).min(1.0);
-    let (lower, upper, center) = band(id, n, p);
+    let (lower, upper, center) = band(definition, n, p);
     let mut check = Check {
-        id,
+        id: definition.id,
+        definition,
         members: m,
         false_alarm_rate: share,
         lower,
@@ -264,11 +285,11 @@ pub fn judge(id: CheckId, stats: &EnsembleStats, share: f64) -> Check {
         center,
         failures: 0,
         worst: None,
-        min_realizations: id.min_realizations(p),
+        min_realizations: definition.min_realizations(p),
         verdict: Verdict::Pass,
     };
     let mut worst: Option<(f64, Worst)> = None;
-    members::for_each(id, stats, &mut |value, member| {
+    (definition.for_each_member)(stats, &mut |value, member| {
         if !(lower..=upper).contains(&value) {
             check.failures += 1;
         }
@@ -297,14 +318,33 @@ pub fn judge(id: CheckId, stats: &EnsembleStats, share: f64) -> Check {
     check
 }
 
-/// Runs every check on `stats` within `budget`, and the statement's single residual pair.
+/// Runs every check of [`CATALOGUE`] on `stats` within `budget`, and the statement's single
+/// residual pair.
 pub fn evaluate(stats: &EnsembleStats, budget: &Budget) -> Verdicts {
-    let checks = CheckId::ALL
-        .iter()
-        .map(|&id| judge(id, stats, budget.share(id)))
-        .collect();
+    evaluate_with(stats, budget, CATALOGUE)
+}
+
+/// Runs the checks of `catalogue` on `stats` within `budget`, and the statement's single residual
+/// pair (tested at the share of one check).
+pub fn evaluate_with(
+    stats: &EnsembleStats,
+    budget: &Budget,
+    catalogue: &[&'static Definition],
+) -> Verdicts {
+    Verdicts {
+        checks: catalogue
+            .iter()
+            .map(|&check| judge(check, stats, budget.share()))
+            .collect(),
+        residual_pair: residual_pair(stats, budget.share()),
+        false_alarm_rate: budget.total(catalogue.len()),
+    }
+}
+
+/// The statement's single residual pair, its four products tested at `share` together.
+fn residual_pair(stats: &EnsembleStats, share: f64) -> ResidualPair {
     let [m, i] = stats.pair;
-    let bound = normal_bound(budget.share(CheckId::ResidualWhiteness).min(1.0) / 4.0);
+    let bound = normal_bound(share.min(1.0) / 4.0);
     let diagonal = |a| stats.residual_moment(a, a).unwrap_or(f64::NAN);
     let z: [[f64; 2]; 2] = std::array::from_fn(|j| {
         std::array::from_fn(|k| {
@@ -326,21 +366,17 @@ pub fn evaluate(stats: &EnsembleStats, budget: &Budget) -> Verdicts {
     } else {
         Verdict::Fail
     };
-    Verdicts {
-        checks,
-        residual_pair: ResidualPair {
-            earlier: m,
-            later: i,
-            t_m_s: stats.fixes[m].time_s,
-            t_i_s: stats.fixes[i].time_s,
-            mean_product: std::array::from_fn(|j| {
-                std::array::from_fn(|k| stats.pair_moments[(j, k)])
-            }),
-            z,
-            bound,
-            verdict,
-        },
-        false_alarm_rate: budget.total(),
+    ResidualPair {
+        earlier: m,
+        later: i,
+        t_m_s: stats.fixes[m].time_s,
+        t_i_s: stats.fixes[i].time_s,
+        mean_product: std::array::from_fn(|j| {
+            std::array::from_fn(|k| stats.pair_moments[(j, k)])
+        }),
+        z,
+        bound,
+        verdict,
     }
 }
 

@@ -21,7 +21,11 @@ pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
     let mut bar = Bar::new(args.model.quiet);
     let study = Study::run(&model, &mut bar)?.with_sensitivity(&mut bar)?;
     let command = reproduce_command(args);
-    let page = report::render(&study, &command)?;
+    let page = report::render(&report::ReportInput {
+        study: &study,
+        command: &command,
+        threads: rayon::current_num_threads(),
+    })?;
     let data = export::report_data_json(&study);
     write_all_atomic(
         &args.out,

@@ -60,22 +60,23 @@ fn figures_of(study: &Study, case: Case) -> Vec<(&'static str, String)> {
         ),
         ("trajectory", trajectory(&study.realization).unwrap()),
     ];
-    // Every check is drawn by one figure; a new check does not compile until it has one.
+    // Every figure of a check; a check without a figure of its own is in the verdict tables only.
     for id in CheckId::ALL {
         let figure = match id {
-            CheckId::MeanError => ("mean_error", mean_error(s, v.get(id), &p.prediction.fixes)),
-            CheckId::CovarianceMatch => ("covariance", covariance(s, v.get(id))),
-            CheckId::CovarianceCorrelation => continue, // drawn by the covariance figure
-            CheckId::Orthogonality => ("orthogonality", orthogonality(s, v.get(id))),
-            CheckId::ResidualWhiteness => (
+            CheckId::MEAN_ERROR => ("mean_error", mean_error(s, v.get(id), &p.prediction.fixes)),
+            CheckId::COVARIANCE_MATCH => ("covariance", covariance(s, v.get(id))),
+            CheckId::COVARIANCE_CORRELATION => continue, // drawn by the covariance figure
+            CheckId::ORTHOGONALITY => ("orthogonality", orthogonality(s, v.get(id))),
+            CheckId::RESIDUAL_WHITENESS => (
                 "residual_whiteness",
                 residual_whiteness(s, v.get(id), &v.residual_pair),
             ),
-            CheckId::Nees => (
+            CheckId::NEES => (
                 "consistency",
-                consistency(s, v.get(id), v.get(CheckId::Nis)),
+                consistency(s, v.get(id), v.get(CheckId::NIS)),
             ),
-            CheckId::Nis => continue, // drawn with NEES
+            CheckId::NIS => continue, // drawn with NEES
+            _ => continue,
         };
         out.push((figure.0, figure.1.unwrap()));
     }
@@ -160,7 +161,7 @@ fn non_finite_statistics_are_skipped() {
     stats.fixes[2].post.ensemble_cov[1][1] = f64::INFINITY;
     stats.fixes[3].prior.orthogonality_corr[2][0] = f64::NAN;
     stats.fixes[4].nis_avg = f64::NAN;
-    let c = check(study, CheckId::MeanError);
+    let c = check(study, CheckId::MEAN_ERROR);
     let prediction = vec![[[f64::NAN; 3]; 2]; stats.fixes.len()];
     let rms = vec![[f64::NAN; 3]; stats.fixes.len()];
     for svg in [
@@ -199,7 +200,7 @@ fn figures_survive_statistics_that_are_all_undefined() {
         s.sigma = [f64::NAN; 3];
         s.estimate = [f64::INFINITY; 3];
     }
-    let c = check(study, CheckId::MeanError);
+    let c = check(study, CheckId::MEAN_ERROR);
     let mut pair = study.case(CASE).verdicts.residual_pair.clone();
     pair.z = [[f64::NAN; 2]; 2];
     let prediction = vec![[[f64::INFINITY; 3]; 2]; stats.fixes.len()];

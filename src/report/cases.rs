@@ -3,9 +3,13 @@
 
 use super::prose::{and_list, case_title, failure_sentence, letter};
 use super::rich::rich;
-use super::view::{CaseView, CheckRow, FigureView, PairView, SummaryCell, SummaryRow};
-use crate::checks::{Check, CheckId, Untestable, Verdict};
+use super::view::{
+    AccuracyCell, AccuracyRow, CaseView, CheckRow, FigureView, PairView, PerformanceRow,
+    PredictionRow, SummaryCell, SummaryRow, VerdictView,
+};
+use crate::checks::{Check, CheckId, Untestable, Verdict, Verdicts};
 use crate::format::{count, fixed, sig};
+use crate::state::{ErrorState, StateModel, Variable};
 use crate::study::CaseOutcome;
 
 /// The verdict in words: "pass", "fail", "untestable at N = 10, needs N ≥ 22".
@@ -40,8 +44,8 @@ pub fn check_row(c: &Check, n: u64, fix_times_s: &[f64]) -> CheckRow {
     let (worst, band) = worst_and_band(c);
     CheckRow {
         id: c.id.name().to_string(),
-        what: c.id.hypothesis().to_string(),
-        statistic: c.id.statistic().to_string(),
+        what: c.definition.hypothesis.to_string(),
+        statistic: c.definition.statistic.to_string(),
         members: count(c.members as u64),
         worst,
         worst_at: c
@@ -49,25 +53,30 @@ pub fn check_row(c: &Check, n: u64, fix_times_s: &[f64]) -> CheckRow {
             .map_or_else(String::new, |w| w.member.describe(fix_times_s)),
         band,
         outside: count(c.failures as u64),
-        verdict: c.verdict.name().to_string(),
+        verdict: VerdictView::of(c.verdict),
         verdict_words: verdict_words(c.verdict, n),
     }
 }
 
-/// The verdict summary: one row per check, one cell per case.
+/// The verdict summary: one row per check the cases ran, one cell per case.
 pub fn summary(cases: &[CaseOutcome]) -> Vec<SummaryRow> {
-    CheckId::ALL
+    let Some(first) = cases.first() else {
+        return Vec::new();
+    };
+    first
+        .verdicts
+        .checks
         .iter()
-        .map(|&id| SummaryRow {
-            id: id.name().to_string(),
-            title: id.title().to_string(),
+        .map(|check| SummaryRow {
+            id: check.id.name().to_string(),
+            title: check.definition.title.to_string(),
             cells: cases
                 .iter()
                 .map(|o| {
-                    let c = o.verdicts.get(id);
+                    let c = o.verdicts.get(check.id);
                     let (worst, band) = worst_and_band(c);
                     SummaryCell {
-                        verdict: c.verdict.name().to_string(),
+                        verdict: VerdictView::of(c.verdict),
                         detail: match (c.is_normal(), c.failures > 0) {
                             (true, false) => format!("{worst} ≤ {}", fixed(c.upper, 2)),
                             (true, true) => format!("{worst} > {}", fixed(c.upper, 2)),
@@ -103,29 +112,25 @@ fn pair_view(o: &CaseOutcome) -> PairView {
             })
             .collect(),
         bound: fixed(p.bound, 2),
-        verdict: p.verdict.name().to_string(),
+        verdict: VerdictView::of(p.verdict),
     }
 }
 
-/// The view of case `o`, the `index`-th; its tables are numbered `tables` (verdicts, pair).
-pub fn case_view(
-    o: &CaseOutcome,
-    index: usize,
-    tables: (usize, usize),
-    figures: Vec<FigureView>,
-    claimed: [f64; 3],
-) -> CaseView {
-    let v = &o.verdicts;
-    let n = o.run.stats.realizations;
-    let fix_times_s: Vec<f64> = o.run.stats.fixes.iter().map(|f| f.time_s).collect();
-    let failed: Vec<String> = v.failed().map(|c| c.id.title().to_string()).collect();
+/// The state variables, in state order.
+pub fn states() -> [Variable; ErrorState::DIM] {
+    <ErrorState as StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }>>::STATES
+}
+
+/// "What failed" of a case: "every check passes", "fails mean error and NEES", ….
+fn verdict_words_of(v: &Verdicts) -> String {
+    let failed: Vec<String> = v.failed().map(|c| c.definition.title.to_string()).collect();
     let untestable: Vec<String> = v
         .checks
         .iter()
         .filter(|c| matches!(c.verdict, Verdict::Untestable(_)))
-        .map(|c| c.id.title().to_string())
+        .map(|c| c.definition.title.to_string())
         .collect();
-    let verdict = match (failed.is_empty(), untestable.is_empty()) {
+    match (failed.is_empty(), untestable.is_empty()) {
         (true, true) => "every check passes".to_string(),
         (false, true) => format!("fails {}", and_list(&failed)),
         (true, false) => format!("{} untestable at this N", and_list(&untestable)),
@@ -134,9 +139,34 @@ pub fn case_view(
             and_list(&failed),
             and_list(&untestable)
         ),
-    };
+    }
+}
+
+/// "0.998, 1.00 and 1.01": achieved over claimed σ per state.
+fn ratios_words(o: &CaseOutcome, claimed: [f64; ErrorState::DIM]) -> String {
     let achieved = o.achieved_rms_final();
-    let mean = v.get(CheckId::MeanError);
+    let ratios: Vec<String> = (0..ErrorState::DIM)
+        .map(|k| fixed(achieved[k] / claimed[k], 3))
+        .collect();
+    and_list(&ratios)
+}
+
+/// "position, velocity and bias".
+fn states_words() -> String {
+    and_list(&states().map(|s| s.key.to_string()))
+}
+
+/// The view of case `o`, the `index`-th; its tables are numbered `tables` (verdicts, pair).
+pub fn case_view(
+    o: &CaseOutcome,
+    index: usize,
+    tables: (usize, usize),
+    figures: Vec<FigureView>,
+    claimed: [f64; ErrorState::DIM],
+) -> CaseView {
+    let v = &o.verdicts;
+    let n = o.run.stats.realizations;
+    let fix_times_s: Vec<f64> = o.run.stats.fixes.iter().map(|f| f.time_s).collect();
     CaseView {
         id: o.case.id().replace('_', "-"),
         letter: letter(index),
@@ -145,7 +175,7 @@ pub fn case_view(
         output: o.case.output.name().to_string(),
         consistent: v.all_passed(),
         realizations: count(n),
-        verdict,
+        verdict: verdict_words_of(v),
         passed_count: format!(
             "{} of {}",
             v.checks.iter().filter(|c| c.passed()).count(),
@@ -159,21 +189,56 @@ pub fn case_view(
             .collect(),
         pair_table_number: tables.1,
         pair: pair_view(o),
-        achieved: achieved.iter().map(|x| sig(*x, 3)).collect(),
-        claimed: claimed.iter().map(|x| sig(*x, 3)).collect(),
-        ratio: (0..3).map(|k| fixed(achieved[k] / claimed[k], 3)).collect(),
+        ratios_words: ratios_words(o, claimed),
+        states_words: states_words(),
         worst_se: fixed(o.prediction.worst_se, 2),
-        mean_bound: fixed(mean.upper, 2),
-        explained: o.prediction.worst_se <= mean.upper,
-        predicted_nees: sig(o.prediction.predicted_nees_final, 4),
-        measured_nees: sig(o.prediction.measured_nees_final, 4),
+        explained: o.prediction.worst_se <= v.get(CheckId::MEAN_ERROR).upper,
         max_mean_over_sigma: o.max_mean_over_sigma.iter().map(|x| sig(*x, 2)).collect(),
         failures_html: v
             .failed()
             .map(|c| rich(&failure_sentence(c, &fix_times_s)))
             .collect(),
-        rate: count(o.run.realizations_per_s().round() as u64),
-        elapsed: fixed(o.run.elapsed_s, 2),
         figures,
+    }
+}
+
+/// "A: Euler-integrated truth, point samples" for the `index`-th case.
+pub fn case_label(o: &CaseOutcome, index: usize) -> String {
+    format!("{}: {}", letter(index), case_title(o.case))
+}
+
+/// The accuracy table's row of case `o`, the `index`-th.
+pub fn accuracy_row(o: &CaseOutcome, index: usize, claimed: [f64; ErrorState::DIM]) -> AccuracyRow {
+    let achieved = o.achieved_rms_final();
+    AccuracyRow {
+        case: case_label(o, index),
+        cells: (0..ErrorState::DIM)
+            .map(|k| AccuracyCell {
+                achieved: sig(achieved[k], 3),
+                claimed: sig(claimed[k], 3),
+                ratio: fixed(achieved[k] / claimed[k], 3),
+            })
+            .collect(),
+    }
+}
+
+/// The prediction table's row of case `o`, the `index`-th.
+pub fn prediction_row(o: &CaseOutcome, index: usize) -> PredictionRow {
+    PredictionRow {
+        case: case_label(o, index),
+        worst_se: fixed(o.prediction.worst_se, 2),
+        mean_bound: fixed(o.verdicts.get(CheckId::MEAN_ERROR).upper, 2),
+        predicted_nees: sig(o.prediction.predicted_nees_final, 4),
+        measured_nees: sig(o.prediction.measured_nees_final, 4),
+    }
+}
+
+/// The performance table's row of case `o`, the `index`-th.
+pub fn performance_row(o: &CaseOutcome, index: usize) -> PerformanceRow {
+    PerformanceRow {
+        case: case_label(o, index),
+        realizations: count(o.run.stats.realizations),
+        elapsed: fixed(o.run.elapsed_s, 2),
+        rate: count(o.run.realizations_per_s().round() as u64),
     }
 }

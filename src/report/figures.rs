@@ -1,7 +1,8 @@
-//! The report's figures: which plot shows which check, their captions, and their numbers. Figure
-//! and table numbers are handed out here, in the order the page shows them.
+//! The report's figures: which plot shows which check and their captions; their numbers come
+//! from the [`super::outline`].
 
 use super::RenderError;
+use super::outline::{Figure, Numbers};
 use super::prose::{case_title, letter};
 use super::rich::rich;
 use super::view::FigureView;
@@ -10,29 +11,8 @@ use crate::format::{count, fixed, percent, sig};
 use crate::plot;
 use crate::study::{CaseOutcome, Study};
 
-/// Hands out figure and table numbers in reading order.
-#[derive(Debug, Default)]
-pub struct Numbering {
-    figures: usize,
-    tables: usize,
-}
-
-impl Numbering {
-    /// The next figure's number.
-    pub fn figure(&mut self) -> usize {
-        self.figures += 1;
-        self.figures
-    }
-
-    /// The next table's number.
-    pub fn table(&mut self) -> usize {
-        self.tables += 1;
-        self.tables
-    }
-}
-
 /// A figure that shows the members of one or more checks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum CheckFigure {
     /// The ensemble mean error.
     MeanError,
@@ -56,16 +36,17 @@ impl CheckFigure {
         CheckFigure::Consistency,
     ];
 
-    /// The figure that shows check `id`.
-    pub fn of(id: CheckId) -> Self {
-        match id {
-            CheckId::MeanError => CheckFigure::MeanError,
+    /// The figure that shows check `id`; `None` for a check that has no figure of its own.
+    pub fn of(id: CheckId) -> Option<Self> {
+        Some(match id {
+            CheckId::MEAN_ERROR => CheckFigure::MeanError,
             // The correlations are the off-diagonal terms of the covariance the figure compares.
-            CheckId::CovarianceMatch | CheckId::CovarianceCorrelation => CheckFigure::Covariance,
-            CheckId::Orthogonality => CheckFigure::Orthogonality,
-            CheckId::ResidualWhiteness => CheckFigure::Whiteness,
-            CheckId::Nees | CheckId::Nis => CheckFigure::Consistency,
-        }
+            CheckId::COVARIANCE_MATCH | CheckId::COVARIANCE_CORRELATION => CheckFigure::Covariance,
+            CheckId::ORTHOGONALITY => CheckFigure::Orthogonality,
+            CheckId::RESIDUAL_WHITENESS => CheckFigure::Whiteness,
+            CheckId::NEES | CheckId::NIS => CheckFigure::Consistency,
+            _ => return None,
+        })
     }
 
     fn id(self) -> &'static str {
@@ -116,7 +97,7 @@ fn check_figure(
     let v: &Verdicts = &o.verdicts;
     let get = |id| v.get(id);
     let case = case_title(o.case);
-    let share = percent(get(CheckId::MeanError).false_alarm_rate);
+    let share = percent(get(CheckId::MEAN_ERROR).false_alarm_rate);
     let id = format!("{}-{id_stem}", which.id());
     match which {
         CheckFigure::MeanError => figure(
@@ -126,10 +107,10 @@ fn check_figure(
             &format!(
                 "The a priori and a posteriori ensemble mean error e^{{ave}} of each state at every GPS fix ({case}, N = {}), against the band ±{}·σ/√N, where σ is the filter's standard deviation and {} the Bonferroni bound of the check's share α_{{c}} = {share}. Thin lines: the mean error predicted by one noise-free pass of the filter over the truth's deterministic part (a posteriori black, a priori grey).",
                 count(s.realizations),
-                fixed(get(CheckId::MeanError).upper, 2),
-                fixed(get(CheckId::MeanError).upper, 2),
+                fixed(get(CheckId::MEAN_ERROR).upper, 2),
+                fixed(get(CheckId::MEAN_ERROR).upper, 2),
             ),
-            plot::mean_error(s, get(CheckId::MeanError), &o.prediction.fixes),
+            plot::mean_error(s, get(CheckId::MEAN_ERROR), &o.prediction.fixes),
         ),
         CheckFigure::Covariance => figure(
             &id,
@@ -137,10 +118,10 @@ fn check_figure(
             "Ensemble variance against the filter's covariance",
             &format!(
                 "Left: the ensemble variance P^{{ave}} (N − 1 normalization) and the filter's P, a priori and a posteriori, on a logarithmic axis ({case}). Right: their ratio, with the χ² band [{}, {}] that holds the check's share α_{{c}} = {share}.",
-                sig(get(CheckId::CovarianceMatch).lower, 4),
-                sig(get(CheckId::CovarianceMatch).upper, 4)
+                sig(get(CheckId::COVARIANCE_MATCH).lower, 4),
+                sig(get(CheckId::COVARIANCE_MATCH).upper, 4)
             ),
-            plot::covariance(s, get(CheckId::CovarianceMatch)),
+            plot::covariance(s, get(CheckId::COVARIANCE_MATCH)),
         ),
         CheckFigure::Orthogonality => figure(
             &id,
@@ -148,9 +129,9 @@ fn check_figure(
             "Orthogonality of error and estimate",
             &format!(
                 "The normalized correlation √N·corr(e − e^{{ave}}, δx̂) of every error component with every estimate component, a priori and a posteriori, at every fix ({case}), against ±{}.",
-                fixed(get(CheckId::Orthogonality).upper, 2)
+                fixed(get(CheckId::ORTHOGONALITY).upper, 2)
             ),
-            plot::orthogonality(s, get(CheckId::Orthogonality)),
+            plot::orthogonality(s, get(CheckId::ORTHOGONALITY)),
         ),
         CheckFigure::Whiteness => figure(
             &id,
@@ -162,12 +143,12 @@ fn check_figure(
                     None => "every pair of fixes".to_string(),
                     Some(l) => format!("the pairs of fixes at most {l} fixes apart"),
                 },
-                fixed(get(CheckId::ResidualWhiteness).upper, 2),
+                fixed(get(CheckId::RESIDUAL_WHITENESS).upper, 2),
                 fixed(v.residual_pair.t_m_s, 1),
                 fixed(v.residual_pair.t_i_s, 1),
                 fixed(v.residual_pair.bound, 2)
             ),
-            plot::residual_whiteness(s, get(CheckId::ResidualWhiteness), &v.residual_pair),
+            plot::residual_whiteness(s, get(CheckId::RESIDUAL_WHITENESS), &v.residual_pair),
         ),
         CheckFigure::Consistency => figure(
             &id,
@@ -176,20 +157,24 @@ fn check_figure(
             &format!(
                 "The ensemble average of the normalized estimation error squared (expected 3) and of the normalized innovation squared (expected 2) at every fix ({case}), with their χ² bounds."
             ),
-            plot::consistency(s, get(CheckId::Nees), get(CheckId::Nis)),
+            plot::consistency(s, get(CheckId::NEES), get(CheckId::NIS)),
         ),
     }
 }
 
-/// The check figures of case `o`, numbered from `numbers`.
+/// The check figures of case `o`, the `index`-th, numbered by `numbers`.
 pub fn check_figures(
     o: &CaseOutcome,
-    numbers: &mut Numbering,
+    index: usize,
+    numbers: &Numbers,
 ) -> Result<Vec<FigureView>, RenderError> {
     let stem = o.case.id().replace('_', "-");
     CheckFigure::ALL
         .iter()
-        .map(|&which| check_figure(which, o, numbers.figure(), &stem))
+        .map(|&which| {
+            let number = numbers.figure(Figure::Check(index, which));
+            check_figure(which, o, number, &stem)
+        })
         .collect()
 }
 
@@ -207,27 +192,30 @@ fn series(study: &Study) -> Vec<plot::CaseSeries<'_>> {
         .collect()
 }
 
-/// The realization figures (trajectory and errors).
-pub fn realization_figures(
-    study: &Study,
-    numbers: &mut Numbering,
-) -> Result<(FigureView, FigureView), RenderError> {
+/// The trajectory of the recorded realization, numbered by `numbers`.
+pub fn trajectory_figure(study: &Study, numbers: &Numbers) -> Result<FigureView, RenderError> {
     let r = &study.realization;
     let case = case_title(study.realization_case);
-    let consistent = study.case(study.realization_case).verdicts.all_passed();
-    let trajectory = figure(
+    figure(
         "fig-trajectory",
-        numbers.figure(),
+        numbers.figure(Figure::Trajectory),
         "Acceleration profile and true trajectory",
         &format!(
             "Left: the true acceleration a(t), velocity and position of realization {} (seed {}, {case}), with the accelerometer's integration from the prior means. Right: the realization's bias, velocity drift δv = v − v_{{c}} and position drift δp = p − p_{{c}}, with the filter's estimates of each.",
             r.index, r.seed,
         ),
         plot::trajectory(r),
-    )?;
-    let realization = figure(
+    )
+}
+
+/// The estimation error of the recorded realization, numbered by `numbers`.
+pub fn realization_figure(study: &Study, numbers: &Numbers) -> Result<FigureView, RenderError> {
+    let r = &study.realization;
+    let case = case_title(study.realization_case);
+    let consistent = study.case(study.realization_case).verdicts.all_passed();
+    figure(
         "fig-realization",
-        numbers.figure(),
+        numbers.figure(Figure::Realization),
         "Estimation error of one realization",
         &format!(
             "The error δx − δx̂ of position, velocity and bias at every accelerometer sample ({case}{}), with the filter's ±1σ. Left: the whole run; right: the filter's σ over a short window, growing between fixes and dropping at each fix (open circles before the update, dots after); the bias σ is a staircase, constant between fixes.",
@@ -238,27 +226,26 @@ pub fn realization_figures(
             }
         ),
         plot::realization_errors(r),
-    )?;
-    Ok((trajectory, realization))
+    )
 }
 
 /// The figures that compare the cases.
 pub fn comparison_figures(
     study: &Study,
-    numbers: &mut Numbering,
+    numbers: &Numbers,
 ) -> Result<(FigureView, FigureView), RenderError> {
     let cases = series(study);
     let accuracy = figure(
         "fig-accuracy",
-        numbers.figure(),
+        numbers.figure(Figure::Accuracy),
         "Achieved accuracy against the filter's claim",
         "The achieved RMS a posteriori error √(mean² + variance) of each state over the ensemble, divided by the filter's σ, at every fix, for every case. A consistent filter stays at 1, within the sampling scatter; a ratio above 1 is accuracy the filter claims but does not reach.",
         plot::accuracy_ratio(&cases),
     )?;
-    let bound = study.cases[0].verdicts.get(CheckId::MeanError).upper;
+    let bound = study.cases[0].verdicts.get(CheckId::MEAN_ERROR).upper;
     let mean_error = figure(
         "fig-mean-error-cases",
-        numbers.figure(),
+        numbers.figure(Figure::MeanErrorCases),
         "Mean error of every case, in units of the filter's σ",
         &format!(
             "The a posteriori |e^{{ave}}| / σ of each state at every fix on a logarithmic axis, for every case, with the mean-error check's bound {}/√N in the same units (black). Sampling noise alone stays below the bound; a systematic error stands decades above it.",

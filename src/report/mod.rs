@@ -1,31 +1,34 @@
 //! The HTML report of a [`Study`]: draws the figures, builds the view, fills the templates. Pure:
 //! it returns the page and its view as text, and the caller writes them.
 //!
-//! Layers: [`view`] holds the view types, [`prose`] and [`params`] the words and the parameter
-//! table, [`figures`] the figures and the numbering, [`equations`] every formula as MathML; the
-//! templates under `templates/` only place that text.
+//! Layers: [`outline`] orders the sections and numbers every table, figure and equation;
+//! [`sections`] builds each section's view ([`view`]) from the study, with [`prose`] and
+//! [`params`] for the words and the parameter table, [`cases`] for the per-case tables,
+//! [`figures`] for the figures and [`equations`] for every formula as MathML; [`html`] fills one
+//! template per section, and the templates under `templates/` only place that text.
 
 pub mod calibration;
 pub mod cases;
 pub mod equations;
 pub mod figures;
+pub mod html;
 pub mod math;
+pub mod outline;
 pub mod params;
 pub mod prose;
 pub mod rich;
+pub mod sections;
 pub mod sensitivity;
 pub mod view;
 
 use askama::Template;
 use base64::Engine;
 
-use crate::checks::CheckId;
-use crate::format::{count, fixed, percent, short, sig};
 use crate::study::Study;
 use equations::Equations;
-use figures::Numbering;
 use math::Math;
-use view::{CatalogueEntry, EquationNumbers, Figures, ReportView, TableNumbers};
+use outline::Outline;
+use view::{ReportView, SectionNode, TocEntry};
 
 /// The report could not be rendered.
 #[derive(Debug, thiserror::Error)]
@@ -41,18 +44,6 @@ pub enum RenderError {
     /// The templates could not be filled.
     #[error("cannot fill the report templates: {0}")]
     Template(#[from] askama::Error),
-}
-
-/// The report page.
-#[derive(Template)]
-#[template(path = "report.html")]
-pub struct ReportPage<'a> {
-    /// The view.
-    pub v: &'a ReportView,
-    /// The equations.
-    pub eq: &'a Equations,
-    /// The stylesheet.
-    pub style: &'a str,
 }
 
 /// A rendered report: the page, and its view as JSON.
@@ -76,191 +67,99 @@ pub fn stylesheet() -> String {
     )
 }
 
-/// σ_b after 1 s and 5 s where the run is that long, and at the end.
-fn bias_sigma_progress(study: &Study) -> String {
-    let fixes = &study.schedule.fixes;
-    let last = fixes.last().expect("at least two fixes");
-    let end_s = last.time_s;
-    let mut milestones: Vec<String> = [1.0, 5.0]
-        .into_iter()
-        .filter(|&t| t < end_s - 1e-9)
-        .filter_map(|t| fixes.iter().find(|f| f.time_s >= t - 1e-9))
-        .map(|f| {
-            format!(
-                "{} m/s² after {} s",
-                sig(f.p_post[(2, 2)].sqrt(), 2),
-                short(f.time_s)
-            )
-        })
-        .collect();
-    milestones.push(format!(
-        "{} m/s² at the end ({} s)",
-        sig(last.p_post[(2, 2)].sqrt(), 2),
-        short(end_s)
-    ));
-    match milestones.split_last() {
-        Some((end, [])) => end.clone(),
-        Some((end, rest)) => format!("{} and {end}", rest.join(", ")),
-        None => String::new(),
-    }
+/// What the report is made from: the study, and how the run that made it was set up.
+#[derive(Clone, Copy)]
+pub struct ReportInput<'a> {
+    /// The study.
+    pub study: &'a Study,
+    /// The command that reproduces the report.
+    pub command: &'a str,
+    /// Threads the ensembles ran on (the run times depend on it, the numbers do not).
+    pub threads: usize,
 }
 
-/// The check catalogue as the theory section shows it.
-fn catalogue(math: &Math) -> Vec<CatalogueEntry> {
-    CheckId::ALL
-        .iter()
-        .map(|&id| {
-            let h = id.hypothesis();
-            CatalogueEntry {
-                id: id.name().to_string(),
-                title: format!("{}{}", id.title()[..1].to_uppercase(), &id.title()[1..]),
-                hypothesis: format!("{}{}.", h[..1].to_uppercase(), &h[1..]),
-                rationale: id.rationale().to_string(),
-                members: id.members().to_string(),
-                formula: math.block(id.formula()),
-            }
-        })
-        .collect()
-}
-
-/// Numbers the display equations in reading order.
-fn equation_numbers() -> EquationNumbers {
-    let mut n = 0;
-    let mut next = || {
-        n += 1;
-        n
-    };
-    EquationNumbers {
-        profile: next(),
-        analytic_truth: next(),
-        accelerometer: next(),
-        interval_mean: next(),
-        integration: next(),
-        gps: next(),
-        euler_truth: next(),
-        dynamics: next(),
-        measurement: next(),
-        lag: next(),
-        prediction: next(),
-    }
-}
-
-/// Builds the view of `study`; `command` reproduces it.
+/// Builds the view of `input`, its sections in the order of `outline`.
 ///
 /// # Errors
 /// [`RenderError`] when a figure cannot be drawn.
-pub fn build(study: &Study, command: &str, math: &Math) -> Result<ReportView, RenderError> {
-    let model = &study.model;
-    let c = &model.config;
-    let tl = &model.timeline;
-    let r = &study.realization;
-    let last = r.fixes.last().expect("at least two fixes");
-    let first = &study.schedule.fixes[0];
-    let eqn = equation_numbers();
-    // Tables and figures are numbered in the order the page shows them.
-    let mut numbers = Numbering::default();
-    let params_table = numbers.table();
-    let (trajectory, realization) = figures::realization_figures(study, &mut numbers)?;
-    let summary_table = numbers.table();
-    let accuracy_table = numbers.table();
-    let (accuracy, mean_error) = figures::comparison_figures(study, &mut numbers)?;
-    let prediction_table = numbers.table();
-    let claimed = prose::claimed_sigma(study);
-    let mut cases = Vec::with_capacity(study.cases.len());
-    for (i, o) in study.cases.iter().enumerate() {
-        let tables = (numbers.table(), numbers.table());
-        let figures = figures::check_figures(o, &mut numbers)?;
-        cases.push(cases::case_view(o, i, tables, figures, claimed));
-    }
-    let tables = TableNumbers {
-        params: params_table,
-        summary: summary_table,
-        accuracy: accuracy_table,
-        prediction: prediction_table,
-        performance: numbers.table(),
-    };
-    let sensitivity = study
-        .sensitivity
-        .as_ref()
-        .map(|s| sensitivity::view(s, &mut numbers))
-        .transpose()?;
+pub fn build(
+    input: &ReportInput,
+    outline: &Outline,
+    math: &Math,
+) -> Result<ReportView, RenderError> {
+    let study = input.study;
+    let numbers = outline.numbers();
     let differences = params::filter_differences(study);
+    let context = sections::Context {
+        input,
+        numbers: &numbers,
+        math,
+        differences: &differences,
+    };
+    let sections = outline
+        .nodes
+        .iter()
+        .map(|node| {
+            Ok(SectionNode {
+                view: context.view(node.section)?,
+                children: node
+                    .children
+                    .iter()
+                    .map(|&c| {
+                        Ok(SectionNode {
+                            view: context.view(c)?,
+                            children: Vec::new(),
+                        })
+                    })
+                    .collect::<Result<_, RenderError>>()?,
+            })
+        })
+        .collect::<Result<Vec<_>, RenderError>>()?;
     Ok(ReportView {
         version: env!("CARGO_PKG_VERSION").to_string(),
-        realizations: count(c.ensemble.realizations),
-        fixes: count(tl.fixes() as u64),
-        steps: count(tl.steps as u64),
-        accel_rate: short(c.accelerometer.sample_rate_hz),
-        gps_rate: short(c.gps.sample_rate_hz),
-        steps_per_fix: tl.steps_per_fix.to_string(),
-        first_fix: fixed(tl.fix_time_s(0), 2),
-        false_alarm: percent(c.checks.false_alarm_rate),
-        false_alarm_share: prose::share_words(c.checks.false_alarm_rate),
-        seed: c.ensemble.seed.to_string(),
-        filter_matches_truth: differences.is_empty(),
-        params: params::params(study),
-        choices_html: params::choices(study, &differences)
+        seed: study.model.config.ensemble.seed.to_string(),
+        toc: sections
             .iter()
-            .map(|c| rich::rich(c))
+            .map(|n| TocEntry {
+                anchor: n.view.anchor(),
+                title: n.view.title(),
+            })
             .collect(),
-        catalogue: catalogue(math),
-        summary: cases::summary(&study.cases),
-        realization_case: {
-            let i = study
-                .cases
-                .iter()
-                .position(|o| o.case == study.realization_case)
-                .unwrap_or(0);
-            format!(
-                "case {} ({})",
-                prose::letter(i),
-                prose::case_title(study.realization_case)
-            )
-        },
-        bias_true: sig(r.bias_m_s2, 3),
-        bias_estimate: sig(last.post[2], 3),
-        bias_error_sigmas: fixed((r.bias_m_s2 - last.post[2]) / last.sigma_post[2], 2),
-        bias_prior_sigma: sig(c.filter_bias_var_m2_s4().sqrt(), 2),
-        end_time: short(last.t_s),
-        first_fix_sigma_p: sig(first.p_post[(0, 0)].sqrt(), 2),
-        first_fix_sigma_v: sig(first.p_post[(1, 1)].sqrt(), 2),
-        bias_sigma_progress: bias_sigma_progress(study),
-        euler_velocity_drift: prose::euler_velocity_drift(study),
-        interval_position_error: sig(tl.dt_s * tl.dt_s * c.profile.accel_amplitude_m_s2 / 12.0, 2),
-        threads: rayon::current_num_threads().to_string(),
-        fig: Figures {
-            trajectory,
-            realization,
-            accuracy,
-            mean_error,
-        },
-        abstract_html: rich::rich(&prose::abstract_findings(study, &differences)),
-        conclusions_html: prose::conclusions(study, &differences, eqn.dynamics, tables.accuracy)
-            .iter()
-            .map(|c| rich::rich(c))
-            .collect(),
-        cases,
-        sensitivity,
-        tables,
-        eqn,
-        filter_differences: differences,
-        config_toml: c.to_toml_string(),
-        command: command.to_string(),
+        sections,
     })
 }
 
-/// Renders the report of `study` as HTML, with its view as JSON. `command` reproduces it.
+/// The outline of the report of `study`: every case, and the sensitivity section when the
+/// study ran it.
+pub fn outline_of(study: &Study) -> Outline {
+    Outline::standard(study.cases.len(), study.sensitivity.is_some())
+}
+
+/// Renders the report of `input` as HTML, with its view as JSON.
 ///
 /// # Errors
 /// [`RenderError`] when a figure cannot be drawn or the templates cannot be filled.
-pub fn render(study: &Study, command: &str) -> Result<Page, RenderError> {
+pub fn render(input: &ReportInput) -> Result<Page, RenderError> {
+    render_outline(input, &outline_of(input.study))
+}
+
+/// Renders the report of `input` with its sections in the order of `outline`.
+///
+/// # Errors
+/// [`RenderError`] when a figure cannot be drawn or the templates cannot be filled.
+pub fn render_outline(input: &ReportInput, outline: &Outline) -> Result<Page, RenderError> {
     let math = Math::new();
-    let view = build(study, command, &math)?;
+    let view = build(input, outline, &math)?;
     let eq = Equations::render(&math);
     let style = stylesheet();
-    let html = ReportPage {
+    let sections_html = view
+        .sections
+        .iter()
+        .map(|node| html::section(node, &eq))
+        .collect::<Result<Vec<_>, _>>()?;
+    let html = html::ReportPage {
         v: &view,
-        eq: &eq,
+        sections_html: &sections_html,
         style: &style,
     }
     .render()?;

@@ -1,9 +1,8 @@
 //! The parameter table and the list of statistics the filter assumes differently from the truth.
 
-use super::prose::share_words;
+use super::prose::{checks_run, share_words};
 use super::rich::rich;
 use super::view::ParamRow;
-use crate::checks::CheckId;
 use crate::format::{count, fixed, percent, sig};
 use crate::study::Study;
 
@@ -123,7 +122,7 @@ pub fn params(study: &Study) -> Vec<ParamRow> {
             format!(
                 "{} ({} per check)",
                 percent(c.checks.false_alarm_rate),
-                percent(c.checks.false_alarm_rate / CheckId::ALL.len() as f64)
+                share_words(c.checks.false_alarm_rate, checks_run(study))
             ),
             "",
             "checks.false_alarm_rate",
@@ -213,8 +212,8 @@ pub fn choices(study: &Study, differences: &[String]) -> Vec<String> {
         format!(
             "The study-wide false-alarm rate α = {} is the probability that a consistent filter fails any check; each of the {} checks gets {} of it, split over its distinct members (Bonferroni at both levels).",
             percent(c.checks.false_alarm_rate),
-            CheckId::ALL.len(),
-            share_words(c.checks.false_alarm_rate)
+            checks_run(study),
+            share_words(c.checks.false_alarm_rate, checks_run(study))
         ),
     ];
     if !differences.is_empty() {

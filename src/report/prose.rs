@@ -3,7 +3,7 @@
 //! verdicts and numbers; none is written for a result the run did not produce. Strings may hold
 //! `_{…}`/`^{…}` notation, which [`super::rich::rich`] turns into sub- and superscripts.
 
-use crate::checks::{Check, CheckId, Verdict};
+use crate::checks::{Check, CheckId, FailureWords, Verdict};
 use crate::config::{AccelerometerOutput, Case, TruthModel};
 use crate::format::{count, fixed, percent, sig};
 use crate::study::{CaseOutcome, Study};
@@ -42,53 +42,23 @@ pub fn failure_sentence(c: &Check, fix_times_s: &[f64]) -> String {
     let at = c
         .worst
         .map_or_else(String::new, |w| w.member.describe(fix_times_s));
-    let outside = format!(
-        "{} of {} members",
-        count(c.failures as u64),
-        count(c.members as u64)
-    );
-    let band = format!("[{}, {}]", sig(c.lower, 4), sig(c.upper, 4));
-    match c.id {
-        CheckId::MeanError => format!(
-            "The ensemble mean error is not zero: {outside} leave the band, the worst ({at}) by |z| = {} against a bound of {}. The errors carry a systematic part that the filter's model does not contain.",
-            fixed(c.worst_value(), 1),
-            fixed(c.upper, 2)
+    let words = FailureWords {
+        outside: format!(
+            "{} of {} members",
+            count(c.failures as u64),
+            count(c.members as u64)
         ),
-        CheckId::CovarianceMatch => format!(
-            "The ensemble variance does not match the filter's P: {outside} leave the χ² band {band}, the worst ratio being {} ({at}). The filter's covariance misstates its actual errors.",
-            sig(c.worst_value(), 3)
-        ),
-        CheckId::CovarianceCorrelation => format!(
-            "The correlations between error components differ from those of the filter's P: {outside} exceed |z| = {}, up to {} ({at}).",
-            fixed(c.upper, 2),
-            fixed(c.worst_value(), 1)
-        ),
-        CheckId::Orthogonality => format!(
-            "Errors are correlated with estimates: {outside} exceed |z| = {}, up to {} ({at}). The gain is not the minimum-variance gain for the simulated system.",
-            fixed(c.upper, 2),
-            fixed(c.worst_value(), 1)
-        ),
-        CheckId::ResidualWhiteness => format!(
-            "The residuals are not white: {outside} exceed |z| = {}, up to {} ({at}). Information is left in the residual sequence.",
-            fixed(c.upper, 2),
-            fixed(c.worst_value(), 1)
-        ),
-        CheckId::Nees => format!(
-            "The average NEES leaves its χ² band {band} at {outside}; the worst value is {} ({at}).",
-            sig(c.worst_value(), 3)
-        ),
-        CheckId::Nis => format!(
-            "The average NIS leaves its χ² band {band} at {outside}; the worst value is {} ({at}).",
-            sig(c.worst_value(), 3)
-        ),
-    }
+        band: format!("[{}, {}]", sig(c.lower, 4), sig(c.upper, 4)),
+        at,
+    };
+    (c.definition.failure)(c, &words)
 }
 
 fn failed_list(o: &CaseOutcome) -> String {
     let titles: Vec<String> = o
         .verdicts
         .failed()
-        .map(|c| c.id.title().to_string())
+        .map(|c| c.definition.title.to_string())
         .collect();
     and_list(&titles)
 }
@@ -98,7 +68,7 @@ fn untestable_list(o: &CaseOutcome) -> Vec<&'static str> {
         .checks
         .iter()
         .filter(|c| matches!(c.verdict, Verdict::Untestable(_)))
-        .map(|c| c.id.title())
+        .map(|c| c.definition.title)
         .collect()
 }
 
@@ -179,7 +149,7 @@ fn accuracy_sentence(study: &Study, o: &CaseOutcome) -> String {
 
 /// The pairs of fixes the whiteness check tested, in words.
 pub fn whiteness_pairs(o: &CaseOutcome) -> String {
-    let pairs = count(o.verdicts.get(CheckId::ResidualWhiteness).members as u64 / 4);
+    let pairs = count(o.verdicts.get(CheckId::RESIDUAL_WHITENESS).members as u64 / 4);
     match o.run.stats.residual_layout.max_lag() {
         None => format!("all {pairs} pairs of fixes"),
         Some(l) => format!("the {pairs} pairs of fixes at most {l} fixes apart"),
@@ -188,7 +158,7 @@ pub fn whiteness_pairs(o: &CaseOutcome) -> String {
 
 /// Whether the prediction explains the case's mean error within the mean-error check's bound.
 fn explained(o: &CaseOutcome) -> bool {
-    o.prediction.worst_se <= o.verdicts.get(CheckId::MeanError).upper
+    o.prediction.worst_se <= o.verdicts.get(CheckId::MEAN_ERROR).upper
 }
 
 /// The abstract's findings; `differences` lists the mistuned statistics.
@@ -214,7 +184,7 @@ pub fn abstract_findings(study: &Study, differences: &[String]) -> String {
         .filter(|(_, o)| o.verdicts.failed().next().is_some())
         .map(|(i, o)| format!("case {} fails {}", letter(i), failed_list(o)))
         .collect();
-    let total = CheckId::ALL.len();
+    let total = checks_run(study);
     if !consistent.is_empty() {
         let (noun, verb) = if consistent.len() == 1 {
             ("Case", "passes")
@@ -250,7 +220,8 @@ pub fn abstract_findings(study: &Study, differences: &[String]) -> String {
         .filter(|o| o.case.truth == TruthModel::Analytic)
     {
         s.push_str(&accuracy_sentence(study, o));
-        if !o.verdicts.all_passed() && o.verdicts.get(CheckId::MeanError).verdict == Verdict::Fail {
+        if !o.verdicts.all_passed() && o.verdicts.get(CheckId::MEAN_ERROR).verdict == Verdict::Fail
+        {
             s.push_str(&format!(
                 " Its mean error is deterministic: one noise-free pass of the filter predicts it {}.",
                 if explained(o) {
@@ -363,13 +334,19 @@ pub fn conclusions(
         let mut s = format!(
             "With {}, {passed} of {} checks pass. ",
             named(study, o),
-            CheckId::ALL.len()
+            v.checks.len()
         );
         let untestable: Vec<String> = v
             .checks
             .iter()
             .filter(|c| matches!(c.verdict, Verdict::Untestable(_)))
-            .map(|c| format!("{} (needs N ≥ {})", c.id.title(), count(c.min_realizations)))
+            .map(|c| {
+                format!(
+                    "{} (needs N ≥ {})",
+                    c.definition.title,
+                    count(c.min_realizations)
+                )
+            })
             .collect();
         if !untestable.is_empty() {
             s.push_str(&format!(
@@ -385,7 +362,7 @@ pub fn conclusions(
         s.push_str(&sentences.join(" "));
         if o.case.output == AccelerometerOutput::Sample
             && o.case.truth == TruthModel::Analytic
-            && v.get(CheckId::MeanError).verdict == Verdict::Fail
+            && v.get(CheckId::MEAN_ERROR).verdict == Verdict::Fail
             && explained(o)
         {
             s.push_str(&format!(
@@ -422,7 +399,12 @@ pub fn conclusions(
     out
 }
 
-/// The share of each check, in words: "0.14 %".
-pub fn share_words(alpha: f64) -> String {
-    percent(alpha / CheckId::ALL.len() as f64)
+/// The share of each of `checks` checks, in words: "0.14 %".
+pub fn share_words(alpha: f64, checks: usize) -> String {
+    percent(alpha / checks as f64)
+}
+
+/// The number of checks the study ran (every case runs the same catalogue).
+pub fn checks_run(study: &Study) -> usize {
+    study.cases.first().map_or(0, |o| o.verdicts.checks.len())
 }

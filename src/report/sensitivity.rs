@@ -2,7 +2,8 @@
 //! against claimed σ, the table of detection probabilities, and words chosen from the numbers.
 
 use super::RenderError;
-use super::figures::{Numbering, figure};
+use super::figures::figure;
+use super::outline::{Figure, Numbers, Table};
 use super::prose::and_list;
 use super::view::{DetectionCell, DetectionRow, SensitivityView};
 use crate::checks::CheckId;
@@ -150,7 +151,7 @@ fn cell(c: &SensitivityCase, id: CheckId) -> DetectionCell {
 ///
 /// # Errors
 /// [`RenderError`] when the figure cannot be drawn.
-pub fn view(s: &Sensitivity, numbers: &mut Numbering) -> Result<SensitivityView, RenderError> {
+pub fn view(s: &Sensitivity, numbers: &Numbers) -> Result<SensitivityView, RenderError> {
     let series: Vec<SensitivitySeries> = parameters(s)
         .into_iter()
         .map(|p| SensitivitySeries {
@@ -168,7 +169,7 @@ pub fn view(s: &Sensitivity, numbers: &mut Numbering) -> Result<SensitivityView,
         .collect();
     let figure = figure(
         "fig-sensitivity",
-        numbers.figure(),
+        numbers.figure(Figure::Sensitivity),
         "Actual against claimed accuracy of a mistuned filter",
         "The actual σ of each state's error at the last fix divided by the σ the filter claims, when the filter assumes one statistic's standard deviation times the factor and the truth keeps its value (the Euler-integrated truth, point samples). Exact: from the actual covariance recursion, no random numbers. Above 1 the filter is overconfident, below 1 conservative; the priors' lines lie on 1, hidden under one another, because the data override them by the end of the run.",
         plot::sigma_ratio(&series),
@@ -187,7 +188,7 @@ pub fn view(s: &Sensitivity, numbers: &mut Numbering) -> Result<SensitivityView,
         .collect();
     Ok(SensitivityView {
         figure,
-        table_number: numbers.table(),
+        table_number: numbers.table(Table::Detection),
         checks: CheckId::ALL
             .iter()
             .map(|c| capitalized(c.title()))

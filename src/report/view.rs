@@ -5,7 +5,49 @@
 //! superscripts); the rest are plain text. The whole view is also written as `view.json` beside
 //! the page, so that a test or a person can read what the page shows.
 
+use std::fmt;
+
 use serde::Serialize;
+
+use crate::checks::Verdict;
+
+/// A verdict as the page shows it: its word is also its CSS class.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum VerdictView {
+    /// Every member in its band.
+    Pass,
+    /// Some member outside its band.
+    Fail,
+    /// The check cannot fail at this N.
+    Untestable,
+}
+
+impl VerdictView {
+    /// The view of `verdict`.
+    pub fn of(verdict: Verdict) -> Self {
+        match verdict {
+            Verdict::Pass => VerdictView::Pass,
+            Verdict::Fail => VerdictView::Fail,
+            Verdict::Untestable(_) => VerdictView::Untestable,
+        }
+    }
+
+    /// Whether the check could not be tested (its row then says why).
+    pub fn is_untestable(&self) -> bool {
+        *self == VerdictView::Untestable
+    }
+}
+
+impl fmt::Display for VerdictView {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            VerdictView::Pass => "pass",
+            VerdictView::Fail => "fail",
+            VerdictView::Untestable => "untestable",
+        })
+    }
+}
 
 /// A figure: number, title, caption and the SVG itself.
 #[derive(Clone, Debug, Serialize)]
@@ -21,19 +63,6 @@ pub struct FigureView {
     /// The inline SVG (left out of view.json).
     #[serde(skip)]
     pub svg: String,
-}
-
-/// The figures that are not per case.
-#[derive(Clone, Debug, Serialize)]
-pub struct Figures {
-    /// Acceleration profile and trajectory.
-    pub trajectory: FigureView,
-    /// Estimation error of one realization.
-    pub realization: FigureView,
-    /// Achieved RMS error over the filter's σ, every case.
-    pub accuracy: FigureView,
-    /// |Mean error| / σ of every case, log scale.
-    pub mean_error: FigureView,
 }
 
 /// A row of the parameter table.
@@ -68,8 +97,8 @@ pub struct CheckRow {
     pub band: String,
     /// Members outside the band.
     pub outside: String,
-    /// "pass", "fail" or "untestable" (also the CSS class).
-    pub verdict: String,
+    /// Pass, fail or untestable (its word is also the CSS class).
+    pub verdict: VerdictView,
     /// The verdict in words ("untestable at N = 10, needs N ≥ 22").
     pub verdict_words: String,
 }
@@ -77,8 +106,8 @@ pub struct CheckRow {
 /// One cell of the verdict summary: a check on a case.
 #[derive(Clone, Debug, Serialize)]
 pub struct SummaryCell {
-    /// "pass", "fail" or "untestable".
-    pub verdict: String,
+    /// Pass, fail or untestable.
+    pub verdict: VerdictView,
     /// Worst against bound, e.g. "|z| = 1.92 ≤ 4.76".
     pub detail: String,
 }
@@ -105,11 +134,11 @@ pub struct PairView {
     pub rows: Vec<[String; 3]>,
     /// Bound on |z|.
     pub bound: String,
-    /// "pass", "fail" or "untestable".
-    pub verdict: String,
+    /// Pass, fail or untestable.
+    pub verdict: VerdictView,
 }
 
-/// One case: its verdicts, accuracy, prediction and figures.
+/// One case: its verdicts, accuracy, prediction and figures (a subsection of the results).
 #[derive(Clone, Debug, Serialize)]
 pub struct CaseView {
     /// Element id stem, e.g. `euler-sample`.
@@ -138,47 +167,68 @@ pub struct CaseView {
     pub pair_table_number: usize,
     /// The single residual pair.
     pub pair: PairView,
-    /// Achieved RMS error at the last fix, per state.
-    pub achieved: Vec<String>,
-    /// The filter's σ at the last fix, per state.
-    pub claimed: Vec<String>,
-    /// Achieved over claimed, per state.
-    pub ratio: Vec<String>,
+    /// Achieved RMS error over the filter's σ at the last fix, per state: "0.998, 1.00 and 1.01".
+    pub ratios_words: String,
+    /// The states in that order: "position, velocity and bias".
+    pub states_words: String,
     /// Worst |e_ave − m_pred| / (σ/√N).
     pub worst_se: String,
-    /// The mean-error check's bound.
-    pub mean_bound: String,
-    /// Whether the prediction explains the mean error within that bound.
+    /// Whether the prediction explains the mean error within the mean-error check's bound.
     pub explained: bool,
-    /// Predicted average a posteriori NEES at the last fix.
-    pub predicted_nees: String,
-    /// Measured average a posteriori NEES at the last fix.
-    pub measured_nees: String,
     /// Largest |a posteriori mean error| / σ per state over the run.
     pub max_mean_over_sigma: Vec<String>,
     /// Sentences on what failed, as HTML; empty when nothing did.
     pub failures_html: Vec<String>,
-    /// Realizations per second.
-    pub rate: String,
-    /// Run time, s.
-    pub elapsed: String,
     /// Its check figures.
     pub figures: Vec<FigureView>,
 }
 
-/// Numbers of the tables that are not per case.
+/// One state's accuracy on one case at the last fix.
 #[derive(Clone, Debug, Serialize)]
-pub struct TableNumbers {
-    /// The parameter table.
-    pub params: usize,
-    /// The verdict summary.
-    pub summary: usize,
-    /// Achieved against claimed accuracy.
-    pub accuracy: usize,
-    /// The mean-error prediction.
-    pub prediction: usize,
-    /// The run times.
-    pub performance: usize,
+pub struct AccuracyCell {
+    /// Achieved RMS error.
+    pub achieved: String,
+    /// The filter's σ.
+    pub claimed: String,
+    /// Achieved over claimed.
+    pub ratio: String,
+}
+
+/// A row of the accuracy table: one case.
+#[derive(Clone, Debug, Serialize)]
+pub struct AccuracyRow {
+    /// "A: Euler-integrated truth, point samples".
+    pub case: String,
+    /// One cell per state.
+    pub cells: Vec<AccuracyCell>,
+}
+
+/// A row of the prediction table: one case.
+#[derive(Clone, Debug, Serialize)]
+pub struct PredictionRow {
+    /// "A: Euler-integrated truth, point samples".
+    pub case: String,
+    /// Worst |e_ave − m_pred| / (σ/√N).
+    pub worst_se: String,
+    /// The mean-error check's bound.
+    pub mean_bound: String,
+    /// Predicted average a posteriori NEES at the last fix.
+    pub predicted_nees: String,
+    /// Measured average a posteriori NEES at the last fix.
+    pub measured_nees: String,
+}
+
+/// A row of the performance table: one case.
+#[derive(Clone, Debug, Serialize)]
+pub struct PerformanceRow {
+    /// "A: Euler-integrated truth, point samples".
+    pub case: String,
+    /// N.
+    pub realizations: String,
+    /// Run time, s.
+    pub elapsed: String,
+    /// Realizations per second.
+    pub rate: String,
 }
 
 /// Numbers of the display equations, in reading order.
@@ -208,85 +258,252 @@ pub struct EquationNumbers {
     pub prediction: usize,
 }
 
-/// Everything the report's templates show.
+/// The abstract.
 #[derive(Clone, Debug, Serialize)]
-pub struct ReportView {
-    /// accelcal version.
-    pub version: String,
+pub struct AbstractView {
+    /// Accelerometer rate, Hz.
+    pub accel_rate: String,
+    /// GPS rate, Hz.
+    pub gps_rate: String,
     /// N.
     pub realizations: String,
-    /// Number of GPS fixes.
-    pub fixes: String,
-    /// Number of accelerometer samples.
-    pub steps: String,
+    /// Number of checks each case runs.
+    pub check_count: String,
+    /// Their titles, "mean error, variance, … and NIS".
+    pub check_titles: String,
+    /// Study-wide false-alarm rate.
+    pub false_alarm: String,
+    /// The results, as HTML.
+    pub findings_html: String,
+}
+
+/// The introduction (its words do not depend on the run).
+#[derive(Clone, Debug, Serialize)]
+pub struct IntroductionView {}
+
+/// The problem and its parameters.
+#[derive(Clone, Debug, Serialize)]
+pub struct ProblemView {
+    /// Equation numbers.
+    pub eqn: EquationNumbers,
     /// Accelerometer rate, Hz.
     pub accel_rate: String,
     /// GPS rate, Hz.
     pub gps_rate: String,
     /// Samples between fixes.
     pub steps_per_fix: String,
-    /// Time of the first fix, s.
-    pub first_fix: String,
-    /// Study-wide false-alarm rate.
-    pub false_alarm: String,
-    /// Each check's share of it.
-    pub false_alarm_share: String,
-    /// Seed.
-    pub seed: String,
+    /// Number of the parameter table.
+    pub params_table: usize,
+    /// The parameter table.
+    pub params: Vec<ParamRow>,
     /// Whether the filter assumes the truth's statistics.
     pub filter_matches_truth: bool,
     /// What the filter assumes differently.
     pub filter_differences: Vec<String>,
-    /// The parameter table.
-    pub params: Vec<ParamRow>,
     /// Interpretation choices, as HTML.
     pub choices_html: Vec<String>,
-    /// The check catalogue.
-    pub catalogue: Vec<CatalogueEntry>,
-    /// Table numbers.
-    pub tables: TableNumbers,
+    /// Acceleration profile and trajectory.
+    pub trajectory: FigureView,
+}
+
+/// Theory and algorithm.
+#[derive(Clone, Debug, Serialize)]
+pub struct TheoryView {
     /// Equation numbers.
     pub eqn: EquationNumbers,
-    /// The cases.
-    pub cases: Vec<CaseView>,
-    /// The verdict summary, one row per check.
-    pub summary: Vec<SummaryRow>,
-    /// The sensitivity section, when the study ran it.
-    pub sensitivity: Option<SensitivityView>,
+    /// Samples between fixes.
+    pub steps_per_fix: String,
+    /// Δt·A/2, m/s.
+    pub euler_velocity_drift: String,
+    /// Δt²·A/12, the position error left with interval means, m.
+    pub interval_position_error: String,
+    /// N.
+    pub realizations: String,
+    /// Study-wide false-alarm rate.
+    pub false_alarm: String,
+    /// Each check's share of it.
+    pub false_alarm_share: String,
+    /// Number of checks each case runs.
+    pub check_count: String,
+    /// The checks each case runs.
+    pub catalogue: Vec<CatalogueEntry>,
+    /// Number of accelerometer samples.
+    pub steps: String,
+    /// Number of GPS fixes.
+    pub fixes: String,
+}
+
+/// Results: one realization, the verdicts of every case, accuracy and the mean error.
+#[derive(Clone, Debug, Serialize)]
+pub struct ResultsView {
+    /// Estimation error of one realization.
+    pub realization: FigureView,
     /// The case of the recorded realization, in words.
     pub realization_case: String,
-    /// The realization's true bias, m/s².
-    pub bias_true: String,
-    /// Its final estimate, m/s².
-    pub bias_estimate: String,
-    /// Estimate error in σ.
-    pub bias_error_sigmas: String,
-    /// The bias prior σ the filter assumes, m/s².
-    pub bias_prior_sigma: String,
-    /// Time of the last fix, s.
-    pub end_time: String,
+    /// Time of the first fix, s.
+    pub first_fix: String,
     /// Position σ after the first fix, m.
     pub first_fix_sigma_p: String,
     /// Velocity σ after the first fix, m/s.
     pub first_fix_sigma_v: String,
     /// "0.0094 m/s² after 1 s, … and 0.00047 m/s² at the end": milestones within the run.
     pub bias_sigma_progress: String,
-    /// Δt·A/2, m/s.
-    pub euler_velocity_drift: String,
-    /// Δt²·A/12, the position error left with interval means, m.
-    pub interval_position_error: String,
+    /// The realization's true bias, m/s².
+    pub bias_true: String,
+    /// Its final estimate, m/s².
+    pub bias_estimate: String,
+    /// Estimate error in σ.
+    pub bias_error_sigmas: String,
+    /// N.
+    pub realizations: String,
+    /// Study-wide false-alarm rate.
+    pub false_alarm: String,
+    /// Number of the verdict summary.
+    pub summary_table: usize,
+    /// The cases, "A: Euler-integrated truth, point samples", the summary's columns.
+    pub cases: Vec<String>,
+    /// The verdict summary, one row per check.
+    pub summary: Vec<SummaryRow>,
+    /// Number of the accuracy table.
+    pub accuracy_table: usize,
+    /// Time of the last fix, s.
+    pub end_time: String,
+    /// The accuracy table's columns: "position (m)", one per state.
+    pub state_columns: Vec<String>,
+    /// The accuracy table's rows.
+    pub accuracy_rows: Vec<AccuracyRow>,
+    /// Achieved RMS error over the filter's σ, every case.
+    pub accuracy: FigureView,
+    /// Number of the mean-error prediction equation.
+    pub prediction_eq: usize,
+    /// Number of the prediction table.
+    pub prediction_table: usize,
+    /// The prediction table's rows.
+    pub prediction_rows: Vec<PredictionRow>,
+    /// |Mean error| / σ of every case, log scale.
+    pub mean_error: FigureView,
+}
+
+/// The run times of the ensembles.
+#[derive(Clone, Debug, Serialize)]
+pub struct PerformanceView {
+    /// Number of the table.
+    pub table: usize,
     /// Threads of the ensemble runs.
     pub threads: String,
-    /// The figures that are not per case.
-    pub fig: Figures,
-    /// The abstract's results, as HTML.
-    pub abstract_html: String,
-    /// The conclusions, one paragraph each, as HTML.
-    pub conclusions_html: Vec<String>,
-    /// The configuration as TOML.
-    pub config_toml: String,
+    /// Accelerometer rate, Hz.
+    pub accel_rate: String,
+    /// One row per case.
+    pub rows: Vec<PerformanceRow>,
+}
+
+/// Conclusions.
+#[derive(Clone, Debug, Serialize)]
+pub struct ConclusionsView {
+    /// One paragraph each, as HTML.
+    pub paragraphs_html: Vec<String>,
+}
+
+/// Configuration and reproduction.
+#[derive(Clone, Debug, Serialize)]
+pub struct AppendixView {
     /// The command that reproduces the report.
     pub command: String,
+    /// The configuration as TOML.
+    pub config_toml: String,
+}
+
+/// The view of one section.
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "section", rename_all = "snake_case")]
+pub enum SectionView {
+    /// The abstract.
+    Abstract(AbstractView),
+    /// The introduction.
+    Introduction(IntroductionView),
+    /// The problem and its parameters.
+    Problem(ProblemView),
+    /// Theory and algorithm.
+    Theory(TheoryView),
+    /// Results.
+    Results(ResultsView),
+    /// One case.
+    Case(CaseView),
+    /// Run times.
+    Performance(PerformanceView),
+    /// Sensitivity to the assumed statistics.
+    Sensitivity(SensitivityView),
+    /// Conclusions.
+    Conclusions(ConclusionsView),
+    /// Configuration and reproduction.
+    Appendix(AppendixView),
+}
+
+impl SectionView {
+    /// The element id of the section.
+    pub fn anchor(&self) -> String {
+        match self {
+            SectionView::Abstract(_) => "abstract".to_string(),
+            SectionView::Introduction(_) => "introduction".to_string(),
+            SectionView::Problem(_) => "problem".to_string(),
+            SectionView::Theory(_) => "theory".to_string(),
+            SectionView::Results(_) => "results".to_string(),
+            SectionView::Case(c) => format!("case-{}", c.id),
+            SectionView::Performance(_) => "performance".to_string(),
+            SectionView::Sensitivity(_) => "sensitivity".to_string(),
+            SectionView::Conclusions(_) => "conclusions".to_string(),
+            SectionView::Appendix(_) => "appendix".to_string(),
+        }
+    }
+
+    /// The section's heading.
+    pub fn title(&self) -> String {
+        match self {
+            SectionView::Abstract(_) => "Abstract".to_string(),
+            SectionView::Introduction(_) => "Introduction".to_string(),
+            SectionView::Problem(_) => "The problem and its parameters".to_string(),
+            SectionView::Theory(_) => "Theory and algorithm".to_string(),
+            SectionView::Results(_) => "Results and performance".to_string(),
+            SectionView::Case(c) => format!("Case {}: {}", c.letter, c.title),
+            SectionView::Performance(_) => "Performance".to_string(),
+            SectionView::Sensitivity(_) => "Sensitivity to the assumed statistics".to_string(),
+            SectionView::Conclusions(_) => "Conclusions".to_string(),
+            SectionView::Appendix(_) => "Appendix: configuration and reproduction".to_string(),
+        }
+    }
+}
+
+/// A section's view and its subsections'.
+#[derive(Clone, Debug, Serialize)]
+pub struct SectionNode {
+    /// The section.
+    #[serde(flatten)]
+    pub view: SectionView,
+    /// Its subsections, in order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub children: Vec<SectionNode>,
+}
+
+/// An entry of the table of contents.
+#[derive(Clone, Debug, Serialize)]
+pub struct TocEntry {
+    /// The element id it links to.
+    pub anchor: String,
+    /// The section's heading.
+    pub title: String,
+}
+
+/// Everything the report page shows: its sections in the order of the outline.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReportView {
+    /// accelcal version.
+    pub version: String,
+    /// Seed.
+    pub seed: String,
+    /// The table of contents: the top-level sections.
+    pub toc: Vec<TocEntry>,
+    /// The sections.
+    pub sections: Vec<SectionNode>,
 }
 
 /// One entry of the check catalogue, for the theory section.

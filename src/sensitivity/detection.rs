@@ -69,7 +69,7 @@ pub fn predicted(
     };
     let mut p = Vec::new();
     match id {
-        CheckId::MeanError | CheckId::CovarianceMatch => {
+        CheckId::MEAN_ERROR | CheckId::COVARIANCE_MATCH => {
             let mut ratios = Vec::new();
             for (i, f) in actual.iter().enumerate() {
                 for stage in Stage::ALL {
@@ -82,10 +82,10 @@ pub fn predicted(
                     }
                 }
             }
-            let share = budget.share(id) / ratios.len() as f64;
-            let (lo, hi, _) = band(id, n, share);
+            let share = budget.share() / ratios.len() as f64;
+            let (lo, hi, _) = band(id.definition(), n, share);
             for r in ratios {
-                p.push(if id == CheckId::MeanError {
+                p.push(if id == CheckId::MEAN_ERROR {
                     // e_ave/√(P/N) ~ N(0, r): outside ±b with probability 2·Φ(−b/√r).
                     2.0 * Normal::standard().cdf(-hi / r.sqrt())
                 } else {
@@ -94,10 +94,10 @@ pub fn predicted(
                 });
             }
         }
-        CheckId::Nees | CheckId::Nis => {
+        CheckId::NEES | CheckId::NIS => {
             let mut forms = Vec::new();
             for (i, f) in actual.iter().enumerate() {
-                if id == CheckId::Nees {
+                if id == CheckId::NEES {
                     for stage in Stage::ALL {
                         let (pa, _, pinv) = stages(f, i, stage);
                         forms.push(weights(&pinv, &pa));
@@ -106,8 +106,8 @@ pub fn predicted(
                     forms.push(weights(&schedule.fixes[i].s_inv, &f.innovation));
                 }
             }
-            let share = budget.share(id) / forms.len() as f64;
-            let (lo, hi, _) = band(id, n, share);
+            let share = budget.share() / forms.len() as f64;
+            let (lo, hi, _) = band(id.definition(), n, share);
             for (sum, sum_sq) in forms {
                 // N·average = Σ_k λ_k χ²(N) ≈ a·χ²(ν) with the same mean and variance.
                 let a = sum_sq / sum;
@@ -115,9 +115,8 @@ pub fn predicted(
                 p.push(outside_scaled_chi_squared(nu, a, nf, (lo, hi)));
             }
         }
-        CheckId::CovarianceCorrelation | CheckId::Orthogonality | CheckId::ResidualWhiteness => {
-            return None;
-        }
+        // The correlation scores, and any other check.
+        _ => return None,
     }
     Some(Detection::of(&p))
 }

@@ -320,47 +320,15 @@ pub fn run(
     progress.start_in("predict", grid.len() as u64 * draws, "sampled ensembles");
     let mut cases = Vec::with_capacity(grid.len());
     for &(parameter, factor) in &grid {
-        let (model, schedule) = mistuned(&world, parameter, factor)?;
-        let actual = actual_covariance(&model.timeline, &schedule, &model.truth_stats);
-        let (last_fix, last_actual) = (
-            schedule.fixes.last().expect("fixes"),
-            actual.last().expect("fixes"),
-        );
-        let bounds = CheckId::ALL
-            .iter()
-            .map(|&id| detection::predicted(id, &schedule, &actual, plan.realizations, &budget))
-            .collect();
-        let predicted = if draws > 0 {
-            sampler::Sampler::new(
-                &model.timeline,
-                &schedule,
-                &model.truth_stats,
-                plan.realizations,
-                model.residual_pair,
-            )
-            .detection(
-                &schedule,
-                &budget,
-                draws,
-                case_seed(seed, SAMPLED, parameter, factor),
-            )
-        } else {
-            vec![None; CheckId::ALL.len()]
-        };
-        progress.advance((cases.len() as u64 + 1) * draws);
-        cases.push(SensitivityCase {
-            parameter,
-            factor,
-            claimed_sigma_final: sigma(&last_fix.p_post),
-            actual_sigma_final: sigma(&last_actual.post),
-            expected_nees_final: covariance::weights(&last_fix.p_post_inv, &last_actual.post).0,
-            expected_nis_final: covariance::weights(&last_fix.s_inv, &last_actual.innovation).0,
-            predicted,
+        let predictions = Predictions {
+            world: &world,
+            plan,
+            budget: &budget,
             draws,
-            bounds,
-            ensembles: plan.ensembles,
-            detected: None,
-        });
+            seed,
+        };
+        cases.push(predictions.case(parameter, factor)?);
+        progress.advance(cases.len() as u64 * draws);
     }
     progress.finish();
 
@@ -370,28 +338,8 @@ pub fn run(
         progress.start("sensitivity", total);
         let mut done = 0;
         for case in &mut cases {
-            // Built again rather than kept from the first pass: one covariance pass, against
-            // memory that would grow with cases × fixes.
-            let (model, schedule) = mistuned(&world, case.parameter, case.factor)?;
-            let prepared = ensemble::Prepared::new(plan.engine, &model, &schedule);
-            let mut failures = [0u64; 7];
-            for k in 0..plan.ensembles {
-                let seed = mix(case_seed(seed, ENSEMBLES, case.parameter, case.factor), k);
-                let acc = ensemble::run_prepared(
-                    &prepared,
-                    &model,
-                    &schedule,
-                    seed,
-                    plan.realizations,
-                    |d| progress.advance(done + d),
-                );
-                done += plan.realizations;
-                let stats = EnsembleStats::from_sums(&acc, &schedule);
-                let v = checks::evaluate(&stats, &budget);
-                for c in &v.checks {
-                    failures[c.id.index()] += u64::from(c.verdict == Verdict::Fail);
-                }
-            }
+            let failures = monte_carlo(&world, plan, &budget, seed, case, (progress, done))?;
+            done += plan.ensembles * plan.realizations;
             case.detected = Some(
                 failures
                     .iter()
@@ -407,6 +355,99 @@ pub fn run(
         tuned_sigma_final: sigma(&tuned_schedule.fixes.last().expect("fixes").p_post),
         cases,
     })
+}
+
+/// What the predictions of every case share.
+struct Predictions<'a> {
+    world: &'a Config,
+    plan: &'a Plan,
+    budget: &'a Budget,
+    draws: u64,
+    seed: u64,
+}
+
+impl Predictions<'_> {
+    /// The exact and sampled predictions for `parameter` × `factor`, without simulation.
+    fn case(
+        &self,
+        parameter: AssumedStatistic,
+        factor: f64,
+    ) -> Result<SensitivityCase, SensitivityError> {
+        let (plan, budget, draws) = (self.plan, self.budget, self.draws);
+        let (model, schedule) = mistuned(self.world, parameter, factor)?;
+        let actual = actual_covariance(&model.timeline, &schedule, &model.truth_stats);
+        let (last_fix, last_actual) = (
+            schedule.fixes.last().expect("fixes"),
+            actual.last().expect("fixes"),
+        );
+        let bounds = CheckId::ALL
+            .iter()
+            .map(|&id| detection::predicted(id, &schedule, &actual, plan.realizations, budget))
+            .collect();
+        let predicted = if draws > 0 {
+            sampler::Sampler::new(
+                &model.timeline,
+                &schedule,
+                &model.truth_stats,
+                plan.realizations,
+                model.residual_pair,
+            )
+            .detection(
+                &schedule,
+                budget,
+                draws,
+                case_seed(self.seed, SAMPLED, parameter, factor),
+            )
+        } else {
+            vec![None; CheckId::ALL.len()]
+        };
+        Ok(SensitivityCase {
+            parameter,
+            factor,
+            claimed_sigma_final: sigma(&last_fix.p_post),
+            actual_sigma_final: sigma(&last_actual.post),
+            expected_nees_final: covariance::weights(&last_fix.p_post_inv, &last_actual.post).0,
+            expected_nis_final: covariance::weights(&last_fix.s_inv, &last_actual.innovation).0,
+            predicted,
+            draws,
+            bounds,
+            ensembles: plan.ensembles,
+            detected: None,
+        })
+    }
+}
+
+/// Runs the Monte Carlo ensembles of `case` and counts, per check in [`CheckId::ALL`] order,
+/// the ensembles in which it failed; `progress` is told the realizations done, counted from the
+/// second element.
+fn monte_carlo(
+    world: &Config,
+    plan: &Plan,
+    budget: &Budget,
+    seed: u64,
+    case: &SensitivityCase,
+    (progress, before): (&mut dyn Progress, u64),
+) -> Result<Vec<u64>, SensitivityError> {
+    // Built again rather than kept from the first pass: one covariance pass, against
+    // memory that would grow with cases × fixes.
+    let (model, schedule) = mistuned(world, case.parameter, case.factor)?;
+    let prepared = ensemble::Prepared::new(plan.engine, &model, &schedule);
+    let mut failures = vec![0u64; CheckId::ALL.len()];
+    let mut done = before;
+    for k in 0..plan.ensembles {
+        let seed = mix(case_seed(seed, ENSEMBLES, case.parameter, case.factor), k);
+        let acc =
+            ensemble::run_prepared(&prepared, &model, &schedule, seed, plan.realizations, |d| {
+                progress.advance(done + d)
+            });
+        done += plan.realizations;
+        let stats = EnsembleStats::from_sums(&acc, &schedule);
+        let v = checks::evaluate(&stats, budget);
+        for (failed, c) in failures.iter_mut().zip(&v.checks) {
+            *failed += u64::from(c.verdict == Verdict::Fail);
+        }
+    }
+    Ok(failures)
 }
 
 /// Domains of the seeds a case derives: its sampled ensembles and its Monte Carlo ensembles.

@@ -242,7 +242,7 @@ impl Sampler {
             .iter()
             .zip(failed)
             .map(|(&id, f)| {
-                (id != CheckId::ResidualWhiteness && draws > 0).then(|| f as f64 / draws as f64)
+                (id != CheckId::RESIDUAL_WHITENESS && draws > 0).then(|| f as f64 / draws as f64)
             })
             .collect()
     }

@@ -267,7 +267,7 @@ fn titles_say_what_the_axes_clip() {
 #[test]
 fn consistency_far_from_its_band_gets_a_log_axis_and_the_band_enlarged() {
     let study = small_study();
-    let (nees, nis) = (check(study, CheckId::Nees), check(study, CheckId::Nis));
+    let (nees, nis) = (check(study, CheckId::NEES), check(study, CheckId::NIS));
     let mut near = study.case(CASE).run.stats.clone();
     for f in &mut near.fixes {
         (f.prior.nees_avg, f.post.nees_avg, f.nis_avg) = (3.0, 3.0, 2.0);

@@ -1,0 +1,33 @@
+//! The NEES check: the average NEES is 3, the state dimension.
+
+use super::catalogue::{CheckId, Definition, FailureWords, Null};
+use super::members;
+use crate::format::sig;
+use crate::state::ErrorState;
+
+/// The average normalized estimation error squared is the state dimension.
+///
+/// # Formula
+/// N·ε̄ = Σ eᵀP⁻¹e ~ χ²(3N), for each fix and stage.
+pub const CHECK: Definition = Definition {
+    id: CheckId::NEES,
+    title: "NEES",
+    hypothesis: "the average NEES is 3, the state dimension",
+    statistic: "(1/N) Σ eᵀP⁻¹e",
+    members: "each fix, a priori and a posteriori",
+    rationale: "Each realization's eᵀP⁻¹e is χ²(3) for Gaussian errors, so N times the average \
+                 is χ²(3N).",
+    formula: r"\bar{\epsilon}(t_i) = \frac{1}{N} \sum_{l=1}^{N} e^l(t_i)\T P(t_i)^{-1} e^l(t_i), \qquad N \bar{\epsilon} \sim \chi^2(3N)",
+    null: |n| Null::ChiSquared {
+        dof: ErrorState::DIM as f64 * n,
+        scale: n,
+    },
+    for_each_member: |stats, f| members::for_each(CheckId::NEES, stats, f),
+    failure: |c, w| {
+        let FailureWords { outside, band, at } = w;
+        format!(
+            "The average NEES leaves its χ² band {band} at {outside}; the worst value is {} ({at}).",
+            sig(c.worst_value(), 3)
+        )
+    },
+};

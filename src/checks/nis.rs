@@ -1,0 +1,32 @@
+//! The NIS check: the average NIS is 2, the measurement dimension.
+
+use super::catalogue::{CheckId, Definition, FailureWords, Null};
+use super::members;
+use crate::format::sig;
+use crate::state::ErrorState;
+
+/// The average normalized innovation squared is the measurement dimension.
+///
+/// # Formula
+/// N·ν̄ = Σ rᵀS⁻¹r ~ χ²(2N), for each fix.
+pub const CHECK: Definition = Definition {
+    id: CheckId::NIS,
+    title: "NIS",
+    hypothesis: "the average NIS is 2, the measurement dimension",
+    statistic: "(1/N) Σ rᵀS⁻¹r",
+    members: "each fix",
+    rationale: "Each realization's rᵀS⁻¹r is χ²(2), so N times the average is χ²(2N).",
+    formula: r"\bar{\nu}(t_i) = \frac{1}{N} \sum_{l=1}^{N} r^l(t_i)\T S(t_i)^{-1} r^l(t_i), \qquad N \bar{\nu} \sim \chi^2(2N)",
+    null: |n| Null::ChiSquared {
+        dof: ErrorState::MEAS as f64 * n,
+        scale: n,
+    },
+    for_each_member: |stats, f| members::for_each(CheckId::NIS, stats, f),
+    failure: |c, w| {
+        let FailureWords { outside, band, at } = w;
+        format!(
+            "The average NIS leaves its χ² band {band} at {outside}; the worst value is {} ({at}).",
+            sig(c.worst_value(), 3)
+        )
+    },
+};

@@ -1,0 +1,117 @@
+//! The templates of the report: one per section, and the page that places them in the order of
+//! the outline. Each section renders to a complete HTML fragment.
+
+use askama::Template;
+
+use super::equations::Equations;
+use super::view::{
+    AbstractView, AppendixView, CaseView, ConclusionsView, PerformanceView, ProblemView,
+    ReportView, ResultsView, SectionNode, SectionView, SensitivityView, TheoryView,
+};
+
+/// The report page.
+#[derive(Template)]
+#[template(path = "report.html")]
+pub struct ReportPage<'a> {
+    /// The view.
+    pub v: &'a ReportView,
+    /// The sections, rendered, in outline order.
+    pub sections_html: &'a [String],
+    /// The stylesheet.
+    pub style: &'a str,
+}
+
+#[derive(Template)]
+#[template(path = "sections/abstract.html")]
+struct AbstractHtml<'a> {
+    v: &'a AbstractView,
+}
+
+#[derive(Template)]
+#[template(path = "sections/introduction.html")]
+struct IntroductionHtml;
+
+#[derive(Template)]
+#[template(path = "sections/problem.html")]
+struct ProblemHtml<'a> {
+    v: &'a ProblemView,
+    eq: &'a Equations,
+}
+
+#[derive(Template)]
+#[template(path = "sections/theory.html")]
+struct TheoryHtml<'a> {
+    v: &'a TheoryView,
+    eq: &'a Equations,
+}
+
+#[derive(Template)]
+#[template(path = "sections/results.html")]
+struct ResultsHtml<'a> {
+    v: &'a ResultsView,
+    children_html: &'a [String],
+}
+
+#[derive(Template)]
+#[template(path = "sections/case.html")]
+struct CaseHtml<'a> {
+    c: &'a CaseView,
+}
+
+#[derive(Template)]
+#[template(path = "sections/performance.html")]
+struct PerformanceHtml<'a> {
+    v: &'a PerformanceView,
+}
+
+#[derive(Template)]
+#[template(path = "sections/sensitivity.html")]
+struct SensitivityHtml<'a> {
+    s: &'a SensitivityView,
+}
+
+#[derive(Template)]
+#[template(path = "sections/conclusions.html")]
+struct ConclusionsHtml<'a> {
+    v: &'a ConclusionsView,
+}
+
+#[derive(Template)]
+#[template(path = "sections/appendix.html")]
+struct AppendixHtml<'a> {
+    v: &'a AppendixView,
+}
+
+/// Renders `node` and its subsections with the equations `eq`.
+///
+/// # Errors
+/// [`askama::Error`] when a template cannot be filled.
+pub fn section(node: &SectionNode, eq: &Equations) -> Result<String, askama::Error> {
+    let children: Vec<String> = node
+        .children
+        .iter()
+        .map(|c| section(c, eq))
+        .collect::<Result<_, _>>()?;
+    let children_html = children.as_slice();
+    let own = match &node.view {
+        SectionView::Abstract(v) => AbstractHtml { v }.render(),
+        SectionView::Introduction(_) => IntroductionHtml.render(),
+        SectionView::Problem(v) => ProblemHtml { v, eq }.render(),
+        SectionView::Theory(v) => TheoryHtml { v, eq }.render(),
+        SectionView::Results(v) => ResultsHtml { v, children_html }.render(),
+        SectionView::Case(c) => CaseHtml { c }.render(),
+        SectionView::Performance(v) => PerformanceHtml { v }.render(),
+        SectionView::Sensitivity(s) => SensitivityHtml { s }.render(),
+        SectionView::Conclusions(v) => ConclusionsHtml { v }.render(),
+        SectionView::Appendix(v) => AppendixHtml { v }.render(),
+    }?;
+    // The results place their subsections; any other section is followed by its own.
+    Ok(match node.view {
+        SectionView::Results(_) => own,
+        _ => [own]
+            .into_iter()
+            .chain(children)
+            .collect::<Vec<_>>()
+            .join("\n"),
+    })
+}

@@ -1,0 +1,269 @@
+//! The report's outline: which sections the page shows, in which order, and what each one holds.
+//! Table, figure and equation numbers and the table of contents are derived from it, so that a
+//! section moved in the outline takes its numbers and its entry in the contents along.
+//!
+//! Numbers are handed out like labels in a typeset document: a first pass walks the outline in
+//! reading order and numbers every table, figure and equation each section declares; the
+//! sections are then built with every number known, so a section may cite one that a later
+//! section holds.
+
+use std::collections::HashMap;
+
+use super::figures::CheckFigure;
+
+/// A section of the report page.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Section {
+    /// The abstract.
+    Abstract,
+    /// The introduction.
+    Introduction,
+    /// The problem and its parameters.
+    Problem,
+    /// Theory and algorithm.
+    Theory,
+    /// Results and performance: the realization, the verdict summary, accuracy, prediction.
+    Results,
+    /// One case of the study, by its index.
+    Case(usize),
+    /// The run times of the ensembles.
+    Performance,
+    /// Sensitivity to the assumed statistics.
+    Sensitivity,
+    /// Conclusions.
+    Conclusions,
+    /// Configuration and reproduction.
+    Appendix,
+}
+
+/// A numbered table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Table {
+    /// The parameters of the run.
+    Params,
+    /// The verdicts of every check on every case.
+    Summary,
+    /// Achieved against claimed accuracy.
+    Accuracy,
+    /// The predicted mean error against the measured one.
+    Prediction,
+    /// The verdict table of a case.
+    Checks(usize),
+    /// The single residual pair of a case.
+    Pair(usize),
+    /// The run times.
+    Performance,
+    /// The detection of a mistuned filter.
+    Detection,
+}
+
+/// A numbered figure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Figure {
+    /// The acceleration profile and trajectory.
+    Trajectory,
+    /// The estimation error of one realization.
+    Realization,
+    /// Achieved accuracy over the filter's σ, every case.
+    Accuracy,
+    /// The mean error of every case in units of σ.
+    MeanErrorCases,
+    /// A check figure of a case.
+    Check(usize, CheckFigure),
+    /// Actual against claimed σ of the mistuned filters.
+    Sensitivity,
+}
+
+/// A numbered display equation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Equation {
+    /// The acceleration profile.
+    Profile,
+    /// The closed-form truth.
+    AnalyticTruth,
+    /// The accelerometer, point samples.
+    Accelerometer,
+    /// The accelerometer, interval means.
+    IntervalMean,
+    /// The accelerometer's Euler integration.
+    Integration,
+    /// The GPS.
+    Gps,
+    /// The truth integrated like the accelerometer.
+    EulerTruth,
+    /// The error dynamics.
+    Dynamics,
+    /// The measurement of the error state.
+    Measurement,
+    /// The velocity lag of point samples.
+    Lag,
+    /// The predicted mean error.
+    Prediction,
+}
+
+/// Something a section numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Label {
+    /// A table.
+    Table(Table),
+    /// A figure.
+    Figure(Figure),
+    /// An equation.
+    Equation(Equation),
+}
+
+impl Section {
+    /// What the section numbers, in the order its template shows them.
+    pub fn labels(self) -> Vec<Label> {
+        use Label::{Equation as E, Figure as F, Table as T};
+        match self {
+            Section::Abstract
+            | Section::Introduction
+            | Section::Conclusions
+            | Section::Appendix => Vec::new(),
+            Section::Problem => vec![
+                E(Equation::Profile),
+                E(Equation::AnalyticTruth),
+                T(Table::Params),
+                F(Figure::Trajectory),
+            ],
+            Section::Theory => [
+                Equation::Accelerometer,
+                Equation::IntervalMean,
+                Equation::Integration,
+                Equation::Gps,
+                Equation::EulerTruth,
+                Equation::Dynamics,
+                Equation::Measurement,
+                Equation::Lag,
+                Equation::Prediction,
+            ]
+            .map(E)
+            .to_vec(),
+            Section::Results => vec![
+                F(Figure::Realization),
+                T(Table::Summary),
+                T(Table::Accuracy),
+                F(Figure::Accuracy),
+                T(Table::Prediction),
+                F(Figure::MeanErrorCases),
+            ],
+            Section::Case(i) => [T(Table::Checks(i)), T(Table::Pair(i))]
+                .into_iter()
+                .chain(CheckFigure::ALL.map(|f| F(Figure::Check(i, f))))
+                .collect(),
+            Section::Performance => vec![T(Table::Performance)],
+            Section::Sensitivity => vec![F(Figure::Sensitivity), T(Table::Detection)],
+        }
+    }
+}
+
+/// A section and the sections nested in it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Node {
+    /// The section.
+    pub section: Section,
+    /// Its subsections, in order; they follow everything the section itself shows.
+    pub children: Vec<Section>,
+}
+
+impl Node {
+    /// A section without subsections.
+    pub fn leaf(section: Section) -> Self {
+        Node {
+            section,
+            children: Vec::new(),
+        }
+    }
+}
+
+/// The sections of the page, in reading order.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Outline {
+    /// The top-level sections.
+    pub nodes: Vec<Node>,
+}
+
+impl Outline {
+    /// The report's order for a study of `cases` cases, with the sensitivity section when
+    /// `sensitivity` is true.
+    pub fn standard(cases: usize, sensitivity: bool) -> Self {
+        let results = Node {
+            section: Section::Results,
+            children: (0..cases)
+                .map(Section::Case)
+                .chain([Section::Performance])
+                .collect(),
+        };
+        let mut nodes = vec![
+            Node::leaf(Section::Abstract),
+            Node::leaf(Section::Introduction),
+            Node::leaf(Section::Problem),
+            Node::leaf(Section::Theory),
+            results,
+        ];
+        if sensitivity {
+            nodes.push(Node::leaf(Section::Sensitivity));
+        }
+        nodes.push(Node::leaf(Section::Conclusions));
+        nodes.push(Node::leaf(Section::Appendix));
+        Outline { nodes }
+    }
+
+    /// Every section in reading order, subsections after their section.
+    pub fn sections(&self) -> impl Iterator<Item = Section> + '_ {
+        self.nodes
+            .iter()
+            .flat_map(|n| std::iter::once(n.section).chain(n.children.iter().copied()))
+    }
+
+    /// Numbers every table, figure and equation in reading order, each kind from 1.
+    pub fn numbers(&self) -> Numbers {
+        let mut next = [0usize; 3];
+        let mut map = HashMap::new();
+        for label in self.sections().flat_map(Section::labels) {
+            let kind = match label {
+                Label::Table(_) => 0,
+                Label::Figure(_) => 1,
+                Label::Equation(_) => 2,
+            };
+            next[kind] += 1;
+            map.insert(label, next[kind]);
+        }
+        Numbers { map }
+    }
+}
+
+/// The number of every table, figure and equation of an outline.
+#[derive(Clone, Debug, Default)]
+pub struct Numbers {
+    map: HashMap<Label, usize>,
+}
+
+impl Numbers {
+    /// The number of `label`.
+    ///
+    /// # Panics
+    /// When no section of the outline shows it: a section cites what the page does not hold.
+    pub fn of(&self, label: Label) -> usize {
+        *self
+            .map
+            .get(&label)
+            .unwrap_or_else(|| panic!("{label:?} is in no section of the outline"))
+    }
+
+    /// The number of table `t`.
+    pub fn table(&self, t: Table) -> usize {
+        self.of(Label::Table(t))
+    }
+
+    /// The number of figure `f`.
+    pub fn figure(&self, f: Figure) -> usize {
+        self.of(Label::Figure(f))
+    }
+
+    /// The number of equation `e`.
+    pub fn equation(&self, e: Equation) -> usize {
+        self.of(Label::Equation(e))
+    }
+}
