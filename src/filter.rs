@@ -22,41 +22,6 @@ pub type Matrix2x3 = SMatrix<f64, { ErrorState::MEAS }, { ErrorState::DIM }>;
 /// Kalman gain K of the error state.
 pub type Matrix3x2 = SMatrix<f64, { ErrorState::DIM }, { ErrorState::MEAS }>;
 
-/// A component of the error state δx = (δp, δv, b); the first two are also the components of a
-/// GPS measurement and of a residual.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Component {
-    /// Position error δp, m.
-    Position,
-    /// Velocity error δv, m/s.
-    Velocity,
-    /// Accelerometer bias b, m/s².
-    Bias,
-}
-
-impl Component {
-    /// The state components, in state order.
-    pub const STATE: [Component; ErrorState::DIM] =
-        [Component::Position, Component::Velocity, Component::Bias];
-    /// The measured components, in measurement order.
-    pub const MEASURED: [Component; ErrorState::MEAS] = [Component::Position, Component::Velocity];
-
-    /// Index in the state vector.
-    pub fn index(self) -> usize {
-        match self {
-            Component::Position => ErrorState::POSITION,
-            Component::Velocity => ErrorState::VELOCITY,
-            Component::Bias => ErrorState::BIAS,
-        }
-    }
-
-    /// The unit of the component.
-    pub fn unit(self) -> &'static str {
-        <ErrorState as StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }>>::STATES[self.index()]
-            .unit
-    }
-}
-
 /// Before or after the measurement update at a fix.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Stage {
@@ -227,6 +192,8 @@ pub struct FilterSchedule<
     pub model: FilterModel<N, M>,
     /// One entry per GPS fix.
     pub fixes: Vec<FixCovariance<N, M>>,
+    /// Which states are constant between fixes (see [`StateModel::constant_states`]).
+    pub constant: [bool; N],
 }
 
 impl FilterSchedule {
@@ -277,6 +244,7 @@ impl<const N: usize, const M: usize> FilterSchedule<N, M> {
         Ok(Self {
             model: system,
             fixes,
+            constant: model.constant_states(),
         })
     }
 }

@@ -29,6 +29,15 @@ pub struct Variable {
     pub unit: &'static str,
 }
 
+/// The sizes of a state model: what a check's null distribution depends on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Dims {
+    /// Number of states N.
+    pub states: usize,
+    /// Number of measured components M.
+    pub measurements: usize,
+}
+
 /// A linear Gaussian state model with `N` states and `M` measured components.
 ///
 /// Between fixes the state moves as x(t + τ) = Φ(t, τ)·x(t) + w, w ~ N(0, Q(t, τ)); a fix measures
@@ -53,6 +62,25 @@ pub trait StateModel<const N: usize, const M: usize> {
     fn measurement_noise(&self) -> SMatrix<f64, M, M>;
     /// Prior covariance P(0).
     fn initial_covariance(&self) -> SMatrix<f64, N, N>;
+
+    /// The model's sizes.
+    fn dims(&self) -> Dims {
+        Dims {
+            states: N,
+            measurements: M,
+        }
+    }
+
+    /// Which states are constant between fixes: row k of Φ is the unit row and Q has nothing in
+    /// row k (read off one step of a second at t = 0). The a priori error and estimate of such a
+    /// state at a fix are the a posteriori ones of the previous fix, so the checks count them once.
+    fn constant_states(&self) -> [bool; N] {
+        let phi = self.transition(0.0, 1.0);
+        let q = self.process_noise(0.0, 1.0);
+        std::array::from_fn(|k| {
+            (0..N).all(|c| phi[(k, c)] == if k == c { 1.0 } else { 0.0 } && q[(k, c)] == 0.0)
+        })
+    }
 }
 
 /// The accelerometer's error state δx = (δp, δv, b) for one set of noise statistics.
@@ -77,6 +105,17 @@ impl ErrorState {
     pub const GPS_POSITION: usize = 0;
     /// Index of the GPS velocity in a measurement or residual.
     pub const GPS_VELOCITY: usize = 1;
+    /// The sizes of the error state and the GPS measurement.
+    pub const DIMS: Dims = Dims {
+        states: Self::DIM,
+        measurements: Self::MEAS,
+    };
+    /// The error state's variables (see [`StateModel::STATES`]).
+    pub const VARIABLES: [Variable; Self::DIM] =
+        <Self as StateModel<{ Self::DIM }, { Self::MEAS }>>::STATES;
+    /// The GPS measurement's components (see [`StateModel::MEASUREMENTS`]).
+    pub const MEASURED: [Variable; Self::MEAS] =
+        <Self as StateModel<{ Self::DIM }, { Self::MEAS }>>::MEASUREMENTS;
 }
 
 /// A vector of the error state (m, m/s, m/s²).
@@ -205,7 +244,6 @@ impl StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }> for ErrorState {
 mod tests {
     use super::*;
     use crate::config::Config;
-    use crate::filter::ErrorStateModel;
     use crate::model::Model;
 
     type Matrix2x3Lit = SMatrix<f64, 2, 3>;
@@ -217,7 +255,6 @@ mod tests {
         let model = ErrorState {
             stats: m.filter_stats,
         };
-        let filter = ErrorStateModel::new(m.timeline.dt_s, &m.filter_stats);
         let dt = m.timeline.dt_s;
         // eq. (5) written out.
         let phi = StateMatrix::new(1.0, dt, -0.5 * dt * dt, 0.0, 1.0, -dt, 0.0, 0.0, 1.0);
@@ -225,11 +262,20 @@ mod tests {
         let gamma = StateVector::new(-0.5 * dt * dt, -dt, 0.0);
         let q = gamma * gamma.transpose() * m.filter_stats.accel_noise_var_m2_s4;
         assert_eq!(model.process_noise(0.0, dt), q);
-        assert_eq!(filter.phi, phi);
-        assert_eq!(filter.q, q);
-        assert_eq!(filter.h, Matrix2x3Lit::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0));
-        assert_eq!(model.measurement_noise(), filter.r);
-        assert_eq!(model.initial_covariance(), filter.p0);
+        let h = Matrix2x3Lit::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0);
+        assert_eq!(model.observation(), h);
+        let s = &m.filter_stats;
+        let r = MeasVector::new(
+            s.gps_position_sigma_m.powi(2),
+            s.gps_velocity_sigma_m_s.powi(2),
+        );
+        assert_eq!(model.measurement_noise(), MeasMatrix::from_diagonal(&r));
+        let p0 = StateVector::new(
+            s.initial_position_sigma_m.powi(2),
+            s.initial_velocity_sigma_m_s.powi(2),
+            s.bias_var_m2_s4,
+        );
+        assert_eq!(model.initial_covariance(), StateMatrix::from_diagonal(&p0));
     }
 
     /// Names and indices agree.
@@ -248,5 +294,14 @@ mod tests {
             0.0,
             "the bias is not measured"
         );
+    }
+
+    /// Only the bias is constant between fixes.
+    #[test]
+    fn the_bias_is_the_constant_state() {
+        let stats = Model::new(&Config::default()).unwrap().filter_stats;
+        let constant = ErrorState { stats }.constant_states();
+        let expected: [bool; ErrorState::DIM] = std::array::from_fn(|k| k == ErrorState::BIAS);
+        assert_eq!(constant, expected);
     }
 }

@@ -11,8 +11,9 @@ use serde::{Deserialize, Serialize};
 
 use super::{Check, covariance_correlation, covariance_match, mean_error, nees, nis};
 use super::{orthogonality, residual_whiteness};
-use crate::ensemble::EnsembleStats;
-use crate::filter::{Component, Stage};
+use crate::ensemble::Statistics;
+use crate::filter::Stage;
+use crate::state::{Dims, ErrorState, Variable};
 use crate::stats::normal_bound;
 
 /// Every check, in the order the report and the JSON present them: the one registration list.
@@ -58,10 +59,11 @@ pub struct Definition {
     pub rationale: &'static str,
     /// The check's equations, as LaTeX (the report renders them; macros `\dx`, `\dxhat`, `\T`).
     pub formula: &'static str,
-    /// The distribution of a member under a consistent filter, for N realizations.
-    pub null: fn(n: f64) -> Null,
+    /// The distribution of a member under a consistent filter, for N realizations of a model
+    /// of sizes `dims`.
+    pub null: fn(n: f64, dims: Dims) -> Null,
     /// Calls `f(value, member)` for every member, in fix order.
-    pub for_each_member: fn(&EnsembleStats, &mut dyn FnMut(f64, MemberId)),
+    pub for_each_member: fn(&dyn Statistics, &mut dyn FnMut(f64, MemberId)),
     /// What a failure means, in one or two sentences.
     pub failure: fn(&Check, &FailureWords) -> String,
 }
@@ -83,7 +85,7 @@ impl Definition {
     /// `p_member`: its approximation must hold (Fisher's z needs N > 3), and a score bounded by
     /// √N must be able to pass its bound b (N > b²).
     pub fn min_realizations(&self, p_member: f64) -> u64 {
-        match (self.null)(2.0) {
+        match (self.null)(2.0, ErrorState::DIMS) {
             Null::Normal | Null::ChiSquared { .. } => 2,
             Null::Fisher => 4,
             Null::CorrelationScore => {
@@ -94,7 +96,7 @@ impl Definition {
     }
 
     /// Number of members on `stats`.
-    pub fn count(&self, stats: &EnsembleStats) -> usize {
+    pub fn count(&self, stats: &dyn Statistics) -> usize {
         let mut m = 0;
         (self.for_each_member)(stats, &mut |_, _| m += 1);
         m
@@ -195,9 +197,10 @@ impl CheckId {
         self.definition().statistic
     }
 
-    /// The distribution of a member under a consistent filter, for `n` realizations.
-    pub fn null(self, n: u64) -> Null {
-        (self.definition().null)(n as f64)
+    /// The distribution of a member under a consistent filter, for `n` realizations of a model
+    /// of sizes `dims`.
+    pub fn null(self, n: u64, dims: Dims) -> Null {
+        (self.definition().null)(n as f64, dims)
     }
 
     /// See [`Definition::min_realizations`].
@@ -235,8 +238,8 @@ pub enum MemberId {
         fix: u32,
         /// A priori or a posteriori.
         stage: Stage,
-        /// The state.
-        state: Component,
+        /// The state's index.
+        state: usize,
     },
     /// The correlation of two error components of one stage at a fix.
     Correlation {
@@ -244,10 +247,10 @@ pub enum MemberId {
         fix: u32,
         /// A priori or a posteriori.
         stage: Stage,
-        /// The first component.
-        a: Component,
-        /// The second component.
-        b: Component,
+        /// The first state's index.
+        a: usize,
+        /// The second state's index.
+        b: usize,
     },
     /// An error component against an estimate component (orthogonality).
     ErrorEstimate {
@@ -255,10 +258,10 @@ pub enum MemberId {
         fix: u32,
         /// A priori or a posteriori.
         stage: Stage,
-        /// The error component.
-        error: Component,
-        /// The estimate component.
-        estimate: Component,
+        /// The error's state index.
+        error: usize,
+        /// The estimate's state index.
+        estimate: usize,
     },
     /// A residual component at a later fix against one at an earlier fix.
     ResidualPair {
@@ -266,10 +269,10 @@ pub enum MemberId {
         later: u32,
         /// The earlier fix m < i.
         earlier: u32,
-        /// Component of r(tᵢ).
-        at_later: Component,
-        /// Component of r(tₘ).
-        at_earlier: Component,
+        /// Component of r(tᵢ), an index into the measurement.
+        at_later: usize,
+        /// Component of r(tₘ), an index into the measurement.
+        at_earlier: usize,
     },
     /// The NEES of one stage at a fix.
     Nees {
@@ -299,10 +302,21 @@ impl MemberId {
         fix as usize
     }
 
-    /// The member in words, e.g. "a posteriori velocity at 12.4 s"; `fix_times_s` are the
-    /// times of the fixes.
+    /// The member of an error-state ensemble in words, e.g. "a posteriori velocity at 12.4 s";
+    /// `fix_times_s` are the times of the fixes.
     pub fn describe(self, fix_times_s: &[f64]) -> String {
+        self.describe_with(fix_times_s, &ErrorState::VARIABLES, &ErrorState::MEASURED)
+    }
+
+    /// The member in words, with the names of the model's `states` and `measurements`.
+    pub fn describe_with(
+        self,
+        fix_times_s: &[f64],
+        states: &[Variable],
+        measurements: &[Variable],
+    ) -> String {
         let at = |fix: u32| format!("{:.1} s", fix_times_s[fix as usize]);
+        let state_words = |k: usize| states[k].key;
         match self {
             MemberId::State { fix, stage, state } => {
                 format!(
@@ -338,9 +352,9 @@ impl MemberId {
                 at_earlier,
             } => format!(
                 "{} residual at {} × {} residual at {}",
-                state_words(at_later),
+                measurements[at_later].key,
                 at(later),
-                state_words(at_earlier),
+                measurements[at_earlier].key,
                 at(earlier)
             ),
             MemberId::Nees { fix, stage } => format!("{} NEES at {}", stage_words(stage), at(fix)),
@@ -354,15 +368,6 @@ pub fn stage_words(stage: Stage) -> &'static str {
     match stage {
         Stage::Prior => "a priori",
         Stage::Posterior => "a posteriori",
-    }
-}
-
-/// "position", "velocity" or "bias".
-pub fn state_words(c: Component) -> &'static str {
-    match c {
-        Component::Position => "position",
-        Component::Velocity => "velocity",
-        Component::Bias => "bias",
     }
 }
 

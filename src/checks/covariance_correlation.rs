@@ -19,7 +19,7 @@ pub const CHECK: Definition = Definition {
                  with the correlation ρ that the filter's P implies, through Fisher's \
                  transformation, whose normal approximation needs N\u{a0}>\u{a0}3.",
     formula: r"r_{jk} = \frac{P^{\mathrm{ave}}_{jk}}{\sqrt{P^{\mathrm{ave}}_{jj} P^{\mathrm{ave}}_{kk}}}, \quad \rho_{jk} = \frac{P_{jk}}{\sqrt{P_{jj} P_{kk}}}, \qquad z = \sqrt{N-3}\,\left(\operatorname{atanh} r_{jk} - \operatorname{atanh} \rho_{jk}\right) \approx \mathcal{N}(0, 1)",
-    null: |_| Null::Fisher,
+    null: |_, _| Null::Fisher,
     for_each_member: |stats, f| members::for_each(CheckId::COVARIANCE_CORRELATION, stats, f),
     failure: |c, w| {
         let FailureWords { outside, at, .. } = w;

@@ -18,7 +18,7 @@ pub const CHECK: Definition = Definition {
     rationale: "For Gaussian errors each diagonal ratio of the unbiased ensemble covariance to \
                  P is a scaled χ²(N−1) variable.",
     formula: r"P^{\mathrm{ave}}(t_i) = \frac{1}{N-1} \sum_{l=1}^{N} \left(e^l - e^{\mathrm{ave}}\right)\left(e^l - e^{\mathrm{ave}}\right)\T, \qquad (N-1)\,\frac{P^{\mathrm{ave}}_{kk}}{P_{kk}} \sim \chi^2(N-1)",
-    null: |n| Null::ChiSquared {
+    null: |n, _| Null::ChiSquared {
         dof: n - 1.0,
         scale: n - 1.0,
     },

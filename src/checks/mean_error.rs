@@ -18,7 +18,7 @@ pub const CHECK: Definition = Definition {
     rationale: "Its standard error is σ/√N with σ from the filter's P, so each component of the \
                  mean error divided by it is a standard normal score.",
     formula: r"e^{\mathrm{ave}}(t_i) = \frac{1}{N} \sum_{l=1}^{N} e^l(t_i), \qquad z = \frac{e^{\mathrm{ave}}_k(t_i)}{\sqrt{P_{kk}(t_i)/N}} \sim \mathcal{N}(0, 1)",
-    null: |_| Null::Normal,
+    null: |_, _| Null::Normal,
     for_each_member: |stats, f| members::for_each(CheckId::MEAN_ERROR, stats, f),
     failure: |c, w| {
         let FailureWords { outside, at, .. } = w;

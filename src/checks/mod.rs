@@ -21,10 +21,11 @@ mod residual_whiteness;
 
 use serde::Serialize;
 
-use crate::ensemble::EnsembleStats;
+use crate::ensemble::Statistics;
+use crate::state::{Dims, ErrorState};
 use crate::stats::{chi_squared_band, chi_squared_median, normal_bound};
 pub use catalogue::{CATALOGUE, CheckId, Definition, FailureWords, MemberId, Null};
-pub use members::{is_bias_copy, residual_z};
+pub use members::residual_z;
 
 /// How the study-wide false-alarm rate is spent over the checks.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -141,7 +142,7 @@ impl Check {
 
     /// Whether the members are normal scores (else χ² statistics).
     pub fn is_normal(&self) -> bool {
-        match (self.definition.null)(2.0) {
+        match (self.definition.null)(2.0, ErrorState::DIMS) {
             Null::Normal | Null::CorrelationScore | Null::Fisher => true,
             Null::ChiSquared { .. } => false,
         }
@@ -191,10 +192,10 @@ pub struct ResidualPair {
     pub t_i_s: f64,
     /// Second moments (1/N) Σ r(t_i)·r(t_m)ᵀ, rows components of r(t_i), columns of r(t_m),
     /// (m, m/s)².
-    pub mean_product: [[f64; 2]; 2],
+    pub mean_product: Vec<Vec<f64>>,
     /// The same as normalized scores z = √N·corr.
-    pub z: [[f64; 2]; 2],
-    /// Two-sided bound on |z| for these four members at the residual-whiteness share.
+    pub z: Vec<Vec<f64>>,
+    /// Two-sided bound on |z| for these M² members at the residual-whiteness share.
     pub bound: f64,
     /// Pass, fail or untestable.
     #[serde(serialize_with = "verdict_name")]
@@ -240,10 +241,10 @@ impl Verdicts {
 }
 
 /// The acceptance band (lower, upper, centre) of every member of check `check` at `n`
-/// realizations, each member tested two-sided at rate `p_member`.
-pub fn band(check: &Definition, n: u64, p_member: f64) -> (f64, f64, f64) {
+/// realizations of a model of sizes `dims`, each member tested two-sided at rate `p_member`.
+pub fn band(check: &Definition, n: u64, dims: Dims, p_member: f64) -> (f64, f64, f64) {
     let p = p_member.min(1.0);
-    match (check.null)(n as f64) {
+    match (check.null)(n as f64, dims) {
         Null::Normal | Null::CorrelationScore | Null::Fisher => {
             let b = normal_bound(p);
             (-b, b, 0.0)
@@ -258,7 +259,7 @@ pub fn band(check: &Definition, n: u64, p_member: f64) -> (f64, f64, f64) {
 /// Whether `check`, judged on one ensemble, would fail on `stats`, another ensemble of the same
 /// design (same members, same N): its band reused, so that many ensembles are judged at the cost
 /// of computing their members.
-pub fn fails_again(check: &Check, stats: &EnsembleStats) -> bool {
+pub fn fails_again(check: &Check, stats: &dyn Statistics) -> bool {
     if matches!(check.verdict, Verdict::Untestable(_)) {
         return false;
     }
@@ -270,11 +271,11 @@ pub fn fails_again(check: &Check, stats: &EnsembleStats) -> bool {
 }
 
 /// Judges check `definition` on `stats` at false-alarm share `share`.
-pub fn judge(definition: &'static Definition, stats: &EnsembleStats, share: f64) -> Check {
-    let n = stats.realizations;
+pub fn judge(definition: &'static Definition, stats: &dyn Statistics, share: f64) -> Check {
+    let n = stats.realizations();
     let m = definition.count(stats);
     let p = (share / m.max(1) as f64).min(1.0);
-    let (lower, upper, center) = band(definition, n, p);
+    let (lower, upper, center) = band(definition, n, stats.dims(), p);
     let mut check = Check {
         id: definition.id,
         definition,
@@ -320,14 +321,14 @@ pub fn judge(definition: &'static Definition, stats: &EnsembleStats, share: f64)
 
 /// Runs every check of [`CATALOGUE`] on `stats` within `budget`, and the statement's single
 /// residual pair.
-pub fn evaluate(stats: &EnsembleStats, budget: &Budget) -> Verdicts {
+pub fn evaluate(stats: &dyn Statistics, budget: &Budget) -> Verdicts {
     evaluate_with(stats, budget, CATALOGUE)
 }
 
 /// Runs the checks of `catalogue` on `stats` within `budget`, and the statement's single residual
 /// pair (tested at the share of one check).
 pub fn evaluate_with(
-    stats: &EnsembleStats,
+    stats: &dyn Statistics,
     budget: &Budget,
     catalogue: &[&'static Definition],
 ) -> Verdicts {
@@ -342,21 +343,26 @@ pub fn evaluate_with(
 }
 
 /// The statement's single residual pair, its four products tested at `share` together.
-fn residual_pair(stats: &EnsembleStats, share: f64) -> ResidualPair {
-    let [m, i] = stats.pair;
-    let bound = normal_bound(share.min(1.0) / 4.0);
+fn residual_pair(stats: &dyn Statistics, share: f64) -> ResidualPair {
+    let [m, i] = stats.pair();
+    let width = stats.dims().measurements;
+    let bound = normal_bound(share.min(1.0) / (width * width) as f64);
     let diagonal = |a| stats.residual_moment(a, a).unwrap_or(f64::NAN);
-    let z: [[f64; 2]; 2] = std::array::from_fn(|j| {
-        std::array::from_fn(|k| {
-            members::z_score(
-                stats.realizations,
-                stats.pair_moments[(j, k)],
-                diagonal(2 * i + j),
-                diagonal(2 * m + k),
-            )
+    let z: Vec<Vec<f64>> = (0..width)
+        .map(|j| {
+            (0..width)
+                .map(|k| {
+                    members::z_score(
+                        stats.realizations(),
+                        stats.pair_moment(j, k),
+                        diagonal(width * i + j),
+                        diagonal(width * m + k),
+                    )
+                })
+                .collect()
         })
-    });
-    let reachable = (stats.realizations as f64).sqrt() > bound;
+        .collect();
+    let reachable = (stats.realizations() as f64).sqrt() > bound;
     let verdict = if !reachable {
         Verdict::Untestable(Untestable::TooFewRealizations {
             needs: (bound * bound).floor() as u64 + 1,
@@ -369,11 +375,11 @@ fn residual_pair(stats: &EnsembleStats, share: f64) -> ResidualPair {
     ResidualPair {
         earlier: m,
         later: i,
-        t_m_s: stats.fixes[m].time_s,
-        t_i_s: stats.fixes[i].time_s,
-        mean_product: std::array::from_fn(|j| {
-            std::array::from_fn(|k| stats.pair_moments[(j, k)])
-        }),
+        t_m_s: stats.time_s(m),
+        t_i_s: stats.time_s(i),
+        mean_product: (0..width)
+            .map(|j| (0..width).map(|k| stats.pair_moment(j, k)).collect())
+            .collect(),
         z,
         bound,
         verdict,

@@ -3,7 +3,6 @@
 use super::catalogue::{CheckId, Definition, FailureWords, Null};
 use super::members;
 use crate::format::sig;
-use crate::state::ErrorState;
 
 /// The average normalized estimation error squared is the state dimension.
 ///
@@ -18,8 +17,8 @@ pub const CHECK: Definition = Definition {
     rationale: "Each realization's eᵀP⁻¹e is χ²(3) for Gaussian errors, so N times the average \
                  is χ²(3N).",
     formula: r"\bar{\epsilon}(t_i) = \frac{1}{N} \sum_{l=1}^{N} e^l(t_i)\T P(t_i)^{-1} e^l(t_i), \qquad N \bar{\epsilon} \sim \chi^2(3N)",
-    null: |n| Null::ChiSquared {
-        dof: ErrorState::DIM as f64 * n,
+    null: |n, dims| Null::ChiSquared {
+        dof: dims.states as f64 * n,
         scale: n,
     },
     for_each_member: |stats, f| members::for_each(CheckId::NEES, stats, f),

@@ -3,7 +3,6 @@
 use super::catalogue::{CheckId, Definition, FailureWords, Null};
 use super::members;
 use crate::format::sig;
-use crate::state::ErrorState;
 
 /// The average normalized innovation squared is the measurement dimension.
 ///
@@ -17,8 +16,8 @@ pub const CHECK: Definition = Definition {
     members: "each fix",
     rationale: "Each realization's rᵀS⁻¹r is χ²(2), so N times the average is χ²(2N).",
     formula: r"\bar{\nu}(t_i) = \frac{1}{N} \sum_{l=1}^{N} r^l(t_i)\T S(t_i)^{-1} r^l(t_i), \qquad N \bar{\nu} \sim \chi^2(2N)",
-    null: |n| Null::ChiSquared {
-        dof: ErrorState::MEAS as f64 * n,
+    null: |n, dims| Null::ChiSquared {
+        dof: dims.measurements as f64 * n,
         scale: n,
     },
     for_each_member: |stats, f| members::for_each(CheckId::NIS, stats, f),

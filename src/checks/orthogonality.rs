@@ -19,7 +19,7 @@ pub const CHECK: Definition = Definition {
                  deviations to a correlation, which for uncorrelated variables has standard \
                  deviation 1/√N; the score cannot exceed √N, so small ensembles cannot fail it.",
     formula: r"C(t_i) = \frac{1}{N} \sum_{l=1}^{N} \left(e^l(t_i) - e^{\mathrm{ave}}(t_i)\right) \dxhat^l(t_i)\T, \qquad z_{jk} = \sqrt{N}\, \frac{C_{jk}}{\sigma(e_j)\, \sigma(\widehat{\delta x}_k)} \approx \mathcal{N}(0, 1)",
-    null: |_| Null::CorrelationScore,
+    null: |_, _| Null::CorrelationScore,
     for_each_member: |stats, f| members::for_each(CheckId::ORTHOGONALITY, stats, f),
     failure: |c, w| {
         let FailureWords { outside, at, .. } = w;

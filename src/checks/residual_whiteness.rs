@@ -19,7 +19,7 @@ pub const CHECK: Definition = Definition {
     rationale: "The residual correlation is computed for every tested pair of fixes and components and \
                  normalized the same way; its score cannot exceed √N either.",
     formula: r"z_{jk} = \sqrt{N}\, \frac{\sum_l r^l_j(t_i)\, r^l_k(t_m)}{\sqrt{\sum_l r^l_j(t_i)^2 \sum_l r^l_k(t_m)^2}} \approx \mathcal{N}(0, 1), \quad t_m < t_i",
-    null: |_| Null::CorrelationScore,
+    null: |_, _| Null::CorrelationScore,
     for_each_member: |stats, f| members::for_each(CheckId::RESIDUAL_WHITENESS, stats, f),
     failure: |c, w| {
         let FailureWords { outside, at, .. } = w;

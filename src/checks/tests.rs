@@ -1,6 +1,7 @@
 use super::*;
 use crate::config::Config;
 use crate::ensemble;
+use crate::ensemble::EnsembleStats;
 use crate::filter::{FilterSchedule, Stage};
 use crate::model::Model;
 

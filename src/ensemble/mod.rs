@@ -24,7 +24,7 @@ use crate::model::Model;
 pub use engine::{Engine, Prepared, Scratch, accumulate, accumulate_into, accumulate_with};
 pub use lane_sums::LaneFix;
 pub use layout::ResidualLayout;
-pub use stats::{EnsembleStats, FixStats, StageStats};
+pub use stats::{EnsembleStats, FixStats, StageStats, StageView, Statistics};
 pub use sums::{Accumulator, FixSums, StageSums};
 pub use tiles::{PASS, PRODUCT_RELATIVE_ERROR};
 

@@ -14,10 +14,9 @@ use super::Engine;
 use super::layout::ResidualLayout;
 use super::sums::{Accumulator, FixSums, StageSums};
 use crate::config::Config;
-use crate::state::{ErrorState, StateMatrix, StateVector};
+use crate::state::ErrorState;
 use nalgebra::SMatrix;
 
-const DIM: usize = ErrorState::DIM;
 const MEAS: usize = ErrorState::MEAS;
 
 /// The first line of every partial file.
@@ -79,44 +78,8 @@ pub enum PartialError {
     },
 }
 
-/// Floats of one stage's sums: Σ e, the upper triangle of Σ e·eᵀ, Σ e·δx̂ᵀ, Σ δx̂, Σ δx̂², NEES.
-const STAGE_LEN: usize = DIM + DIM * (DIM + 1) / 2 + DIM * DIM + DIM + DIM + 1;
 /// Floats of one fix's sums.
-const FIX_LEN: usize = 2 * STAGE_LEN + 1;
-
-fn stage_floats(s: &StageSums, out: &mut Vec<f64>) {
-    out.extend(s.e.iter());
-    out.extend(s.ee_upper());
-    out.extend(s.ex.iter());
-    out.extend(s.x.iter());
-    out.extend(s.xx.iter());
-    out.push(s.nees);
-}
-
-fn stage_from(v: &[f64]) -> StageSums {
-    // The fields in [`stage_floats`] order.
-    let mut rest = v;
-    let mut take = |len: usize| {
-        let (head, tail) = rest.split_at(len);
-        rest = tail;
-        head
-    };
-    let e = StateVector::from_column_slice(take(DIM));
-    let ee = take(DIM * (DIM + 1) / 2);
-    let ex = StateMatrix::from_column_slice(take(DIM * DIM));
-    let x = StateVector::from_column_slice(take(DIM));
-    let xx = StateVector::from_column_slice(take(DIM));
-    let mut s = StageSums {
-        e,
-        ex,
-        x,
-        xx,
-        nees: take(1)[0],
-        ..StageSums::default()
-    };
-    s.set_ee_upper(ee);
-    s
-}
+const FIX_LEN: usize = 2 * <StageSums>::FLOATS + 1;
 
 /// Writes the header of a partial file.
 ///
@@ -137,8 +100,8 @@ pub fn write_block(w: &mut impl Write, index: u64, acc: &Accumulator) -> std::io
     let mut floats =
         Vec::with_capacity(acc.fixes.len() * FIX_LEN + acc.residual_products.len() + MEAS * MEAS);
     for f in &acc.fixes {
-        stage_floats(&f.prior, &mut floats);
-        stage_floats(&f.post, &mut floats);
+        f.prior.write_floats(&mut floats);
+        f.post.write_floats(&mut floats);
         floats.push(f.nis);
     }
     floats.extend(&acc.residual_products);
@@ -217,9 +180,9 @@ pub fn read_block(
     for (i, f) in acc.fixes.iter_mut().enumerate() {
         let v = &floats[i * FIX_LEN..(i + 1) * FIX_LEN];
         *f = FixSums {
-            prior: stage_from(&v[..STAGE_LEN]),
-            post: stage_from(&v[STAGE_LEN..2 * STAGE_LEN]),
-            nis: v[2 * STAGE_LEN],
+            prior: <StageSums>::from_floats(&v[..<StageSums>::FLOATS]),
+            post: <StageSums>::from_floats(&v[<StageSums>::FLOATS..2 * <StageSums>::FLOATS]),
+            nis: v[2 * <StageSums>::FLOATS],
         };
     }
     let products = header.fixes * FIX_LEN;

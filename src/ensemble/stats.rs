@@ -7,7 +7,7 @@ use serde::{Serialize, Serializer};
 use super::layout::ResidualLayout;
 use super::sums::{Accumulator, StageSums};
 use crate::filter::{FilterSchedule, Stage, rows};
-use crate::state::ErrorState;
+use crate::state::{Dims, ErrorState};
 
 /// Ensemble statistics of one stage (a priori or a posteriori) at one fix, for a state of `N`
 /// variables.
@@ -93,6 +93,8 @@ pub struct EnsembleStats<
     pub pair: [usize; 2],
     /// (1/N) Σ r_j(t_i)·r_k(t_m) of the single pair, entry (j, k).
     pub pair_moments: SMatrix<f64, M, M>,
+    /// Which states are constant between fixes (see [`crate::state::StateModel::constant_states`]).
+    pub constant: [bool; N],
 }
 
 impl<const N: usize, const M: usize> EnsembleStats<N, M> {
@@ -117,6 +119,7 @@ impl<const N: usize, const M: usize> EnsembleStats<N, M> {
             residual_moments: acc.residual_products.iter().map(|x| x / n).collect(),
             pair: acc.pair,
             pair_moments: acc.pair_products / n,
+            constant: schedule.constant,
         }
     }
 
@@ -155,5 +158,130 @@ fn stage_stats<const N: usize>(s: &StageSums<N>, p: &SMatrix<f64, N, N>, n: f64)
         orthogonality: rows(&ortho),
         orthogonality_corr: rows(&corr),
         nees_avg: s.nees / n,
+    }
+}
+
+/// One stage's statistics at one fix, whatever the state's size: vectors of length n and
+/// matrices of n × n entries, row-major.
+#[derive(Clone, Copy, Debug)]
+pub struct StageView<'a> {
+    /// Number of states n.
+    pub states: usize,
+    /// See [`StageStats::mean_error`].
+    pub mean_error: &'a [f64],
+    /// See [`StageStats::ensemble_cov`].
+    pub ensemble_cov: &'a [f64],
+    /// See [`StageStats::filter_cov`].
+    pub filter_cov: &'a [f64],
+    /// See [`StageStats::orthogonality_corr`].
+    pub orthogonality_corr: &'a [f64],
+    /// See [`StageStats::nees_avg`].
+    pub nees_avg: f64,
+}
+
+impl StageView<'_> {
+    /// Entry (a, b) of the ensemble covariance.
+    pub fn ensemble_cov(&self, a: usize, b: usize) -> f64 {
+        self.ensemble_cov[a * self.states + b]
+    }
+
+    /// Entry (a, b) of the filter's covariance.
+    pub fn filter_cov(&self, a: usize, b: usize) -> f64 {
+        self.filter_cov[a * self.states + b]
+    }
+
+    /// Entry (error a, estimate b) of the orthogonality correlation.
+    pub fn orthogonality_corr(&self, a: usize, b: usize) -> f64 {
+        self.orthogonality_corr[a * self.states + b]
+    }
+}
+
+/// What the checks read of an ensemble's statistics, for a state and a measurement of any size:
+/// the one interface between the ensemble and the checks.
+pub trait Statistics: Sync {
+    /// The sizes of the state and the measurement.
+    fn dims(&self) -> Dims;
+    /// Number of realizations N.
+    fn realizations(&self) -> u64;
+    /// Number of fixes.
+    fn fix_count(&self) -> usize;
+    /// Time of fix `i`, s.
+    fn time_s(&self, i: usize) -> f64;
+    /// The statistics of `stage` at fix `i`.
+    fn stage(&self, i: usize, stage: Stage) -> StageView<'_>;
+    /// Average NIS at fix `i`.
+    fn nis_avg(&self, i: usize) -> f64;
+    /// Which residual products were kept.
+    fn residual_layout(&self) -> &ResidualLayout;
+    /// (1/N) Σ r_a·r_b of stacked residual components a and b, when kept.
+    fn residual_moment(&self, a: usize, b: usize) -> Option<f64>;
+    /// The fix indices [m, i] of the statement's single residual pair.
+    fn pair(&self) -> [usize; 2];
+    /// (1/N) Σ r_j(t_i)·r_k(t_m) of the single pair.
+    fn pair_moment(&self, j: usize, k: usize) -> f64;
+    /// Whether state `k` is constant between fixes.
+    fn is_constant(&self, k: usize) -> bool;
+
+    /// Whether (fix, stage, state k) is a constant state's a priori value at a fix after the
+    /// first: a copy of the previous fix's a posteriori one, not a member of its own.
+    fn is_copy(&self, fix: usize, stage: Stage, k: usize) -> bool {
+        fix > 0 && stage == Stage::Prior && self.is_constant(k)
+    }
+}
+
+impl<const N: usize, const M: usize> Statistics for EnsembleStats<N, M> {
+    fn dims(&self) -> Dims {
+        Dims {
+            states: N,
+            measurements: M,
+        }
+    }
+
+    fn realizations(&self) -> u64 {
+        self.realizations
+    }
+
+    fn fix_count(&self) -> usize {
+        self.fixes.len()
+    }
+
+    fn time_s(&self, i: usize) -> f64 {
+        self.fixes[i].time_s
+    }
+
+    fn stage(&self, i: usize, stage: Stage) -> StageView<'_> {
+        let s = self.fixes[i].stage(stage);
+        StageView {
+            states: N,
+            mean_error: &s.mean_error,
+            ensemble_cov: s.ensemble_cov.as_flattened(),
+            filter_cov: s.filter_cov.as_flattened(),
+            orthogonality_corr: s.orthogonality_corr.as_flattened(),
+            nees_avg: s.nees_avg,
+        }
+    }
+
+    fn nis_avg(&self, i: usize) -> f64 {
+        self.fixes[i].nis_avg
+    }
+
+    fn residual_layout(&self) -> &ResidualLayout {
+        &self.residual_layout
+    }
+
+    fn residual_moment(&self, a: usize, b: usize) -> Option<f64> {
+        EnsembleStats::residual_moment(self, a, b)
+    }
+
+    fn pair(&self) -> [usize; 2] {
+        self.pair
+    }
+
+    fn pair_moment(&self, j: usize, k: usize) -> f64 {
+        self.pair_moments[(j, k)]
+    }
+
+    fn is_constant(&self, k: usize) -> bool {
+        self.constant[k]
     }
 }

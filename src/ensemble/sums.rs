@@ -65,6 +65,46 @@ impl<const N: usize> StageSums<N> {
         }
     }
 
+    /// Floats of one stage's sums in [`StageSums::write_floats`] order: Σ e, the upper triangle of
+    /// Σ e·eᵀ, Σ e·δx̂ᵀ (column-major), Σ δx̂, Σ δx̂², NEES.
+    pub const FLOATS: usize = N + N * (N + 1) / 2 + N * N + N + N + 1;
+
+    /// Appends the sums to `out` as [`StageSums::FLOATS`] numbers (a partial file's layout).
+    pub fn write_floats(&self, out: &mut Vec<f64>) {
+        out.extend(self.e.iter());
+        out.extend(self.ee_upper());
+        out.extend(self.ex.iter());
+        out.extend(self.x.iter());
+        out.extend(self.xx.iter());
+        out.push(self.nees);
+    }
+
+    /// The sums from the [`StageSums::FLOATS`] numbers `v` that [`StageSums::write_floats`]
+    /// wrote.
+    pub fn from_floats(v: &[f64]) -> Self {
+        let mut rest = v;
+        let mut take = |len: usize| {
+            let (head, tail) = rest.split_at(len);
+            rest = tail;
+            head
+        };
+        let e = SVector::from_column_slice(take(N));
+        let ee = take(N * (N + 1) / 2);
+        let ex = SMatrix::from_column_slice(take(N * N));
+        let x = SVector::from_column_slice(take(N));
+        let xx = SVector::from_column_slice(take(N));
+        let mut s = Self {
+            e,
+            ex,
+            x,
+            xx,
+            nees: take(1)[0],
+            ..Self::default()
+        };
+        s.set_ee_upper(ee);
+        s
+    }
+
     fn merge(&mut self, o: &Self) {
         self.e += o.e;
         self.ee += o.ee;

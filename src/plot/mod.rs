@@ -21,8 +21,7 @@
 use plotters::drawing::DrawingAreaErrorKind;
 use plotters::style::{FontDesc, RGBColor, TextStyle};
 
-use crate::checks::catalogue::state_words;
-use crate::filter::Component;
+use crate::state::ErrorState;
 
 mod axis;
 mod calibration;
@@ -124,14 +123,14 @@ impl<E: std::error::Error + Send + Sync> From<DrawingAreaErrorKind<E>> for PlotE
     }
 }
 
-/// Unit of state component `k` (δp, δv, b).
+/// Unit of state component `k` of the error state.
 pub(crate) fn state_unit(k: usize) -> &'static str {
-    Component::STATE[k].unit()
+    ErrorState::VARIABLES[k].unit
 }
 
-/// Name of state component `k` (δp, δv, b).
+/// Name of state component `k` of the error state.
 pub(crate) fn state_name(k: usize) -> &'static str {
-    state_words(Component::STATE[k])
+    ErrorState::VARIABLES[k].key
 }
 
 /// `s` with its first letter in upper case, for panel titles.

@@ -202,7 +202,7 @@ fn figures_survive_statistics_that_are_all_undefined() {
     }
     let c = check(study, CheckId::MEAN_ERROR);
     let mut pair = study.case(CASE).verdicts.residual_pair.clone();
-    pair.z = [[f64::NAN; 2]; 2];
+    pair.z = vec![vec![f64::NAN; 2]; 2];
     let prediction = vec![[[f64::INFINITY; 3]; 2]; stats.fixes.len()];
     let rms = vec![[f64::NAN; 3]; stats.fixes.len()];
     for svg in [

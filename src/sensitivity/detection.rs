@@ -12,8 +12,9 @@
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
 use super::covariance::{ActualFix, weights};
-use crate::checks::{Budget, CheckId, band, is_bias_copy};
-use crate::filter::{Component, FilterSchedule, Stage};
+use crate::checks::{Budget, CheckId, band};
+use crate::filter::{FilterSchedule, Stage};
+use crate::state::ErrorState;
 
 /// A predicted detection probability with its bounds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,16 +75,16 @@ pub fn predicted(
             for (i, f) in actual.iter().enumerate() {
                 for stage in Stage::ALL {
                     let (pa, pf, _) = stages(f, i, stage);
-                    for c in Component::STATE {
-                        if !is_bias_copy(i, stage, c) {
-                            let k = c.index();
+                    for k in 0..ErrorState::DIM {
+                        let copy = i > 0 && stage == Stage::Prior && schedule.constant[k];
+                        if !copy {
                             ratios.push(pa[(k, k)] / pf[(k, k)]);
                         }
                     }
                 }
             }
             let share = budget.share() / ratios.len() as f64;
-            let (lo, hi, _) = band(id.definition(), n, share);
+            let (lo, hi, _) = band(id.definition(), n, ErrorState::DIMS, share);
             for r in ratios {
                 p.push(if id == CheckId::MEAN_ERROR {
                     // e_ave/√(P/N) ~ N(0, r): outside ±b with probability 2·Φ(−b/√r).
@@ -107,7 +108,7 @@ pub fn predicted(
                 }
             }
             let share = budget.share() / forms.len() as f64;
-            let (lo, hi, _) = band(id.definition(), n, share);
+            let (lo, hi, _) = band(id.definition(), n, ErrorState::DIMS, share);
             for (sum, sum_sq) in forms {
                 // N·average = Σ_k λ_k χ²(N) ≈ a·χ²(ν) with the same mean and variance.
                 let a = sum_sq / sum;
