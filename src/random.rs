@@ -1,6 +1,7 @@
-//! The random numbers of the simulation: one xoshiro256++ generator per realization, seeded by a
-//! SplitMix64 mix of (seed, stream key, realization index), and standard normal numbers from a
-//! 256-layer ziggurat.
+//! The random numbers of the crate: one xoshiro256++ generator per realization (or per sampled
+//! ensemble), seeded by a SplitMix64 mix of (seed, stream key, index), and standard normal
+//! numbers from a 1024-layer ziggurat. [`Stream`] is also a [`rand::Rng`], so the distributions
+//! of `rand_distr` draw from the same generators.
 //!
 //! [`LaneStreams`] runs [`LANES`] such generators side by side in structure-of-arrays form, so that
 //! the compiler advances them with vector instructions; lane k draws exactly the numbers the
@@ -9,15 +10,21 @@
 // Lane loops index several arrays by the lane k; iterators would hide that.
 #![allow(clippy::needless_range_loop)]
 
+use std::convert::Infallible;
 use std::sync::LazyLock;
 
 use crate::lanes::{LANES, Lanes};
 
+/// SplitMix64's increment: 2⁶⁴ divided by the golden ratio, rounded to odd (Steele, Lea and
+/// Flood, 2014).
+const GOLDEN_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
+
 /// SplitMix64: one step of the generator from state `z` (the golden-ratio increment, then the
-/// finalizer), a bijective 64-bit mixer.
+/// finalizer), a bijective 64-bit mixer. The crate's one seed mixer: every seed, stream key and
+/// generator state is derived through it.
 #[inline]
 pub fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = z.wrapping_add(GOLDEN_GAMMA);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
@@ -81,7 +88,7 @@ impl Stream {
         let mut z = base;
         for w in &mut s {
             *w = splitmix64(z);
-            z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            z = z.wrapping_add(GOLDEN_GAMMA);
         }
         if s == [0; 4] {
             s[0] = 1;
@@ -125,6 +132,27 @@ impl Stream {
             }
         }
         self.pos = 0;
+    }
+}
+
+/// The generator as a source of `rand`'s distributions: 64 bits per [`Stream::next_u64`], the
+/// high half of one for a 32-bit word. The normal numbers buffered for [`Stream::normal`] are
+/// not touched: both draw from the one xoshiro256++ sequence, each number of it used once.
+impl rand::TryRng for Stream {
+    type Error = Infallible;
+
+    #[inline]
+    fn try_next_u32(&mut self) -> Result<u32, Infallible> {
+        Ok((self.core.next_u64() >> 32) as u32)
+    }
+
+    #[inline]
+    fn try_next_u64(&mut self) -> Result<u64, Infallible> {
+        Ok(self.core.next_u64())
+    }
+
+    fn try_fill_bytes(&mut self, dst: &mut [u8]) -> Result<(), Infallible> {
+        rand::rand_core::utils::fill_bytes_via_next_word(dst, || self.try_next_u64())
     }
 }
 
