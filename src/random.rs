@@ -300,6 +300,24 @@ mod tests {
     }
 
     #[test]
+    fn rand_draws_the_streams_own_bits() {
+        // Through rand's trait a stream hands out its xoshiro256++ words: a u64 whole, a u32 as
+        // the high half, bytes little-endian; the buffered normal numbers are left alone.
+        let mut ours = Stream::new(3, 7);
+        let mut theirs = ours.clone();
+        assert_eq!(ours.normal().to_bits(), theirs.normal().to_bits());
+        assert_eq!(rand::Rng::next_u64(&mut theirs), ours.next_u64());
+        assert_eq!(
+            u64::from(rand::Rng::next_u32(&mut theirs)),
+            ours.next_u64() >> 32
+        );
+        let mut bytes = [0u8; 8];
+        rand::Rng::fill_bytes(&mut theirs, &mut bytes);
+        assert_eq!(u64::from_le_bytes(bytes), ours.next_u64());
+        assert_eq!(ours.normal().to_bits(), theirs.normal().to_bits());
+    }
+
+    #[test]
     fn lanes_draw_what_scalar_streams_draw() {
         let mut lanes = LaneStreams::new(99, 1000);
         let mut scalar: Vec<Stream> = (0..LANES as u64)
