@@ -2,7 +2,8 @@
 
 use std::path::PathBuf;
 
-use clap::{ArgGroup, Args, Parser, Subcommand};
+use clap::builder::{EnumValueParser, TypedValueParser};
+use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
 
 use accelcal::config::{AccelerometerOutput, TruthModel};
 use accelcal::ensemble::Engine;
@@ -55,10 +56,10 @@ pub struct ModelArgs {
 #[derive(Debug, Args, Default, Clone)]
 pub struct CaseArgs {
     /// Truth model, overriding ensemble.truth.
-    #[arg(long, value_enum, value_name = "MODEL")]
+    #[arg(long, value_name = "MODEL", value_parser = truth_parser())]
     pub truth: Option<TruthModel>,
     /// What the accelerometer reports, overriding accelerometer.output.
-    #[arg(long, value_enum, value_name = "OUTPUT")]
+    #[arg(long, value_name = "OUTPUT", value_parser = output_parser())]
     pub accelerometer_output: Option<AccelerometerOutput>,
 }
 
@@ -111,7 +112,7 @@ pub struct EnsembleArgs {
     /// How realizations are simulated: `sample` draws and integrates every accelerometer
     /// sample; `epoch` draws the noise's exact effect once per GPS interval (same distribution
     /// at the fixes, several times faster).
-    #[arg(long, value_enum, default_value_t = Engine::Sample)]
+    #[arg(long, value_parser = engine_parser(), default_value_t = Engine::Sample)]
     pub engine: Engine,
 }
 
@@ -144,7 +145,7 @@ pub struct SensitivityArgs {
     #[arg(long, value_name = "D")]
     pub draws: Option<u64>,
     /// How the Monte Carlo ensembles simulate their realizations (see `ensemble --engine`).
-    #[arg(long, value_enum, default_value_t = Engine::Epoch)]
+    #[arg(long, value_parser = engine_parser(), default_value_t = Engine::Epoch)]
     pub engine: Engine,
     /// Write the JSON here instead of to standard output.
     #[arg(long, value_name = "FILE")]
@@ -202,9 +203,124 @@ pub struct CalibrateArgs {
     pub quiet: bool,
 }
 
+/// The values `--truth` accepts, each with its help; parsed into a [`TruthModel`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum TruthArg {
+    /// Closed-form integral of the acceleration profile, eq. (1) of the problem statement.
+    Analytic,
+    /// The true acceleration integrated with the accelerometer's Euler formula, eq. (4): the error
+    /// dynamics of eq. (5) are then exact.
+    Euler,
+}
+
+impl From<TruthArg> for TruthModel {
+    fn from(arg: TruthArg) -> Self {
+        match arg {
+            TruthArg::Analytic => TruthModel::Analytic,
+            TruthArg::Euler => TruthModel::Euler,
+        }
+    }
+}
+
+/// The values `--accelerometer-output` accepts; parsed into an [`AccelerometerOutput`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum OutputArg {
+    /// The acceleration at the sample time: a_c(t_j) = a(t_j) + b + w(t_j), eq. (2) of the
+    /// problem statement.
+    #[value(name = "sample")]
+    Sample,
+    /// The mean acceleration over the sample interval, as a strapdown IMU's delta-velocity
+    /// output gives it: a_c(t_j) = (1/Δt)∫ a dt over [t_j, t_j + Δt] + b + w(t_j). The Euler
+    /// velocity integration is then exact.
+    #[value(name = "interval_mean")]
+    IntervalMean,
+}
+
+impl From<OutputArg> for AccelerometerOutput {
+    fn from(arg: OutputArg) -> Self {
+        match arg {
+            OutputArg::Sample => AccelerometerOutput::Sample,
+            OutputArg::IntervalMean => AccelerometerOutput::IntervalMean,
+        }
+    }
+}
+
+/// The values `--engine` accepts; parsed into an [`Engine`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum EngineArg {
+    /// Every accelerometer sample drawn and integrated, as the problem statement describes it.
+    Sample,
+    /// One exact draw of the accelerometer noise's effect per GPS interval (see [`epoch`]): the
+    /// same distribution at the fixes with about a tenth of the random numbers.
+    Epoch,
+}
+
+impl From<EngineArg> for Engine {
+    fn from(arg: EngineArg) -> Self {
+        match arg {
+            EngineArg::Sample => Engine::Sample,
+            EngineArg::Epoch => Engine::Epoch,
+        }
+    }
+}
+
+fn truth_parser() -> impl TypedValueParser<Value = TruthModel> {
+    EnumValueParser::<TruthArg>::new().map(TruthModel::from)
+}
+
+fn output_parser() -> impl TypedValueParser<Value = AccelerometerOutput> {
+    EnumValueParser::<OutputArg>::new().map(AccelerometerOutput::from)
+}
+
+fn engine_parser() -> impl TypedValueParser<Value = Engine> {
+    EnumValueParser::<EngineArg>::new().map(Engine::from)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every value the command line accepts parses into the domain value of the same name, and
+    /// every domain value is reachable.
+    fn names_agree<A: ValueEnum, D: PartialEq + std::fmt::Debug>(
+        map: impl Fn(A) -> D,
+        name: impl Fn(&D) -> &'static str,
+        all: &[D],
+    ) {
+        let mapped: Vec<D> = A::value_variants()
+            .iter()
+            .map(|a| {
+                let value = a.to_possible_value().expect("no value is skipped");
+                let d = map(a.clone());
+                assert_eq!(value.get_name(), name(&d));
+                d
+            })
+            .collect();
+        assert_eq!(mapped.len(), all.len());
+        assert!(all.iter().all(|d| mapped.contains(d)), "{all:?}");
+    }
+
+    #[test]
+    fn command_line_values_map_onto_the_domain_types() {
+        names_agree(
+            |a: TruthArg| TruthModel::from(a),
+            |t| t.name(),
+            &TruthModel::ALL,
+        );
+        names_agree(
+            |a: OutputArg| AccelerometerOutput::from(a),
+            |o| o.name(),
+            &[
+                AccelerometerOutput::Sample,
+                AccelerometerOutput::IntervalMean,
+            ],
+        );
+        names_agree(
+            |a: EngineArg| Engine::from(a),
+            |e| e.name(),
+            &[Engine::Sample, Engine::Epoch],
+        );
+    }
 
     #[test]
     fn bare_command_and_report_subcommand_share_their_defaults() {

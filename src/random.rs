@@ -1,6 +1,7 @@
-//! The random numbers of the simulation: one xoshiro256++ generator per realization, seeded by a
-//! SplitMix64 mix of (seed, stream key, realization index), and standard normal numbers from a
-//! 256-layer ziggurat.
+//! The random numbers of the crate: one xoshiro256++ generator per realization (or per sampled
+//! ensemble), seeded by a SplitMix64 mix of (seed, stream key, index), and standard normal
+//! numbers from a 1024-layer ziggurat. [`Stream`] is also a [`rand::Rng`], so the distributions
+//! of `rand_distr` draw from the same generators.
 //!
 //! [`LaneStreams`] runs [`LANES`] such generators side by side in structure-of-arrays form, so that
 //! the compiler advances them with vector instructions; lane k draws exactly the numbers the
@@ -9,15 +10,23 @@
 // Lane loops index several arrays by the lane k; iterators would hide that.
 #![allow(clippy::needless_range_loop)]
 
-use std::sync::LazyLock;
+use std::convert::Infallible;
 
 use crate::lanes::{LANES, Lanes};
+use ziggurat::ziggurat;
+
+mod ziggurat;
+
+/// SplitMix64's increment: 2⁶⁴ divided by the golden ratio, rounded to odd (Steele, Lea and
+/// Flood, 2014).
+const GOLDEN_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
 
 /// SplitMix64: one step of the generator from state `z` (the golden-ratio increment, then the
-/// finalizer), a bijective 64-bit mixer.
+/// finalizer), a bijective 64-bit mixer. The crate's one seed mixer: every seed, stream key and
+/// generator state is derived through it.
 #[inline]
 pub fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = z.wrapping_add(GOLDEN_GAMMA);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
@@ -81,7 +90,7 @@ impl Stream {
         let mut z = base;
         for w in &mut s {
             *w = splitmix64(z);
-            z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            z = z.wrapping_add(GOLDEN_GAMMA);
         }
         if s == [0; 4] {
             s[0] = 1;
@@ -128,110 +137,24 @@ impl Stream {
     }
 }
 
-/// Layers of the ziggurat: 1024, so that only about 0.3 % of the draws leave the fast path.
-const LAYERS: usize = 1024;
+/// The generator as a source of `rand`'s distributions: 64 bits per [`Stream::next_u64`], the
+/// high half of one for a 32-bit word. The normal numbers buffered for [`Stream::normal`] are
+/// not touched: both draw from the one xoshiro256++ sequence, each number of it used once.
+impl rand::TryRng for Stream {
+    type Error = Infallible;
 
-/// The ziggurat tables: layer edges x_i (x_0 = V/f(R) the base's equivalent width, x_1 = R, …,
-/// x_LAYERS = 0) and f(x_i) = exp(−x_i²/2); R is the base layer's right edge.
-struct Ziggurat {
-    x: [f64; LAYERS + 1],
-    f: [f64; LAYERS + 1],
-    r: f64,
-}
-
-fn pdf(x: f64) -> f64 {
-    (-0.5 * x * x).exp()
-}
-
-/// The edges of a ziggurat of `layers` layers whose base layer ends at `r`: every layer has the
-/// base's area V = r·f(r) + ∫_r^∞ f; returns the edges and how far the top layer's upper edge
-/// f(x_{layers−1}) + V/x_{layers−1} overshoots f(0) = 1 (positive: r is too small).
-fn edges(layers: usize, r: f64) -> (Vec<f64>, f64) {
-    let tail = (std::f64::consts::PI / 2.0).sqrt() * statrs::function::erf::erfc(r / 2f64.sqrt());
-    let v = r * pdf(r) + tail;
-    let mut x = vec![0.0; layers + 1];
-    x[0] = v / pdf(r);
-    x[1] = r;
-    for i in 2..layers {
-        // x_{i−1}·(f(x_i) − f(x_{i−1})) = V, solved for the next edge.
-        let top = v / x[i - 1] + pdf(x[i - 1]);
-        if top >= 1.0 {
-            return (x, top - 1.0 + (layers - i) as f64);
-        }
-        x[i] = (-2.0 * top.ln()).sqrt();
-    }
-    let last = v / x[layers - 1] + pdf(x[layers - 1]) - 1.0;
-    (x, last)
-}
-
-/// The base edge R of a ziggurat of `layers` layers, by bisection.
-fn base_edge(layers: usize) -> f64 {
-    let (mut lo, mut hi) = (1.0, 6.0);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if edges(layers, mid).1 > 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
-}
-
-static ZIGGURAT: LazyLock<Ziggurat> = LazyLock::new(|| {
-    let r = base_edge(LAYERS);
-    let (edges, _) = edges(LAYERS, r);
-    let x: [f64; LAYERS + 1] = std::array::from_fn(|i| if i == LAYERS { 0.0 } else { edges[i] });
-    let f = std::array::from_fn(|i| pdf(x[i]));
-    Ziggurat { x, f, r }
-});
-
-#[inline]
-fn ziggurat() -> &'static Ziggurat {
-    &ZIGGURAT
-}
-
-impl Ziggurat {
-    /// The fast path: layer i from the low 10 bits, u ∈ [−1, 1) from the top 52; accepted when
-    /// |u·x_i| < x_{i+1} (the point lies inside the layer's inner rectangle).
-    #[inline(always)]
-    fn fast(&self, bits: u64) -> (f64, bool) {
-        let i = (bits as usize) & (LAYERS - 1);
-        let u = f64::from_bits((bits >> 12) | 0x4000_0000_0000_0000) - 3.0;
-        let x = u * self.x[i];
-        (x, x.abs() < self.x[i + 1])
+    #[inline]
+    fn try_next_u32(&mut self) -> Result<u32, Infallible> {
+        Ok((self.core.next_u64() >> 32) as u32)
     }
 
-    /// The rest of a draw whose first bits `bits` (giving `x`) fell outside the fast path: the
-    /// tail beyond R for the base layer, else the wedge test; a rejected point starts over.
-    #[cold]
-    #[inline(never)]
-    fn slow(&self, mut bits: u64, mut x: f64, rng: &mut Core) -> f64 {
-        loop {
-            let i = (bits as usize) & (LAYERS - 1);
-            if i == 0 {
-                // Marsaglia's tail: x = −ln(U₁)/R until −2·ln(U₂) ≥ x².
-                let negative = x < 0.0;
-                loop {
-                    let t = -rng.open_closed01().ln() / self.r;
-                    let y = -rng.open_closed01().ln();
-                    if 2.0 * y >= t * t {
-                        let v = self.r + t;
-                        return if negative { -v } else { v };
-                    }
-                }
-            }
-            let f_hi = self.f[i + 1];
-            if f_hi + (self.f[i] - f_hi) * rng.closed_open01() < pdf(x) {
-                return x;
-            }
-            bits = rng.next_u64();
-            let (next, ok) = self.fast(bits);
-            if ok {
-                return next;
-            }
-            x = next;
-        }
+    #[inline]
+    fn try_next_u64(&mut self) -> Result<u64, Infallible> {
+        Ok(self.core.next_u64())
+    }
+
+    fn try_fill_bytes(&mut self, dst: &mut [u8]) -> Result<(), Infallible> {
+        rand::rand_core::utils::fill_bytes_via_next_word(dst, || self.try_next_u64())
     }
 }
 
@@ -377,15 +300,21 @@ mod tests {
     }
 
     #[test]
-    fn ziggurat_tables_close_at_the_top() {
-        // The solver reproduces Marsaglia and Tsang's published 256-layer table: R and x_255.
-        let r = base_edge(256);
-        assert!((r - 3.654_152_885_361_009).abs() < 1e-10, "R = {r}");
-        assert!((edges(256, r).0[255] - 0.215_241_895_984_875).abs() < 1e-9);
-        let z = ziggurat();
-        assert!(z.x.windows(2).skip(1).all(|w| w[0] > w[1]));
-        // The top layer closes at f(0) = 1.
-        assert!(edges(LAYERS, z.r).1.abs() < 1e-9);
+    fn rand_draws_the_streams_own_bits() {
+        // Through rand's trait a stream hands out its xoshiro256++ words: a u64 whole, a u32 as
+        // the high half, bytes little-endian; the buffered normal numbers are left alone.
+        let mut ours = Stream::new(3, 7);
+        let mut theirs = ours.clone();
+        assert_eq!(ours.normal().to_bits(), theirs.normal().to_bits());
+        assert_eq!(rand::Rng::next_u64(&mut theirs), ours.next_u64());
+        assert_eq!(
+            u64::from(rand::Rng::next_u32(&mut theirs)),
+            ours.next_u64() >> 32
+        );
+        let mut bytes = [0u8; 8];
+        rand::Rng::fill_bytes(&mut theirs, &mut bytes);
+        assert_eq!(u64::from_le_bytes(bytes), ours.next_u64());
+        assert_eq!(ours.normal().to_bits(), theirs.normal().to_bits());
     }
 
     #[test]

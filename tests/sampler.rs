@@ -7,9 +7,9 @@ mod common;
 use accelcal::config::{Config, TruthModel};
 use accelcal::ensemble::EnsembleStats;
 use accelcal::filter::Stage;
+use accelcal::random::Stream;
 use accelcal::sensitivity::sampler::Sampler;
 use accelcal::sensitivity::{AssumedStatistic, actual_covariance};
-use rand::SeedableRng;
 use statrs::distribution::{ContinuousCDF, Normal};
 
 const N: u64 = 300;
@@ -40,7 +40,7 @@ fn draws() -> (Vec<EnsembleStats>, Vec<Stages>, Vec<Stages>, Vec<f64>) {
         N,
         model.residual_pair,
     );
-    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(2024);
+    let mut rng = Stream::new(2024, 0);
     let stats = (0..DRAWS)
         .map(|_| EnsembleStats::from_sums(&sampler.draw(&mut rng), &schedule))
         .collect();

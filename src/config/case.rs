@@ -6,7 +6,7 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 /// Which model produces the true position and velocity.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum TruthModel {
     /// Closed-form integral of the acceleration profile, eq. (1) of the problem statement.
@@ -36,20 +36,16 @@ impl fmt::Display for TruthModel {
 }
 
 /// What the accelerometer reports at each sample t_j.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum AccelerometerOutput {
     /// The acceleration at the sample time: a_c(t_j) = a(t_j) + b + w(t_j), eq. (2) of the
     /// problem statement.
     #[default]
-    #[value(name = "sample")]
     Sample,
     /// The mean acceleration over the sample interval, as a strapdown IMU's delta-velocity
     /// output gives it: a_c(t_j) = (1/Δt)∫ a dt over [t_j, t_j + Δt] + b + w(t_j). The Euler
     /// velocity integration is then exact.
-    #[value(name = "interval_mean")]
     IntervalMean,
 }
 
@@ -80,22 +76,26 @@ pub struct Case {
 }
 
 impl Case {
-    /// The cases of the report, in order: the world the filter's model assumes, the closed-form
-    /// physics with point samples, and the closed-form physics with interval means.
-    pub const REPORT: [Case; 3] = [
-        Case {
-            truth: TruthModel::Euler,
-            output: AccelerometerOutput::Sample,
-        },
-        Case {
-            truth: TruthModel::Analytic,
-            output: AccelerometerOutput::Sample,
-        },
-        Case {
-            truth: TruthModel::Analytic,
-            output: AccelerometerOutput::IntervalMean,
-        },
-    ];
+    /// The world the filter's model assumes: the Euler truth with point samples.
+    pub const MODEL_WORLD: Case = Case {
+        truth: TruthModel::Euler,
+        output: AccelerometerOutput::Sample,
+    };
+
+    /// The closed-form physics with point samples.
+    pub const POINT_SAMPLES: Case = Case {
+        truth: TruthModel::Analytic,
+        output: AccelerometerOutput::Sample,
+    };
+
+    /// The closed-form physics with interval means.
+    pub const INTERVAL_MEANS: Case = Case {
+        truth: TruthModel::Analytic,
+        output: AccelerometerOutput::IntervalMean,
+    };
+
+    /// The cases of the report, in order.
+    pub const REPORT: [Case; 3] = [Self::MODEL_WORLD, Self::POINT_SAMPLES, Self::INTERVAL_MEANS];
 
     /// A number that tells the case's random streams apart from every other case's.
     pub fn stream_key(self) -> u64 {

@@ -9,7 +9,6 @@ mod sensitivity;
 mod source;
 
 use std::f64::consts::PI;
-use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
@@ -233,15 +232,6 @@ impl Config {
                 message: e.message().trim_end().to_string(),
             }
         })
-    }
-
-    /// Reads and parses a TOML file.
-    ///
-    /// # Errors
-    /// [`ConfigError::Read`] when the file cannot be read, [`ConfigError::Parse`] naming the file
-    /// when it is not a valid configuration.
-    pub fn from_file(path: &Path) -> Result<Self, ConfigError> {
-        ConfigText::read(path)?.parse()
     }
 
     /// The configuration as TOML, every field written out (the filter section only where set).

@@ -8,7 +8,7 @@ use plotters::style::{Color, ShapeStyle};
 use super::axis::{Axis, y_label_area};
 use super::geometry::{Point, extent, padded, settled_from, time_span};
 use super::legend::{Entry, Swatch, render_under_legend};
-use super::panel::{Layout, Panel, columns};
+use super::panel::{Area, Layout, Panel, columns};
 use super::{BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotError, PlotResult, VERMILLION, WIDTH_PX};
 use crate::calibrate::NisTest;
 use crate::calibrate::summary::FixReport;
@@ -70,62 +70,74 @@ pub fn calibration_bias(fixes: &[FixReport]) -> PlotResult {
         Entry::new(Swatch::Block(BLUE.mix(0.2).filled()), "smoothed ±1σ"),
     ];
     render_under_legend(&legend, &[ROW_PX, ROW_PX + 30], 0, |parts| {
-        let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
-        let p = Panel::new(
-            &parts[0],
-            "Bias estimate at each fix, ±1σ",
-            time.clone(),
-            bias_axis,
-            Layout::titled(y_area_px, false),
-        )?;
-        let band = |k: &dyn Fn(&FixReport) -> (f64, f64), sign: f64| -> Vec<f64> {
-            fixes
-                .iter()
-                .map(|f| {
-                    let (x, s) = k(f);
-                    x + sign * s
-                })
-                .collect()
-        };
-        let filtered = |f: &FixReport| (f.filtered[2], f.filtered_sigma[2]);
-        let smoothed = |f: &FixReport| (f.smoothed[2], f.smoothed_sigma[2]);
-        p.band(
-            &t,
-            &band(&filtered, -1.0),
-            &band(&filtered, 1.0),
-            ORANGE.mix(0.3),
-        )?;
-        p.band(
-            &t,
-            &band(&smoothed, -1.0),
-            &band(&smoothed, 1.0),
-            BLUE.mix(0.2),
-        )?;
-        p.line(
-            fixes.iter().map(|f| (f.t_s, f.filtered[2])),
-            VERMILLION.stroke_width(2),
-        )?;
-        p.line(
-            fixes.iter().map(|f| (f.t_s, f.smoothed[2])),
-            BLUE.stroke_width(2),
-        )?;
-        let q = Panel::new(
-            &parts[1],
-            "σ of the bias: filtered and smoothed",
-            time,
-            sigma_axis,
-            Layout::titled(y_area_px, true),
-        )?;
-        q.line(
-            fixes.iter().map(|f| (f.t_s, f.filtered_sigma[2])),
-            VERMILLION.stroke_width(2),
-        )?;
-        q.line(
-            fixes.iter().map(|f| (f.t_s, f.smoothed_sigma[2])),
-            BLUE.stroke_width(2),
-        )?;
-        Ok(())
+        draw_bias(parts, fixes, &time, [bias_axis, sigma_axis], y_area_px)
     })
+}
+
+/// The two panels of [`calibration_bias`] on `parts`: the estimates with their bands over
+/// `axes[0]`, their σ over `axes[1]`.
+fn draw_bias(
+    parts: &[Area<'_>],
+    fixes: &[FixReport],
+    time: &Axis,
+    [bias_axis, sigma_axis]: [Axis; 2],
+    y_area_px: u32,
+) -> Result<(), PlotError> {
+    let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
+    let p = Panel::new(
+        &parts[0],
+        "Bias estimate at each fix, ±1σ",
+        time.clone(),
+        bias_axis,
+        Layout::titled(y_area_px, false),
+    )?;
+    let band = |k: &dyn Fn(&FixReport) -> (f64, f64), sign: f64| -> Vec<f64> {
+        fixes
+            .iter()
+            .map(|f| {
+                let (x, s) = k(f);
+                x + sign * s
+            })
+            .collect()
+    };
+    let filtered = |f: &FixReport| (f.filtered[2], f.filtered_sigma[2]);
+    let smoothed = |f: &FixReport| (f.smoothed[2], f.smoothed_sigma[2]);
+    p.band(
+        &t,
+        &band(&filtered, -1.0),
+        &band(&filtered, 1.0),
+        ORANGE.mix(0.3),
+    )?;
+    p.band(
+        &t,
+        &band(&smoothed, -1.0),
+        &band(&smoothed, 1.0),
+        BLUE.mix(0.2),
+    )?;
+    p.line(
+        fixes.iter().map(|f| (f.t_s, f.filtered[2])),
+        VERMILLION.stroke_width(2),
+    )?;
+    p.line(
+        fixes.iter().map(|f| (f.t_s, f.smoothed[2])),
+        BLUE.stroke_width(2),
+    )?;
+    let q = Panel::new(
+        &parts[1],
+        "σ of the bias: filtered and smoothed",
+        time.clone(),
+        sigma_axis,
+        Layout::titled(y_area_px, true),
+    )?;
+    q.line(
+        fixes.iter().map(|f| (f.t_s, f.filtered_sigma[2])),
+        VERMILLION.stroke_width(2),
+    )?;
+    q.line(
+        fixes.iter().map(|f| (f.t_s, f.smoothed_sigma[2])),
+        BLUE.stroke_width(2),
+    )?;
+    Ok(())
 }
 
 /// Left: velocity and position at every fix — the GPS fix, the integrated accelerometer (eq. 3)
@@ -134,13 +146,9 @@ pub fn calibration_bias(fixes: &[FixReport]) -> PlotResult {
 pub fn calibration_trajectory(fixes: &[FixReport]) -> PlotResult {
     let (t0, t1) = time_span(fixes.iter().map(|f| f.t_s));
     let time = Axis::linear("time", "s", (t0, t1), 6);
-    let corrected = |f: &FixReport, k: usize| f.integrated[k] + f.smoothed[k];
-    let names = [("velocity", "m/s"), ("position", "m")];
-    let comp = [1usize, 0];
-    let left: Vec<Axis> = comp
+    let left: Vec<Axis> = TRAJECTORY_ROWS
         .iter()
-        .zip(names)
-        .map(|(&k, (name, unit))| {
+        .map(|&(k, name, unit)| {
             fitted(
                 name,
                 unit,
@@ -151,10 +159,9 @@ pub fn calibration_trajectory(fixes: &[FixReport]) -> PlotResult {
             )
         })
         .collect();
-    let right: Vec<Axis> = comp
+    let right: Vec<Axis> = TRAJECTORY_ROWS
         .iter()
-        .zip(names)
-        .map(|(&k, (name, unit))| {
+        .map(|&(k, name, unit)| {
             fitted(
                 &format!("{name} drift"),
                 unit,
@@ -166,8 +173,10 @@ pub fn calibration_trajectory(fixes: &[FixReport]) -> PlotResult {
             )
         })
         .collect();
-    let left_px = y_label_area(&left.iter().collect::<Vec<_>>());
-    let right_px = y_label_area(&right.iter().collect::<Vec<_>>());
+    let y_areas_px = [
+        y_label_area(&left.iter().collect::<Vec<_>>()),
+        y_label_area(&right.iter().collect::<Vec<_>>()),
+    ];
     let legend = [
         Entry::new(Swatch::Marker(BLACK.filled()), "GPS fix"),
         Entry::new(
@@ -178,62 +187,84 @@ pub fn calibration_trajectory(fixes: &[FixReport]) -> PlotResult {
         Entry::new(Swatch::Block(BLUE.mix(0.2).filled()), "smoothed ±1σ"),
     ];
     render_under_legend(&legend, &[ROW_PX, ROW_PX + 30], 0, |parts| {
-        let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
-        for (row, &k) in comp.iter().enumerate() {
-            let last = row == 1;
-            let cols = columns(&parts[row], &[WIDTH_PX / 2]);
-            let (name, _) = names[row];
-            let p = Panel::new(
-                &cols[0],
-                &format!("{}: GPS, integrated, corrected", super::capitalized(name)),
-                time.clone(),
-                left[row].clone(),
-                Layout::titled(left_px, last),
-            )?;
-            p.line(
-                fixes.iter().map(|f| (f.t_s, f.integrated[k])),
-                ORANGE.stroke_width(2),
-            )?;
-            p.line(
-                fixes.iter().map(|f| (f.t_s, corrected(f, k))),
-                BLUE.stroke_width(2),
-            )?;
-            markers(
-                &p,
-                fixes.iter().map(|f| (f.t_s, f.z[k])).collect(),
-                BLACK.filled(),
-            )?;
-            let q = Panel::new(
-                &cols[1],
-                &format!("{} drift of the integration", super::capitalized(name)),
-                time.clone(),
-                right[row].clone(),
-                Layout::titled(right_px, last),
-            )?;
-            let lo: Vec<f64> = fixes
-                .iter()
-                .map(|f| f.smoothed[k] - f.smoothed_sigma[k])
-                .collect();
-            let hi: Vec<f64> = fixes
-                .iter()
-                .map(|f| f.smoothed[k] + f.smoothed_sigma[k])
-                .collect();
-            q.band(&t, &lo, &hi, BLUE.mix(0.2))?;
-            markers(
-                &q,
-                fixes
-                    .iter()
-                    .map(|f| (f.t_s, f.z[k] - f.integrated[k]))
-                    .collect(),
-                BLACK.filled(),
-            )?;
-            q.line(
-                fixes.iter().map(|f| (f.t_s, f.smoothed[k])),
-                BLUE.stroke_width(2),
-            )?;
+        for (row, area) in parts.iter().enumerate() {
+            let axes = [left[row].clone(), right[row].clone()];
+            draw_trajectory_row(area, fixes, row, (&time, axes), y_areas_px)?;
         }
         Ok(())
     })
+}
+
+/// The rows of [`calibration_trajectory`]: the state component, its name and unit.
+const TRAJECTORY_ROWS: [(usize, &str, &str); 2] = [(1, "velocity", "m/s"), (0, "position", "m")];
+
+/// Component `k` of the corrected (smoothed) trajectory at a fix.
+fn corrected(f: &FixReport, k: usize) -> f64 {
+    f.integrated[k] + f.smoothed[k]
+}
+
+/// Row `row` of [`calibration_trajectory`] on `area`: left, the GPS fix, the integration and the
+/// corrected trajectory over `axes[0]`; right, the drift of the integration over `axes[1]`.
+fn draw_trajectory_row(
+    area: &Area<'_>,
+    fixes: &[FixReport],
+    row: usize,
+    (time, [left, right]): (&Axis, [Axis; 2]),
+    [left_px, right_px]: [u32; 2],
+) -> Result<(), PlotError> {
+    let (k, name, _) = TRAJECTORY_ROWS[row];
+    let last = row == TRAJECTORY_ROWS.len() - 1;
+    let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
+    let cols = columns(area, &[WIDTH_PX / 2]);
+    let p = Panel::new(
+        &cols[0],
+        &format!("{}: GPS, integrated, corrected", super::capitalized(name)),
+        time.clone(),
+        left,
+        Layout::titled(left_px, last),
+    )?;
+    p.line(
+        fixes.iter().map(|f| (f.t_s, f.integrated[k])),
+        ORANGE.stroke_width(2),
+    )?;
+    p.line(
+        fixes.iter().map(|f| (f.t_s, corrected(f, k))),
+        BLUE.stroke_width(2),
+    )?;
+    markers(
+        &p,
+        fixes.iter().map(|f| (f.t_s, f.z[k])).collect(),
+        BLACK.filled(),
+    )?;
+    let q = Panel::new(
+        &cols[1],
+        &format!("{} drift of the integration", super::capitalized(name)),
+        time.clone(),
+        right,
+        Layout::titled(right_px, last),
+    )?;
+    let lo: Vec<f64> = fixes
+        .iter()
+        .map(|f| f.smoothed[k] - f.smoothed_sigma[k])
+        .collect();
+    let hi: Vec<f64> = fixes
+        .iter()
+        .map(|f| f.smoothed[k] + f.smoothed_sigma[k])
+        .collect();
+    q.band(&t, &lo, &hi, BLUE.mix(0.2))?;
+    markers(
+        &q,
+        fixes
+            .iter()
+            .map(|f| (f.t_s, f.z[k] - f.integrated[k]))
+            .collect(),
+        BLACK.filled(),
+    )?;
+    q.line(
+        fixes.iter().map(|f| (f.t_s, f.smoothed[k])),
+        BLUE.stroke_width(2),
+    )?;
+    Ok(())
 }
 
 /// The residual r = δz − H·δx̂⁻ of every fix, position and velocity, within the ±√S the filter

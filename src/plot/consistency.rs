@@ -145,8 +145,7 @@ pub fn consistency(stats: &EnsembleStats, nees: &Check, nis: &Check) -> PlotResu
             Scale::Linear(_) => None,
         })
         .collect();
-    let main_area = y_label_area(&main_axes);
-    let zoom_area = y_label_area(&zoom_axes);
+    let y_areas_px = [y_label_area(&main_axes), y_label_area(&zoom_axes)];
 
     let legend = [
         Entry::new(Swatch::Line(ORANGE.stroke_width(2)), "NEES, a priori"),
@@ -159,7 +158,6 @@ pub fn consistency(stats: &EnsembleStats, nees: &Check, nis: &Check) -> PlotResu
 
     render_under_legend(&legend, &[ROW_PX, last_row_px + 6], 0, |parts| {
         for (row, (stat, scale)) in statistics.iter().zip(&scales).enumerate() {
-            let layout = |y_area_px| Layout::titled(y_area_px, row == 1);
             let over = if row == 0 {
                 format!(
                     " over N = {} realizations",
@@ -168,43 +166,61 @@ pub fn consistency(stats: &EnsembleStats, nees: &Check, nis: &Check) -> PlotResu
             } else {
                 String::new()
             };
-            let (lower, upper) = (stat.check.lower, stat.check.upper);
-            let area: &Area<'_> = &parts[row];
-            match scale {
-                Scale::Linear(axis) => {
-                    let p = Panel::new(
-                        area,
-                        &format!(
-                            "Average {}{over}: expected {}, band [{lower:.3}, {upper:.3}]",
-                            stat.name, stat.expected
-                        ),
-                        Axis::linear("time", "s", span, 8),
-                        axis.clone(),
-                        layout(main_area),
-                    )?;
-                    stat.draw(&p, span)?;
-                }
-                Scale::Split { log, zoom } => {
-                    let cols = columns(area, &[FULL_COLUMN_PX]);
-                    let p = Panel::new(
-                        &cols[0],
-                        &format!("Average {}{over}, log axis", stat.name),
-                        Axis::linear("time", "s", span, 7),
-                        log.clone(),
-                        layout(main_area),
-                    )?;
-                    stat.draw(&p, span)?;
-                    let q = Panel::new(
-                        &cols[1],
-                        &format!("Enlarged: band [{lower:.3}, {upper:.3}]"),
-                        Axis::linear("time", "s", span, 4),
-                        zoom.clone(),
-                        layout(zoom_area),
-                    )?;
-                    stat.draw(&q, span)?;
-                }
-            }
+            let last = row == statistics.len() - 1;
+            stat.draw_row(&parts[row], scale, (&over, last), span, y_areas_px)?;
         }
         Ok(())
     })
+}
+
+impl Statistic<'_> {
+    /// The statistic's row on `area` over the times `span`, by its `scale`: one panel, or the
+    /// log-axis panel with the enlarged one beside it. The first title ends with `over`; `last`
+    /// says whether the time axis is titled; the panels' y label areas are `main_px` and
+    /// `zoom_px`.
+    fn draw_row(
+        &self,
+        area: &Area<'_>,
+        scale: &Scale,
+        (over, last): (&str, bool),
+        span: (f64, f64),
+        [main_px, zoom_px]: [u32; 2],
+    ) -> Result<(), PlotError> {
+        let layout = |y_area_px| Layout::titled(y_area_px, last);
+        let (lower, upper) = (self.check.lower, self.check.upper);
+        match scale {
+            Scale::Linear(axis) => {
+                let p = Panel::new(
+                    area,
+                    &format!(
+                        "Average {}{over}: expected {}, band [{lower:.3}, {upper:.3}]",
+                        self.name, self.expected
+                    ),
+                    Axis::linear("time", "s", span, 8),
+                    axis.clone(),
+                    layout(main_px),
+                )?;
+                self.draw(&p, span)
+            }
+            Scale::Split { log, zoom } => {
+                let cols = columns(area, &[FULL_COLUMN_PX]);
+                let p = Panel::new(
+                    &cols[0],
+                    &format!("Average {}{over}, log axis", self.name),
+                    Axis::linear("time", "s", span, 7),
+                    log.clone(),
+                    layout(main_px),
+                )?;
+                self.draw(&p, span)?;
+                let q = Panel::new(
+                    &cols[1],
+                    &format!("Enlarged: band [{lower:.3}, {upper:.3}]"),
+                    Axis::linear("time", "s", span, 4),
+                    zoom.clone(),
+                    layout(zoom_px),
+                )?;
+                self.draw(&q, span)
+            }
+        }
+    }
 }

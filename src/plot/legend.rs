@@ -67,13 +67,13 @@ fn legend_rows(entries: &[Entry], width: f64) -> Vec<Vec<&Entry>> {
 }
 
 /// Height of the legend strip that [`draw_legend`] fills for `entries` over the full width.
-pub(crate) fn legend_height(entries: &[Entry]) -> u32 {
+fn legend_height(entries: &[Entry]) -> u32 {
     let n = legend_rows(entries, WIDTH_PX as f64 - 40.0).len() as u32;
     n * LEGEND_ROW_PX + 8
 }
 
 /// Draws `entries` in centred rows across `area`.
-pub(crate) fn draw_legend(area: &Area<'_>, entries: &[Entry]) -> Result<(), PlotError> {
+fn draw_legend(area: &Area<'_>, entries: &[Entry]) -> Result<(), PlotError> {
     let (w, _) = area.dim_in_pixel();
     let text = font(LEGEND_PX).pos(Pos::new(HPos::Left, VPos::Center));
     for (r, row) in legend_rows(entries, w as f64 - 40.0).iter().enumerate() {

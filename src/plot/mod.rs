@@ -75,8 +75,6 @@ pub const ORANGE: RGBColor = RGBColor(0xB0, 0x7D, 0x00);
 pub const SKY_BLUE: RGBColor = RGBColor(0x3A, 0x8A, 0xCB);
 /// Okabe–Ito bluish green (3.4:1).
 pub const BLUISH_GREEN: RGBColor = RGBColor(0x00, 0x9E, 0x73);
-/// Olive (Okabe–Ito yellow #F0E442 darkened to 3.9:1; the original reaches 1.3:1).
-pub const YELLOW: RGBColor = RGBColor(0x8F, 0x82, 0x00);
 /// Okabe–Ito blue (5.2:1).
 pub const BLUE: RGBColor = RGBColor(0x00, 0x72, 0xB2);
 /// Okabe–Ito vermillion (3.9:1): bounds and warnings.
@@ -96,12 +94,11 @@ pub const GRID: RGBColor = RGBColor(0xE3, 0xE3, 0xE3);
 /// Every colour figures stroke lines, markers or text with, by name. Each reaches 3:1 against
 /// white (WCAG 2 relative luminance); [`GRID`] is left out on purpose (see there).
 #[cfg(test)]
-pub(crate) const STROKE_COLORS: [(&str, RGBColor); 10] = [
+pub(crate) const STROKE_COLORS: [(&str, RGBColor); 9] = [
     ("BLACK", BLACK),
     ("ORANGE", ORANGE),
     ("SKY_BLUE", SKY_BLUE),
     ("BLUISH_GREEN", BLUISH_GREEN),
-    ("YELLOW", YELLOW),
     ("BLUE", BLUE),
     ("VERMILLION", VERMILLION),
     ("REDDISH_PURPLE", REDDISH_PURPLE),

@@ -49,7 +49,7 @@ const LABEL_LINE_EM: f64 = 1.1;
 /// area of `y_area_px`) at [`TITLE_PX`] when it fits before the panel's right edge
 /// (`width_px`); a longer title starts at the panel's left edge, and shrinks if it must (to
 /// [`MIN_TITLE_PX`] at most, a wider panel being the better fix).
-pub(super) fn title_fit(title: &str, width_px: u32, y_area_px: u32) -> (i32, f64) {
+fn title_fit(title: &str, width_px: u32, y_area_px: u32) -> (i32, f64) {
     let fits = |from: u32, px: f64| {
         drawn_chars(title) * TITLE_CHAR_EM * px <= f64::from(width_px.saturating_sub(from + 4))
     };

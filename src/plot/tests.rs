@@ -24,7 +24,7 @@ fn small_study() -> &'static Study {
 }
 
 /// The point-sample case of the closed-form truth: the one with a mean error to draw.
-const CASE: Case = Case::REPORT[1];
+const CASE: Case = Case::POINT_SAMPLES;
 
 fn check(study: &Study, id: CheckId) -> &Check {
     study.case(CASE).verdicts.get(id)
@@ -244,10 +244,10 @@ fn render_default_figures() {
     std::fs::create_dir_all(dir).unwrap();
     let small = small_study();
     for (suffix, study, case) in [
-        ("", &study, Case::REPORT[1]),
-        ("_euler", &study, Case::REPORT[0]),
-        ("_interval", &study, Case::REPORT[2]),
-        ("_small", small, Case::REPORT[1]),
+        ("", &study, Case::POINT_SAMPLES),
+        ("_euler", &study, Case::MODEL_WORLD),
+        ("_interval", &study, Case::INTERVAL_MEANS),
+        ("_small", small, Case::POINT_SAMPLES),
     ] {
         for (name, svg) in figures_of(study, case) {
             texts(&svg);

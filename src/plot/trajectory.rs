@@ -6,8 +6,8 @@ use plotters::style::Color;
 use super::axis::{Axis, y_label_area};
 use super::geometry::{before, clipped_until, extent, padded, settled_from, time_span};
 use super::legend::{Entry, Swatch, render_under_legend};
-use super::panel::{Layout, Panel, columns};
-use super::{BLUE, BLUISH_GREEN, PlotResult, VERMILLION, WIDTH_PX};
+use super::panel::{Area, Layout, Panel, columns};
+use super::{BLUE, BLUISH_GREEN, PlotError, PlotResult, VERMILLION, WIDTH_PX};
 use crate::realization::{Realization, SampleRecord};
 
 /// Height of one row, px.
@@ -23,14 +23,75 @@ const ROW_PX: u32 = 250;
 pub fn trajectory(r: &Realization) -> PlotResult {
     let s = &r.samples;
     let (t0, t1) = time_span(s.iter().map(|x| x.t_s));
-    let settle = settled_from(t0, t1);
     let time = Axis::linear("time", "s", (t0, t1), 7);
+    let left = motion_axes(s);
+    let right = drift_axes(s, settled_from(t0, t1));
+    // Right-hand titles, with what the axis clips of the estimate (the truth is always in).
+    let titles_right: Vec<String> = DRIFT_TITLES
+        .iter()
+        .zip(&right)
+        .zip(DRIFT_INDEX)
+        .map(|(((full, short), axis), k)| {
+            match clipped_until(s.iter().map(|x| (x.t_s, x.estimate[k])), |v| axis.shows(v)) {
+                Some(t) => format!("{short} (off the axis {})", before(t)),
+                None => full.to_string(),
+            }
+        })
+        .collect();
+    let y_areas_px = [
+        y_label_area(&left.iter().collect::<Vec<_>>()),
+        y_label_area(&right.iter().collect::<Vec<_>>()),
+    ];
 
-    let fitted = |name: &str, unit: &str, values: Vec<f64>| {
-        let range = extent(values).map_or((-1.0, 1.0), |e| padded(e, 0.06));
-        Axis::linear(name, unit, range, 6)
-    };
-    let left = [
+    let legend = [
+        Entry::new(Swatch::Line(BLUE.stroke_width(2)), "truth"),
+        Entry::new(
+            Swatch::Line(BLUISH_GREEN.stroke_width(2)),
+            "integrated accelerometer",
+        ),
+        Entry::new(Swatch::Line(VERMILLION.stroke_width(2)), "filter estimate"),
+    ];
+    let last_row_px = ROW_PX + 24;
+
+    render_under_legend(&legend, &[ROW_PX, ROW_PX, last_row_px], 6, |parts| {
+        for (row, area) in parts.iter().enumerate() {
+            let axes = [left[row].clone(), right[row].clone()];
+            let title = titles_right[row].as_str();
+            draw_row(area, s, row, (&time, axes, title), y_areas_px)?;
+        }
+        Ok(())
+    })
+}
+
+/// The state component of each right-hand row: bias, velocity, position.
+const DRIFT_INDEX: [usize; 3] = [2, 1, 0];
+
+/// The right-hand titles: in full, and shortened for a note on what the axis clips.
+const DRIFT_TITLES: [(&str, &str); 3] = [
+    (
+        "Accelerometer bias b and its estimate",
+        "Bias b and its estimate",
+    ),
+    (
+        "Velocity drift δv = v − v_{c} and estimate",
+        "Velocity drift δv = v − v_{c}",
+    ),
+    (
+        "Position drift δp = p − p_{c} and estimate",
+        "Position drift δp = p − p_{c}",
+    ),
+];
+
+/// A linear axis fitted to `values`, padded by 6 %.
+fn fitted(name: &str, unit: &str, values: Vec<f64>) -> Axis {
+    let range = extent(values).map_or((-1.0, 1.0), |e| padded(e, 0.06));
+    Axis::linear(name, unit, range, 6)
+}
+
+/// The left-hand axes: acceleration, velocity and position, fitted to the truth and the
+/// integration.
+fn motion_axes(s: &[SampleRecord]) -> [Axis; 3] {
+    [
         fitted(
             "acceleration",
             "m/s²",
@@ -50,7 +111,12 @@ pub fn trajectory(r: &Realization) -> PlotResult {
                 .flat_map(|x| [x.truth_p_m, x.computed_p_m])
                 .collect(),
         ),
-    ];
+    ]
+}
+
+/// The right-hand axes: bias, velocity drift and position drift, fitted to the truth over the
+/// run and to the estimate from `settle` on.
+fn drift_axes(s: &[SampleRecord], settle: f64) -> [Axis; 3] {
     let drift_axis = |k: usize, name: &str, unit: &str| {
         let values = s
             .iter()
@@ -60,98 +126,60 @@ pub fn trajectory(r: &Realization) -> PlotResult {
         let range = extent(values).map_or((-1.0, 1.0), |e| padded(e, 0.12));
         Axis::linear(name, unit, range, 6)
     };
-    let right = [
+    [
         drift_axis(2, "bias", "m/s²"),
         drift_axis(1, "velocity drift", "m/s"),
         drift_axis(0, "position drift", "m"),
-    ];
-    // Right-hand titles, with what the axis clips of the estimate (the truth is always in).
-    let drift_index = [2, 1, 0];
-    let titles_right: Vec<String> = [
-        (
-            "Accelerometer bias b and its estimate",
-            "Bias b and its estimate",
-        ),
-        (
-            "Velocity drift δv = v − v_{c} and estimate",
-            "Velocity drift δv = v − v_{c}",
-        ),
-        (
-            "Position drift δp = p − p_{c} and estimate",
-            "Position drift δp = p − p_{c}",
-        ),
     ]
-    .iter()
-    .zip(&right)
-    .zip(drift_index)
-    .map(|(((full, short), axis), k)| {
-        match clipped_until(s.iter().map(|x| (x.t_s, x.estimate[k])), |v| axis.shows(v)) {
-            Some(t) => format!("{short} (off the axis {})", before(t)),
-            None => full.to_string(),
-        }
-    })
-    .collect();
-    let left_area = y_label_area(&left.iter().collect::<Vec<_>>());
-    let right_area = y_label_area(&right.iter().collect::<Vec<_>>());
+}
 
-    let legend = [
-        Entry::new(Swatch::Line(BLUE.stroke_width(2)), "truth"),
-        Entry::new(
-            Swatch::Line(BLUISH_GREEN.stroke_width(2)),
-            "integrated accelerometer",
-        ),
-        Entry::new(Swatch::Line(VERMILLION.stroke_width(2)), "filter estimate"),
+/// Row `row` of [`trajectory`] on `area`: left, the truth and the integration over `axes[0]`;
+/// right, the drift (or bias) and its estimate over `axes[1]`, titled `title_right`.
+fn draw_row(
+    area: &Area<'_>,
+    s: &[SampleRecord],
+    row: usize,
+    (time, [left, right], title_right): (&Axis, [Axis; 2], &str),
+    [left_px, right_px]: [u32; 2],
+) -> Result<(), PlotError> {
+    let titles_left = [
+        "True acceleration a(t)",
+        "Velocity: truth v and integrated v_{c}",
+        "Position: truth p and integrated p_{c}",
     ];
-    let last_row_px = ROW_PX + 24;
+    type Series = fn(&SampleRecord) -> f64;
+    let truth: [Series; 3] = [|x| x.accel_m_s2, |x| x.truth_v_m_s, |x| x.truth_p_m];
+    let computed: [Option<Series>; 3] =
+        [None, Some(|x| x.computed_v_m_s), Some(|x| x.computed_p_m)];
+    let cols = columns(area, &[WIDTH_PX / 2]);
+    let layout = |y_area_px| Layout::titled(y_area_px, row == 2);
+    let p = Panel::new(
+        &cols[0],
+        titles_left[row],
+        time.clone(),
+        left,
+        layout(left_px),
+    )?;
+    if let Some(c) = computed[row] {
+        p.line(
+            s.iter().map(|x| (x.t_s, c(x))),
+            BLUISH_GREEN.stroke_width(2),
+        )?;
+    }
+    p.line(
+        s.iter().map(|x| (x.t_s, truth[row](x))),
+        BLUE.stroke_width(2),
+    )?;
 
-    render_under_legend(&legend, &[ROW_PX, ROW_PX, last_row_px], 6, |parts| {
-        let titles_left = [
-            "True acceleration a(t)",
-            "Velocity: truth v and integrated v_{c}",
-            "Position: truth p and integrated p_{c}",
-        ];
-        type Series = fn(&SampleRecord) -> f64;
-        let truth: [Series; 3] = [|x| x.accel_m_s2, |x| x.truth_v_m_s, |x| x.truth_p_m];
-        let computed: [Option<Series>; 3] =
-            [None, Some(|x| x.computed_v_m_s), Some(|x| x.computed_p_m)];
-        for row in 0..3 {
-            let cols = columns(&parts[row], &[WIDTH_PX / 2]);
-            let layout = |y_area_px| Layout::titled(y_area_px, row == 2);
-            let p = Panel::new(
-                &cols[0],
-                titles_left[row],
-                time.clone(),
-                left[row].clone(),
-                layout(left_area),
-            )?;
-            if let Some(c) = computed[row] {
-                p.line(
-                    s.iter().map(|x| (x.t_s, c(x))),
-                    BLUISH_GREEN.stroke_width(2),
-                )?;
-            }
-            p.line(
-                s.iter().map(|x| (x.t_s, truth[row](x))),
-                BLUE.stroke_width(2),
-            )?;
-
-            let k = drift_index[row];
-            let q = Panel::new(
-                &cols[1],
-                &titles_right[row],
-                time.clone(),
-                right[row].clone(),
-                layout(right_area),
-            )?;
-            q.line(
-                s.iter().map(|x| (x.t_s, x.delta_x[k])),
-                BLUE.stroke_width(2),
-            )?;
-            q.line(
-                s.iter().map(|x| (x.t_s, x.estimate[k])),
-                VERMILLION.stroke_width(1),
-            )?;
-        }
-        Ok(())
-    })
+    let k = DRIFT_INDEX[row];
+    let q = Panel::new(&cols[1], title_right, time.clone(), right, layout(right_px))?;
+    q.line(
+        s.iter().map(|x| (x.t_s, x.delta_x[k])),
+        BLUE.stroke_width(2),
+    )?;
+    q.line(
+        s.iter().map(|x| (x.t_s, x.estimate[k])),
+        VERMILLION.stroke_width(1),
+    )?;
+    Ok(())
 }

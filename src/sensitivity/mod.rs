@@ -463,12 +463,7 @@ fn case_seed(seed: u64, domain: u64, parameter: AssumedStatistic, factor: f64) -
     mix(mix(mix(seed, domain), index), factor.to_bits())
 }
 
-/// `seed` mixed with `value` (SplitMix64's finalizer on their combination).
+/// `seed` mixed with `value`: SplitMix64 of their combination.
 fn mix(seed: u64, value: u64) -> u64 {
-    let mut z = seed
-        .wrapping_add(0x9E37_79B9_7F4A_7C15)
-        .wrapping_add(value.wrapping_mul(0xD1B5_4A32_D192_ED03));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+    crate::random::splitmix64(seed.wrapping_add(value.wrapping_mul(0xD1B5_4A32_D192_ED03)))
 }

@@ -19,15 +19,14 @@
 //! correlated across fixes, a matter of thousands of cheap draws.
 
 use nalgebra::{SMatrix, SVector};
-use rand::{RngExt, SeedableRng};
-use rand_distr::{ChiSquared, Distribution, StandardNormal};
-use rand_pcg::Pcg64Mcg;
+use rand_distr::{ChiSquared, Distribution};
 use rayon::prelude::*;
 
 use crate::checks::{self, Budget, CheckId};
 use crate::ensemble::{Accumulator, EnsembleStats, ResidualLayout, StageSums};
 use crate::filter::{ErrorStateModel, FilterSchedule, Matrix2, Matrix3};
 use crate::model::{NoiseStats, Timeline};
+use crate::random::Stream;
 
 type M6 = SMatrix<f64, 6, 6>;
 type M8 = SMatrix<f64, 8, 8>;
@@ -133,8 +132,10 @@ impl Sampler {
         }
     }
 
-    /// One draw of the sums of an ensemble, as [`crate::ensemble::run`] would add them up.
-    pub fn draw<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> Accumulator {
+    /// One draw of the sums of an ensemble, as [`crate::ensemble::run`] would add them up, from
+    /// the engines' generator `rng`: its ziggurat for the normal numbers, and `rand_distr`'s χ²
+    /// on its bits for the Bartlett factors.
+    pub fn draw(&self, rng: &mut Stream) -> Accumulator {
         let n_real = self.realizations as f64;
         let n = self.realizations - 1;
         let sqrt_n = n_real.sqrt();
@@ -144,7 +145,7 @@ impl Sampler {
 
         // Start: e ~ N(0, P(0)), δx̂ = 0.
         let mut scatter = M6::zeros();
-        let w0 = wishart::<3, _>(n, rng);
+        let w0 = wishart::<3>(n, rng);
         scatter
             .fixed_view_mut::<3, 3>(0, 0)
             .copy_from(&(self.p0_root * w0 * self.p0_root.transpose()));
@@ -158,7 +159,7 @@ impl Sampler {
             let l = psd_cholesky(&scatter);
             let b: SMatrix<f64, 3, 6> = normals(rng);
             let a = step.f * l + step.g * b;
-            let w = wishart::<3, _>(n - 6, rng);
+            let w = wishart::<3>(n - 6, rng);
             scatter = symmetric(a * a.transpose() + step.g * w * step.g.transpose());
             let noise: SVector<f64, 3> = normals(rng);
             mean = step.f * mean + step.g * noise / sqrt_n;
@@ -170,7 +171,7 @@ impl Sampler {
             let mut a = SMatrix::<f64, 8, 6>::zeros();
             a.fixed_view_mut::<6, 6>(0, 0).copy_from(&l);
             a.fixed_view_mut::<2, 6>(6, 0).copy_from(&(self.r_root * b));
-            let w = wishart::<2, _>(n - 6, rng);
+            let w = wishart::<2>(n - 6, rng);
             let mut joint: M8 = a * a.transpose();
             let wr = self.r_root * w * self.r_root.transpose();
             for (x, y) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
@@ -210,8 +211,9 @@ impl Sampler {
 impl Sampler {
     /// The fraction of `draws` ensembles in which each check fails within `budget`, in
     /// [`CheckId::ALL`] order; `None` for the residual whiteness, whose products across fixes the
-    /// fix-level sums do not carry. Draw k has its own generator seeded from (`seed`, k), so the
-    /// fractions do not depend on the thread count.
+    /// fix-level sums do not carry. Draw k has its own generator, stream k of those keyed by
+    /// `seed` (as a realization's is in the engines), so the fractions do not depend on the
+    /// thread count.
     pub fn detection(
         &self,
         schedule: &FilterSchedule,
@@ -220,7 +222,7 @@ impl Sampler {
         seed: u64,
     ) -> Vec<Option<f64>> {
         let stats = |k: u64| {
-            let mut rng = Pcg64Mcg::seed_from_u64(mix(seed, k));
+            let mut rng = Stream::new(seed, k);
             EnsembleStats::from_sums(&self.draw(&mut rng), schedule)
         };
         // The bands depend only on N and the members: judged once, reused for every draw.
@@ -248,14 +250,6 @@ impl Sampler {
     }
 }
 
-/// The seed of draw `k` under `seed` (SplitMix64 finalizer).
-fn mix(seed: u64, k: u64) -> u64 {
-    let mut z = seed ^ 0xD1B5_4A32_D192_ED03 ^ k.wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 /// The raw sums Σ e, Σ e·eᵀ, … of one stage from the scatter and the mean of z = (e, δx̂).
 fn stage_sums(scatter: &M6, mean: &V6, n: f64, p_inv: &Matrix3) -> StageSums {
     let raw = scatter + mean * mean.transpose() * n;
@@ -272,21 +266,19 @@ fn stage_sums(scatter: &M6, mean: &V6, n: f64, p_inv: &Matrix3) -> StageSums {
 }
 
 /// A matrix of independent standard normal draws.
-fn normals<const R: usize, const C: usize, G: rand::Rng + ?Sized>(
-    rng: &mut G,
-) -> SMatrix<f64, R, C> {
-    SMatrix::from_fn(|_, _| rng.sample(StandardNormal))
+fn normals<const R: usize, const C: usize>(rng: &mut Stream) -> SMatrix<f64, R, C> {
+    SMatrix::from_fn(|_, _| rng.normal())
 }
 
 /// A Wishart(ν, I_D) draw by the Bartlett decomposition T·Tᵀ, T lower triangular with
 /// T_kk² ~ χ²(ν − k) and standard normal entries below the diagonal.
-fn wishart<const D: usize, G: rand::Rng + ?Sized>(nu: u64, rng: &mut G) -> SMatrix<f64, D, D> {
+fn wishart<const D: usize>(nu: u64, rng: &mut Stream) -> SMatrix<f64, D, D> {
     let mut t = SMatrix::<f64, D, D>::zeros();
     for k in 0..D {
         let chi = ChiSquared::new((nu - k as u64) as f64).expect("positive degrees of freedom");
         t[(k, k)] = chi.sample(rng).sqrt();
         for c in 0..k {
-            t[(k, c)] = rng.sample(StandardNormal);
+            t[(k, c)] = rng.normal();
         }
     }
     t * t.transpose()

@@ -109,7 +109,7 @@ impl Study {
             .into_iter()
             .map(|case| run_case(&model.with_case(case), &schedule, progress))
             .collect();
-        let preferred = [Case::REPORT[2], Case::REPORT[0]];
+        let preferred = [Case::INTERVAL_MEANS, Case::MODEL_WORLD];
         let realization_case = preferred
             .into_iter()
             .find(|c| {

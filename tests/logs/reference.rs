@@ -116,38 +116,7 @@ pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> 
     let mut f_step = Vec::with_capacity(n);
     for k in 0..n {
         if let Some((zp, zv)) = fix_at[k] {
-            // S = H P Hᵀ + R, H = [I₂ 0].
-            let s = [[p[0][0] + rp, p[0][1]], [p[1][0], p[1][1] + rv]];
-            let det = s[0][0] * s[1][1] - s[0][1] * s[1][0];
-            let si = [
-                [s[1][1] / det, -s[0][1] / det],
-                [-s[1][0] / det, s[0][0] / det],
-            ];
-            // K = P Hᵀ S⁻¹ (3×2).
-            let k_gain: [[f64; 2]; 3] = [0, 1, 2].map(|i| {
-                [
-                    p[i][0] * si[0][0] + p[i][1] * si[1][0],
-                    p[i][0] * si[0][1] + p[i][1] * si[1][1],
-                ]
-            });
-            let r = [zp - pc - x[0], zv - vc - x[1]];
-            for i in 0..3 {
-                x[i] += k_gain[i][0] * r[0] + k_gain[i][1] * r[1];
-            }
-            // P⁺ = P⁻ − K S Kᵀ.
-            let mut p_new = p;
-            for i in 0..3 {
-                for j in 0..3 {
-                    let mut ksk = 0.0;
-                    for a in 0..2 {
-                        for b in 0..2 {
-                            ksk += k_gain[i][a] * s[a][b] * k_gain[j][b];
-                        }
-                    }
-                    p_new[i][j] -= ksk;
-                }
-            }
-            p = p_new;
+            update(&mut x, &mut p, [zp - pc, zv - vc], [rp, rv]);
         }
         out.t.push(accel[k].0);
         out.pc.push(pc);
@@ -172,7 +141,51 @@ pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> 
             f_step.push(f);
         }
     }
-    // Rauch–Tung–Striebel over every sample.
+    smooth(&mut out, &f_step, &x_prior_next, &p_prior_next);
+    out
+}
+
+/// The update of the estimate `x` and its covariance `p` by the fix whose difference from the
+/// integration is `dz` = (z_p − p_c, z_v − v_c), with the GPS variances `r`.
+fn update(x: &mut [f64; 3], p: &mut M3, dz: [f64; 2], [rp, rv]: [f64; 2]) {
+    // S = H P Hᵀ + R, H = [I₂ 0].
+    let s = [[p[0][0] + rp, p[0][1]], [p[1][0], p[1][1] + rv]];
+    let det = s[0][0] * s[1][1] - s[0][1] * s[1][0];
+    let si = [
+        [s[1][1] / det, -s[0][1] / det],
+        [-s[1][0] / det, s[0][0] / det],
+    ];
+    // K = P Hᵀ S⁻¹ (3×2).
+    let k_gain: [[f64; 2]; 3] = [0, 1, 2].map(|i| {
+        [
+            p[i][0] * si[0][0] + p[i][1] * si[1][0],
+            p[i][0] * si[0][1] + p[i][1] * si[1][1],
+        ]
+    });
+    let r = [dz[0] - x[0], dz[1] - x[1]];
+    for i in 0..3 {
+        x[i] += k_gain[i][0] * r[0] + k_gain[i][1] * r[1];
+    }
+    // P⁺ = P⁻ − K S Kᵀ.
+    let mut p_new = *p;
+    for i in 0..3 {
+        for j in 0..3 {
+            let mut ksk = 0.0;
+            for a in 0..2 {
+                for b in 0..2 {
+                    ksk += k_gain[i][a] * s[a][b] * k_gain[j][b];
+                }
+            }
+            p_new[i][j] -= ksk;
+        }
+    }
+    *p = p_new;
+}
+
+/// Rauch–Tung–Striebel over every sample: fills `out.xs` and `out.ps` from the filtered
+/// estimates, the transitions `f_step` and the a priori estimates at the next sample.
+fn smooth(out: &mut Processed, f_step: &[M3], x_prior_next: &[[f64; 3]], p_prior_next: &[M3]) {
+    let n = out.x.len();
     out.xs = out.x.clone();
     out.ps = out.p.clone();
     for k in (0..n.saturating_sub(1)).rev() {
@@ -186,5 +199,4 @@ pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> 
         let dp = add(&out.ps[k + 1], &p_prior_next[k], -1.0);
         out.ps[k] = add(&out.p[k], &mul(&mul(&c, &dp), &transpose(&c)), 1.0);
     }
-    out
 }
