@@ -65,7 +65,10 @@ fn assert_contents_follow(page: &Page) {
     let main = &html[html.find("<main>").unwrap()..];
     let mut at = 0;
     for entry in &page.view.toc {
-        let open = format!("<section id=\"{}\">\n<h2>{}</h2>", entry.anchor, entry.title);
+        let open = format!(
+            "<section id=\"{}\">\n<h2>{}</h2>",
+            entry.anchor, entry.title
+        );
         let i = main[at..]
             .find(&open)
             .unwrap_or_else(|| panic!("{} not after the previous section", entry.anchor));
@@ -154,7 +157,10 @@ fn moving_a_section_renumbers_the_page_and_the_contents_follow() {
     let others = case_tables(&page.view);
     assert_eq!(others.len(), cases - 1);
     assert!(others.iter().all(|(_, t)| *t < a.table_number));
-    assert_eq!(page.view.toc.last().unwrap().anchor, format!("case-{}", a.id));
+    assert_eq!(
+        page.view.toc.last().unwrap().anchor,
+        format!("case-{}", a.id)
+    );
     assert!(page.html.rfind("id=\"case-").unwrap() > page.html.find("id=\"appendix\"").unwrap());
 }
 
@@ -188,11 +194,8 @@ fn posterior_nees(stats: &EnsembleStats, f: &mut dyn FnMut(f64, MemberId)) {
 #[test]
 fn a_check_added_to_the_catalogue_shows_up_in_every_table_and_count() {
     let mut study = study().clone();
-    let catalogue: Vec<&'static Definition> = CATALOGUE
-        .iter()
-        .copied()
-        .chain([&POSTERIOR_NEES])
-        .collect();
+    let catalogue: Vec<&'static Definition> =
+        CATALOGUE.iter().copied().chain([&POSTERIOR_NEES]).collect();
     let alpha = study.model.config.checks.false_alarm_rate;
     let budget = Budget::over(alpha, catalogue.len());
     for o in &mut study.cases {
@@ -204,9 +207,12 @@ fn a_check_added_to_the_catalogue_shows_up_in_every_table_and_count() {
     let n = catalogue.len().to_string();
     let id = POSTERIOR_NEES.id;
     let mut seen = 0;
-    for node in page.view.sections.iter().flat_map(|n| {
-        std::iter::once(n).chain(&n.children)
-    }) {
+    for node in page
+        .view
+        .sections
+        .iter()
+        .flat_map(|n| std::iter::once(n).chain(&n.children))
+    {
         match &node.view {
             SectionView::Abstract(a) => {
                 assert_eq!(a.check_count, n);

@@ -43,25 +43,25 @@ impl Context<'_> {
         Ok(match section {
             Section::Abstract => SectionView::Abstract(self.abstract_view()),
             Section::Introduction => SectionView::Introduction(IntroductionView {}),
-            Section::Problem => SectionView::Problem(self.problem()?),
-            Section::Theory => SectionView::Theory(self.theory()),
-            Section::Results => SectionView::Results(self.results()?),
+            Section::Problem => SectionView::Problem(Box::new(self.problem()?)),
+            Section::Theory => SectionView::Theory(Box::new(self.theory())),
+            Section::Results => SectionView::Results(Box::new(self.results()?)),
             Section::Case(i) => {
                 let o = &study.cases[i];
                 let n = self.numbers;
                 let tables = (n.table(Table::Checks(i)), n.table(Table::Pair(i)));
                 let figures = figures::check_figures(o, i, n)?;
                 let claimed = prose::claimed_sigma(study);
-                SectionView::Case(cases::case_view(o, i, tables, figures, claimed))
+                SectionView::Case(Box::new(cases::case_view(o, i, tables, figures, claimed)))
             }
             Section::Performance => SectionView::Performance(self.performance()),
-            Section::Sensitivity => SectionView::Sensitivity(sensitivity::view(
+            Section::Sensitivity => SectionView::Sensitivity(Box::new(sensitivity::view(
                 study
                     .sensitivity
                     .as_ref()
                     .expect("the outline shows sensitivity only when the study ran it"),
                 self.numbers,
-            )?),
+            )?)),
             Section::Conclusions => SectionView::Conclusions(self.conclusions()),
             Section::Appendix => SectionView::Appendix(AppendixView {
                 command: self.input.command.to_string(),

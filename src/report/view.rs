@@ -413,7 +413,7 @@ pub struct AppendixView {
     pub config_toml: String,
 }
 
-/// The view of one section.
+/// The view of one section (the large ones boxed: a section is built once).
 #[derive(Clone, Debug, Serialize)]
 #[serde(tag = "section", rename_all = "snake_case")]
 pub enum SectionView {
@@ -422,17 +422,17 @@ pub enum SectionView {
     /// The introduction.
     Introduction(IntroductionView),
     /// The problem and its parameters.
-    Problem(ProblemView),
+    Problem(Box<ProblemView>),
     /// Theory and algorithm.
-    Theory(TheoryView),
+    Theory(Box<TheoryView>),
     /// Results.
-    Results(ResultsView),
+    Results(Box<ResultsView>),
     /// One case.
-    Case(CaseView),
+    Case(Box<CaseView>),
     /// Run times.
     Performance(PerformanceView),
     /// Sensitivity to the assumed statistics.
-    Sensitivity(SensitivityView),
+    Sensitivity(Box<SensitivityView>),
     /// Conclusions.
     Conclusions(ConclusionsView),
     /// Configuration and reproduction.
