@@ -5,10 +5,11 @@ use super::cases::{self, case_label, states};
 use super::figures;
 use super::math::Math;
 use super::outline::{Equation, Numbers, Section, Table};
-use super::view::{
-    AbstractView, AppendixView, CatalogueEntry, ConclusionsView, EquationNumbers, IntroductionView,
-    PerformanceView, ProblemView, ResultsView, SectionView, TheoryView,
+use super::page::{
+    AbstractView, AppendixView, ConclusionsView, IntroductionView, PerformanceView, ProblemView,
+    ResultsView, SectionView, TheoryView,
 };
+use super::view::{CatalogueEntry, EquationNumbers};
 use super::{RenderError, ReportInput, params, prose, rich, sensitivity};
 use crate::format::{count, fixed, percent, short, sig};
 use crate::state::ErrorState;
