@@ -4,6 +4,8 @@
 
 mod common;
 
+use accelcal::checks::{CATALOGUE, CheckId};
+
 use std::path::Path;
 use std::process::Command;
 
@@ -80,7 +82,16 @@ fn report_is_complete_and_self_contained() {
         },
     )
     .expect("index.html parses");
+    assert_sections_and_figures(&doc, &html);
+    assert_math_and_nothing_outside(&doc, &html);
+    assert_verdict_tables(&doc);
+    let data = assert_data(dir.path());
+    assert_view(dir.path(), &doc, &data);
+    assert_numbering(&doc);
+}
 
+/// Every section has a heading and words; every figure an SVG with labels and a caption.
+fn assert_sections_and_figures(doc: &roxmltree::Document, html: &str) {
     for id in SECTIONS {
         let section = doc
             .descendants()
@@ -121,7 +132,10 @@ fn report_is_complete_and_self_contained() {
             "{id} holds a non-finite number"
         );
     }
+}
 
+/// Equations are MathML in the embedded font, and the page needs nothing outside itself.
+fn assert_math_and_nothing_outside(doc: &roxmltree::Document, html: &str) {
     // Equations are MathML, set in the embedded math font.
     let maths: Vec<_> = doc
         .descendants()
@@ -160,31 +174,26 @@ fn report_is_complete_and_self_contained() {
             }
         }
     }
+}
 
-    // The verdict tables name every check of every case.
+/// The verdict tables name every check of every case.
+fn assert_verdict_tables(doc: &roxmltree::Document) {
     for case in CASES {
         let table = doc
             .descendants()
             .find(|n| n.attribute("id") == Some(&*format!("checks-{case}")))
             .unwrap_or_else(|| panic!("no verdict table for {case}"));
         let text: String = table.descendants().filter_map(|n| n.text()).collect();
-        for id in [
-            "mean_error",
-            "covariance_match",
-            "covariance_correlation",
-            "orthogonality",
-            "residual_whiteness",
-            "nees",
-            "nis",
-        ] {
-            assert!(text.contains(id), "{case} table lacks {id}");
+        for id in CheckId::ALL {
+            assert!(text.contains(id.name()), "{case} table lacks {id:?}");
         }
     }
+}
 
-    // data.json: configuration, the realization at the fixes, both ensembles with summaries.
+/// data.json: configuration, the realization at the fixes, every ensemble with its summary.
+fn assert_data(dir: &Path) -> serde_json::Value {
     let data: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("out/data.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/data.json")).unwrap()).unwrap();
     assert_eq!(data["config"]["profile"]["duration_s"], 6.0);
     assert_eq!(data["realization"]["fixes"].as_array().unwrap().len(), 30);
     let cases: Vec<String> = data["ensembles"]
@@ -207,7 +216,7 @@ fn report_is_complete_and_self_contained() {
     for e in data["ensembles"].as_array().unwrap() {
         let s = &e["summary"];
         assert_eq!(s["realizations"], 400);
-        assert_eq!(s["checks"].as_array().unwrap().len(), 7);
+        assert_eq!(s["checks"].as_array().unwrap().len(), CATALOGUE.len());
         for key in ["position_m", "velocity_m_s", "bias_m_s2"] {
             assert!(s["achieved_rms"][key].as_f64().unwrap() > 0.0, "{key}");
         }
@@ -216,18 +225,33 @@ fn report_is_complete_and_self_contained() {
         }
     }
 
-    // view.json: what the page shows, as text; its verdicts are data.json's.
+    data
+}
+
+/// view.json: what the page shows, as text; its verdicts are data.json's.
+fn assert_view(dir: &Path, doc: &roxmltree::Document, data: &serde_json::Value) {
     let page_text: String = doc.descendants().filter_map(|n| n.text()).collect();
     let view: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("out/view.json")).unwrap())
-            .unwrap();
-    assert_eq!(view["catalogue"].as_array().unwrap().len(), 7);
-    for (e, d) in view["cases"]
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/view.json")).unwrap()).unwrap();
+    let sections = view["sections"].as_array().unwrap();
+    let section = |name: &str| {
+        sections
+            .iter()
+            .find(|s| s["section"] == name)
+            .unwrap_or_else(|| panic!("view.json has no {name} section"))
+    };
+    assert_eq!(
+        section("theory")["catalogue"].as_array().unwrap().len(),
+        CATALOGUE.len()
+    );
+    let cases: Vec<&serde_json::Value> = section("results")["children"]
         .as_array()
         .unwrap()
         .iter()
-        .zip(data["ensembles"].as_array().unwrap())
-    {
+        .filter(|c| c["section"] == "case")
+        .collect();
+    assert_eq!(cases.len(), CASES.len());
+    for (e, d) in cases.iter().zip(data["ensembles"].as_array().unwrap()) {
         for (row, check) in e["checks"]
             .as_array()
             .unwrap()
@@ -239,8 +263,10 @@ fn report_is_complete_and_self_contained() {
             assert!(page_text.contains(row["what"].as_str().unwrap()));
         }
     }
+}
 
-    // Figures and tables are numbered in reading order, from 1, without gaps.
+/// Figures and tables are numbered in reading order, from 1, without gaps.
+fn assert_numbering(doc: &roxmltree::Document) {
     for (tag, word) in [("figcaption", "Figure"), ("caption", "Table")] {
         let numbers: Vec<usize> = doc
             .descendants()

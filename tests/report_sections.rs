@@ -10,7 +10,7 @@ use accelcal::ensemble::Statistics;
 use accelcal::filter::Stage;
 use accelcal::model::Model;
 use accelcal::report::outline::{Node, Outline, Section};
-use accelcal::report::view::{ReportView, SectionView};
+use accelcal::report::page::{ReportView, SectionView};
 use accelcal::report::{self, Page, ReportInput};
 use accelcal::study::{Silent, Study};
 

@@ -1,31 +1,19 @@
-//! The catalogue of checks: the one list of [`Definition`]s, each in its own file under
-//! `src/checks/`, that says for a check the hypothesis it tests, its member statistic, the
+//! What a check is: its [`Definition`] says the hypothesis it tests, its member statistic, the
 //! distribution of that statistic under a consistent filter, its formula, the smallest ensemble
-//! that can test it, how its members are computed and how a failure reads. Nothing else describes
-//! a check: the verdicts, the budget, the JSON, the sensitivity study and the report iterate over
-//! [`CATALOGUE`], so a check is added by its file and one line here.
+//! that can test it, how its members are computed and how a failure reads. Each check fills one
+//! in its own file under `src/checks/`, and [`CATALOGUE`] lists them. Nothing else describes a
+//! check: the verdicts, the budget, the JSON, the sensitivity study and the report iterate over
+//! the catalogue, so a check is added by its file and one line in the list.
 
 use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
-use super::{Check, covariance_correlation, covariance_match, mean_error, nees, nis};
-use super::{orthogonality, residual_whiteness};
+use super::{CATALOGUE, Check};
 use crate::ensemble::Statistics;
 use crate::filter::Stage;
 use crate::state::{Dims, ErrorState, Variable};
 use crate::stats::normal_bound;
-
-/// Every check, in the order the report and the JSON present them: the one registration list.
-pub const CATALOGUE: &[&Definition] = &[
-    &mean_error::CHECK,
-    &covariance_match::CHECK,
-    &covariance_correlation::CHECK,
-    &orthogonality::CHECK,
-    &residual_whiteness::CHECK,
-    &nees::CHECK,
-    &nis::CHECK,
-];
 
 /// The stable identifier of a check, used in JSON and on the command line (`"mean_error"`).
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

@@ -10,22 +10,36 @@
 //! This module returns numbers and typed member ids; words are the catalogue's and the report's.
 
 pub mod catalogue;
-mod covariance_correlation;
-mod covariance_match;
-mod mean_error;
 mod members;
-mod nees;
-mod nis;
-mod orthogonality;
-mod residual_whiteness;
 
 use serde::Serialize;
 
 use crate::ensemble::Statistics;
 use crate::state::{Dims, ErrorState};
 use crate::stats::{chi_squared_band, chi_squared_median, normal_bound};
-pub use catalogue::{CATALOGUE, CheckId, Definition, FailureWords, MemberId, Null};
+pub use catalogue::{CheckId, Definition, FailureWords, MemberId, Null};
 pub use members::residual_z;
+
+/// Declares each check's file as a module and lists its definition in [`CATALOGUE`].
+macro_rules! register {
+    ($($check:ident),* $(,)?) => {
+        $(mod $check;)*
+
+        /// Every check, in the order the report and the JSON present them.
+        pub const CATALOGUE: &[&Definition] = &[$(&$check::CHECK),*];
+    };
+}
+
+// The one registration list: a check is its file under src/checks/ and its name here.
+register!(
+    mean_error,
+    covariance_match,
+    covariance_correlation,
+    orthogonality,
+    residual_whiteness,
+    nees,
+    nis,
+);
 
 /// How the study-wide false-alarm rate is spent over the checks.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -190,7 +190,7 @@ impl Default for EnsembleConfig {
 #[serde(deny_unknown_fields, default)]
 pub struct ChecksConfig {
     /// Study-wide false-alarm rate: the probability that a consistent filter fails any check. Each
-    /// of the seven checks gets a seventh, split over its distinct members (Bonferroni).
+    /// of the checks gets an equal share, split over its distinct members (Bonferroni).
     pub false_alarm_rate: f64,
     /// The single pair (t_m, t_i), t_m < t_i, of GPS fix times whose residual correlation the
     /// problem statement asks for, s. Default: the fixes nearest one third and two thirds of

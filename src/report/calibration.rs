@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::RenderError;
 use super::rich::rich;
-use super::view::FigureView;
+use super::view::{FigureView, VerdictView};
 use crate::calibrate::StepMode;
 use crate::calibrate::summary::{Calibration, Summary};
 use crate::format::{count, percent, short, sig};
@@ -39,8 +39,8 @@ pub struct CalibrationView {
     pub results: Vec<Row>,
     /// The NIS test in words, as HTML.
     pub nis_html: String,
-    /// "pass" or "fail".
-    pub nis_verdict: String,
+    /// Pass or fail.
+    pub nis_verdict: VerdictView,
     /// The filter's assumptions.
     pub settings: Vec<Row>,
     /// The four figures.
@@ -134,22 +134,44 @@ fn method(s: &Summary) -> Vec<String> {
 /// [`RenderError::Figure`] when a figure cannot be drawn.
 pub fn build(cal: &Calibration, command: &str) -> Result<CalibrationView, RenderError> {
     let s = &cal.summary;
+    Ok(CalibrationView {
+        version: s.accelcal_version.to_string(),
+        bias: with_sigma(s.bias_m_s2, s.bias_sigma_m_s2, "m/s²"),
+        end_time: short(s.end_s),
+        logs: logs(s),
+        method_html: method(s),
+        results: results(s),
+        nis_html: nis_words(s),
+        // The NIS test's verdict is a word of summary.json; the page shows it as a verdict.
+        nis_verdict: if s.nis.verdict == "pass" {
+            VerdictView::Pass
+        } else {
+            VerdictView::Fail
+        },
+        settings: settings(s),
+        figures: figures(cal)?,
+        command: command.to_string(),
+    })
+}
+
+/// The four figures of the page.
+fn figures(cal: &Calibration) -> Result<Vec<FigureView>, RenderError> {
     let fig = |id: &str, svg: Result<String, plot::PlotError>| {
         svg.map_err(|source| RenderError::Figure {
             figure: id.to_string(),
             source,
         })
     };
-    let n = &s.nis;
-    let figures = vec![
+    let n = &cal.summary.nis;
+    Ok(vec![
         FigureView {
             id: "fig-bias".into(),
             number: 1,
             title: "The bias estimate".into(),
             caption_html: rich(
                 "The filtered (a posteriori) bias estimate at each fix and the smoothed one, each \
-                 with ±1σ; below, the two σ. The smoothed estimate uses every fix, so it holds \
-                 its final value from the start.",
+             with ±1σ; below, the two σ. The smoothed estimate uses every fix, so it holds \
+             its final value from the start.",
             ),
             svg: fig("fig-bias", plot::calibration_bias(&cal.fixes))?,
         },
@@ -159,9 +181,9 @@ pub fn build(cal: &Calibration, command: &str) -> Result<CalibrationView, Render
             title: "The corrected trajectory".into(),
             caption_html: rich(
                 "Left: velocity and position from the GPS, from the integrated accelerometer \
-                 (p_{c}, v_{c}) and corrected by the smoothed error estimate (p_{c} + δp̂, \
-                 v_{c} + δv̂). Right: the integration's drift, GPS minus integration at each fix, \
-                 with its smoothed estimate ±1σ.",
+             (p_{c}, v_{c}) and corrected by the smoothed error estimate (p_{c} + δp̂, \
+             v_{c} + δv̂). Right: the integration's drift, GPS minus integration at each fix, \
+             with its smoothed estimate ±1σ.",
             ),
             svg: fig("fig-trajectory", plot::calibration_trajectory(&cal.fixes))?,
         },
@@ -171,7 +193,7 @@ pub fn build(cal: &Calibration, command: &str) -> Result<CalibrationView, Render
             title: "Residuals".into(),
             caption_html: rich(
                 "The residual r = δz − Hδx̂^{−} of each fix within the ±√S and ±2√S the filter \
-                 predicts for it (the diagonal of S = HP^{−}H^{T} + R).",
+             predicts for it (the diagonal of S = HP^{−}H^{T} + R).",
             ),
             svg: fig("fig-residuals", plot::calibration_residuals(&cal.fixes))?,
         },
@@ -181,134 +203,143 @@ pub fn build(cal: &Calibration, command: &str) -> Result<CalibrationView, Render
             title: "Normalized innovations squared".into(),
             caption_html: rich(&format!(
                 "The NIS r^{{T}}S^{{−1}}r of each fix, χ²(2) for a consistent filter, with its \
-                 expected value 2 and the per-fix band [{}, {}] that holds it with probability \
-                 1 − α = {}.",
+             expected value 2 and the per-fix band [{}, {}] that holds it with probability \
+             1 − α = {}.",
                 sig(n.per_fix_lower, 3),
                 sig(n.per_fix_upper, 3),
                 percent(1.0 - n.false_alarm_rate)
             )),
             svg: fig("fig-nis", plot::calibration_nis(&cal.fixes, n))?,
         },
-    ];
+    ])
+}
+
+/// The logs and their extent.
+fn logs(s: &Summary) -> Vec<Row> {
+    vec![
+        row("accelerometer log", s.accelerometer_log.clone()),
+        row("GPS log", s.gps_log.clone()),
+        row("samples", count(s.samples)),
+        row("GPS fixes", count(s.fixes as u64)),
+        row(
+            "time span",
+            format!(
+                "{} s to {} s ({} s)",
+                short(s.start_s),
+                short(s.end_s),
+                short(s.duration_s)
+            ),
+        ),
+        row("median step", seconds(s.median_step_s)),
+        row("Δt mode", s.dt_mode.name().to_string()),
+    ]
+}
+
+/// The estimates at the start and the end of the log.
+fn results(s: &Summary) -> Vec<Row> {
     let start = &s.start_smoothed;
     let end = &s.end_estimate;
     let f = &s.filter;
-    Ok(CalibrationView {
-        version: s.accelcal_version.to_string(),
-        bias: with_sigma(s.bias_m_s2, s.bias_sigma_m_s2, "m/s²"),
-        end_time: short(s.end_s),
-        logs: vec![
-            row("accelerometer log", s.accelerometer_log.clone()),
-            row("GPS log", s.gps_log.clone()),
-            row("samples", count(s.samples)),
-            row("GPS fixes", count(s.fixes as u64)),
-            row(
-                "time span",
-                format!(
-                    "{} s to {} s ({} s)",
-                    short(s.start_s),
-                    short(s.end_s),
-                    short(s.duration_s)
-                ),
+    vec![
+        row(
+            "bias b̂ at the end",
+            with_sigma(end.bias_m_s2, end.sigma_bias_m_s2, "m/s²"),
+        ),
+        row(
+            "position error δp̂ at the end",
+            with_sigma(end.dp_m, end.sigma_dp_m, "m"),
+        ),
+        row(
+            "velocity error δv̂ at the end",
+            with_sigma(end.dv_m_s, end.sigma_dv_m_s, "m/s"),
+        ),
+        row(
+            "initial position p(t_{0}) = p_{c}(t_{0}) + δp̂^{s}",
+            with_sigma(
+                f.initial_position_mean_m + start.dp_m,
+                start.sigma_dp_m,
+                "m",
             ),
-            row("median step", seconds(s.median_step_s)),
-            row("Δt mode", s.dt_mode.name().to_string()),
-        ],
-        method_html: method(s),
-        results: vec![
-            row(
-                "bias b̂ at the end",
-                with_sigma(end.bias_m_s2, end.sigma_bias_m_s2, "m/s²"),
+        ),
+        row(
+            "initial velocity v(t_{0}) = v_{c}(t_{0}) + δv̂^{s}",
+            with_sigma(
+                f.initial_velocity_mean_m_s + start.dv_m_s,
+                start.sigma_dv_m_s,
+                "m/s",
             ),
-            row(
-                "position error δp̂ at the end",
-                with_sigma(end.dp_m, end.sigma_dp_m, "m"),
-            ),
-            row(
-                "velocity error δv̂ at the end",
-                with_sigma(end.dv_m_s, end.sigma_dv_m_s, "m/s"),
-            ),
-            row(
-                "initial position p(t_{0}) = p_{c}(t_{0}) + δp̂^{s}",
-                with_sigma(
-                    f.initial_position_mean_m + start.dp_m,
-                    start.sigma_dp_m,
-                    "m",
-                ),
-            ),
-            row(
-                "initial velocity v(t_{0}) = v_{c}(t_{0}) + δv̂^{s}",
-                with_sigma(
-                    f.initial_velocity_mean_m_s + start.dv_m_s,
-                    start.sigma_dv_m_s,
-                    "m/s",
-                ),
-            ),
-        ],
-        nis_html: rich(&format!(
-            "The NIS of the {} fixes sum to {} (mean {}). For a consistent filter the sum is \
-             χ²({}) and lies in [{}, {}] with probability 1 − α = {} (α/2 in each tail, \
-             α = checks.false_alarm_rate): {}. {} of the fixes fall outside the per-fix band; \
-             about {} would by chance. This is the only consistency check real data allows: it \
-             needs no truth.",
-            count(n.fixes as u64),
-            sig(n.sum, 5),
-            sig(n.mean, 4),
-            count(n.dof),
-            sig(n.lower, 5),
-            sig(n.upper, 5),
-            percent(1.0 - n.false_alarm_rate),
-            if n.verdict == "pass" {
-                "the sum is inside, the residuals are as large as the filter predicts"
-            } else if n.sum > n.upper {
-                "the sum is above the band, the residuals are larger than the filter predicts \
-                 (its noise statistics are too small, or the model misses something)"
-            } else {
-                "the sum is below the band, the residuals are smaller than the filter predicts \
-                 (its noise statistics are too large)"
-            },
-            count(n.outside_per_fix as u64),
-            sig(n.expected_outside_per_fix, 2)
-        )),
-        nis_verdict: n.verdict.to_string(),
-        settings: vec![
-            row(
-                "p_{c}(t_{0}), mean of p(0)",
-                format!("{} m", short(f.initial_position_mean_m)),
-            ),
-            row(
-                "v_{c}(t_{0}), mean of v(0)",
-                format!("{} m/s", short(f.initial_velocity_mean_m_s)),
-            ),
-            row(
-                "σ of p(0)",
-                format!("{} m", short(f.initial_position_sigma_m)),
-            ),
-            row(
-                "σ of v(0)",
-                format!("{} m/s", short(f.initial_velocity_sigma_m_s)),
-            ),
-            row(
-                "σ of the bias prior",
-                format!("{} m/s²", short(f.bias_var_m2_s4.sqrt())),
-            ),
-            row(
-                "accelerometer noise variance W",
-                format!("{} (m/s²)²", short(f.accel_noise_var_m2_s4)),
-            ),
-            row(
-                "GPS position σ",
-                format!("{} m", short(f.gps_position_sigma_m)),
-            ),
-            row(
-                "GPS velocity σ",
-                format!("{} m/s", short(f.gps_velocity_sigma_m_s)),
-            ),
-            row("configured Δt", seconds(s.nominal_dt_s)),
-        ],
-        figures,
-        command: command.to_string(),
-    })
+        ),
+    ]
+}
+
+/// The NIS test in words, as HTML.
+fn nis_words(s: &Summary) -> String {
+    let n = &s.nis;
+    rich(&format!(
+        "The NIS of the {} fixes sum to {} (mean {}). For a consistent filter the sum is \
+         χ²({}) and lies in [{}, {}] with probability 1 − α = {} (α/2 in each tail, \
+         α = checks.false_alarm_rate): {}. {} of the fixes fall outside the per-fix band; \
+         about {} would by chance. This is the only consistency check real data allows: it \
+         needs no truth.",
+        count(n.fixes as u64),
+        sig(n.sum, 5),
+        sig(n.mean, 4),
+        count(n.dof),
+        sig(n.lower, 5),
+        sig(n.upper, 5),
+        percent(1.0 - n.false_alarm_rate),
+        if n.verdict == "pass" {
+            "the sum is inside, the residuals are as large as the filter predicts"
+        } else if n.sum > n.upper {
+            "the sum is above the band, the residuals are larger than the filter predicts \
+             (its noise statistics are too small, or the model misses something)"
+        } else {
+            "the sum is below the band, the residuals are smaller than the filter predicts \
+             (its noise statistics are too large)"
+        },
+        count(n.outside_per_fix as u64),
+        sig(n.expected_outside_per_fix, 2)
+    ))
+}
+
+/// The filter's assumptions.
+fn settings(s: &Summary) -> Vec<Row> {
+    let f = &s.filter;
+    vec![
+        row(
+            "p_{c}(t_{0}), mean of p(0)",
+            format!("{} m", short(f.initial_position_mean_m)),
+        ),
+        row(
+            "v_{c}(t_{0}), mean of v(0)",
+            format!("{} m/s", short(f.initial_velocity_mean_m_s)),
+        ),
+        row(
+            "σ of p(0)",
+            format!("{} m", short(f.initial_position_sigma_m)),
+        ),
+        row(
+            "σ of v(0)",
+            format!("{} m/s", short(f.initial_velocity_sigma_m_s)),
+        ),
+        row(
+            "σ of the bias prior",
+            format!("{} m/s²", short(f.bias_var_m2_s4.sqrt())),
+        ),
+        row(
+            "accelerometer noise variance W",
+            format!("{} (m/s²)²", short(f.accel_noise_var_m2_s4)),
+        ),
+        row(
+            "GPS position σ",
+            format!("{} m", short(f.gps_position_sigma_m)),
+        ),
+        row(
+            "GPS velocity σ",
+            format!("{} m/s", short(f.gps_velocity_sigma_m_s)),
+        ),
+        row("configured Δt", seconds(s.nominal_dt_s)),
+    ]
 }
 
 /// Renders the page of `cal` as HTML; `command` wrote it.

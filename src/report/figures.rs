@@ -2,7 +2,7 @@
 //! from the [`super::outline`].
 
 use super::RenderError;
-use super::outline::{Figure, Numbers};
+use super::outline::{CheckFigure, Figure, Numbers};
 use super::prose::{case_title, letter};
 use super::rich::rich;
 use super::view::FigureView;
@@ -10,55 +10,6 @@ use crate::checks::{CheckId, Verdicts};
 use crate::format::{count, fixed, percent, sig};
 use crate::plot;
 use crate::study::{CaseOutcome, Study};
-
-/// A figure that shows the members of one or more checks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum CheckFigure {
-    /// The ensemble mean error.
-    MeanError,
-    /// Ensemble against filter variance.
-    Covariance,
-    /// Error–estimate correlations.
-    Orthogonality,
-    /// Residual correlations over pairs of fixes.
-    Whiteness,
-    /// NEES and NIS.
-    Consistency,
-}
-
-impl CheckFigure {
-    /// The check figures, in the order the report shows them.
-    pub const ALL: [CheckFigure; 5] = [
-        CheckFigure::MeanError,
-        CheckFigure::Covariance,
-        CheckFigure::Orthogonality,
-        CheckFigure::Whiteness,
-        CheckFigure::Consistency,
-    ];
-
-    /// The figure that shows check `id`; `None` for a check that has no figure of its own.
-    pub fn of(id: CheckId) -> Option<Self> {
-        Some(match id {
-            CheckId::MEAN_ERROR => CheckFigure::MeanError,
-            // The correlations are the off-diagonal terms of the covariance the figure compares.
-            CheckId::COVARIANCE_MATCH | CheckId::COVARIANCE_CORRELATION => CheckFigure::Covariance,
-            CheckId::ORTHOGONALITY => CheckFigure::Orthogonality,
-            CheckId::RESIDUAL_WHITENESS => CheckFigure::Whiteness,
-            CheckId::NEES | CheckId::NIS => CheckFigure::Consistency,
-            _ => return None,
-        })
-    }
-
-    fn id(self) -> &'static str {
-        match self {
-            CheckFigure::MeanError => "fig-mean-error",
-            CheckFigure::Covariance => "fig-covariance",
-            CheckFigure::Orthogonality => "fig-orthogonality",
-            CheckFigure::Whiteness => "fig-whiteness",
-            CheckFigure::Consistency => "fig-consistency",
-        }
-    }
-}
 
 /// Removes the SVG namespace declaration: inline SVG in HTML needs none, and the report then
 /// holds no address at all.

@@ -4,10 +4,11 @@
 use askama::Template;
 
 use super::equations::Equations;
-use super::view::{
-    AbstractView, AppendixView, CaseView, ConclusionsView, PerformanceView, ProblemView,
-    ReportView, ResultsView, SectionNode, SectionView, SensitivityView, TheoryView,
+use super::page::{
+    AbstractView, AppendixView, ConclusionsView, PerformanceView, ProblemView, ReportView,
+    ResultsView, SectionNode, SectionView, TheoryView,
 };
+use super::view::{CaseView, SensitivityView};
 
 /// The report page.
 #[derive(Template)]

@@ -2,7 +2,8 @@
 //! it returns the page and its view as text, and the caller writes them.
 //!
 //! Layers: [`outline`] orders the sections and numbers every table, figure and equation;
-//! [`sections`] builds each section's view ([`view`]) from the study, with [`prose`] and
+//! [`sections`] builds each section's view ([`page`], with the rows and cells of [`view`]) from
+//! the study, with [`prose`] and
 //! [`params`] for the words and the parameter table, [`cases`] for the per-case tables,
 //! [`figures`] for the figures and [`equations`] for every formula as MathML; [`html`] fills one
 //! template per section, and the templates under `templates/` only place that text.
@@ -14,6 +15,7 @@ pub mod figures;
 pub mod html;
 pub mod math;
 pub mod outline;
+pub mod page;
 pub mod params;
 pub mod prose;
 pub mod rich;
@@ -28,7 +30,7 @@ use crate::study::Study;
 use equations::Equations;
 use math::Math;
 use outline::Outline;
-use view::{ReportView, SectionNode, TocEntry};
+use page::{ReportView, SectionNode, TocEntry};
 
 /// The report could not be rendered.
 #[derive(Debug, thiserror::Error)]

@@ -9,7 +9,7 @@
 
 use std::collections::HashMap;
 
-use super::figures::CheckFigure;
+use crate::checks::CheckId;
 
 /// A section of the report page.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -265,5 +265,55 @@ impl Numbers {
     /// The number of equation `e`.
     pub fn equation(&self, e: Equation) -> usize {
         self.of(Label::Equation(e))
+    }
+}
+
+/// A figure that shows the members of one or more checks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CheckFigure {
+    /// The ensemble mean error.
+    MeanError,
+    /// Ensemble against filter variance.
+    Covariance,
+    /// Error–estimate correlations.
+    Orthogonality,
+    /// Residual correlations over pairs of fixes.
+    Whiteness,
+    /// NEES and NIS.
+    Consistency,
+}
+
+impl CheckFigure {
+    /// The check figures, in the order the report shows them.
+    pub const ALL: [CheckFigure; 5] = [
+        CheckFigure::MeanError,
+        CheckFigure::Covariance,
+        CheckFigure::Orthogonality,
+        CheckFigure::Whiteness,
+        CheckFigure::Consistency,
+    ];
+
+    /// The figure that shows check `id`; `None` for a check that has no figure of its own.
+    pub fn of(id: CheckId) -> Option<Self> {
+        Some(match id {
+            CheckId::MEAN_ERROR => CheckFigure::MeanError,
+            // The correlations are the off-diagonal terms of the covariance the figure compares.
+            CheckId::COVARIANCE_MATCH | CheckId::COVARIANCE_CORRELATION => CheckFigure::Covariance,
+            CheckId::ORTHOGONALITY => CheckFigure::Orthogonality,
+            CheckId::RESIDUAL_WHITENESS => CheckFigure::Whiteness,
+            CheckId::NEES | CheckId::NIS => CheckFigure::Consistency,
+            _ => return None,
+        })
+    }
+
+    /// The element id stem of the figure.
+    pub fn id(self) -> &'static str {
+        match self {
+            CheckFigure::MeanError => "fig-mean-error",
+            CheckFigure::Covariance => "fig-covariance",
+            CheckFigure::Orthogonality => "fig-orthogonality",
+            CheckFigure::Whiteness => "fig-whiteness",
+            CheckFigure::Consistency => "fig-consistency",
+        }
     }
 }

@@ -6,15 +6,26 @@ use super::view::ParamRow;
 use crate::format::{count, fixed, percent, sig};
 use crate::study::Study;
 
-/// The rows of the parameter table (truth and run settings).
-pub fn params(study: &Study) -> Vec<ParamRow> {
-    let c = &study.model.config;
-    let row = |q: &str, v: String, u: &str, f: &str| ParamRow {
+/// A row: quantity (with `_{…}` notation), value, unit, configuration field.
+fn row(q: &str, v: String, u: &str, f: &str) -> ParamRow {
+    ParamRow {
         quantity_html: rich(q),
         value: v,
         unit: u.to_string(),
         field: f.to_string(),
-    };
+    }
+}
+
+/// The rows of the parameter table (truth and run settings).
+pub fn params(study: &Study) -> Vec<ParamRow> {
+    let mut rows = motion_and_accelerometer(study);
+    rows.extend(gps_prior_and_run(study));
+    rows
+}
+
+/// The rows of the acceleration profile and the accelerometer.
+fn motion_and_accelerometer(study: &Study) -> Vec<ParamRow> {
+    let c = &study.model.config;
     vec![
         row(
             "acceleration amplitude A",
@@ -72,6 +83,13 @@ pub fn params(study: &Study) -> Vec<ParamRow> {
             "",
             "accelerometer.output",
         ),
+    ]
+}
+
+/// The rows of the GPS, the prior and the run.
+fn gps_prior_and_run(study: &Study) -> Vec<ParamRow> {
+    let c = &study.model.config;
+    vec![
         row(
             "GPS rate",
             sig(c.gps.sample_rate_hz, 3),

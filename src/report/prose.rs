@@ -6,6 +6,7 @@
 use crate::checks::{Check, CheckId, FailureWords, Verdict};
 use crate::config::{AccelerometerOutput, Case, TruthModel};
 use crate::format::{count, fixed, percent, sig};
+use crate::state::ErrorState;
 use crate::study::{CaseOutcome, Study};
 
 /// The case in words.
@@ -170,6 +171,37 @@ pub fn abstract_findings(study: &Study, differences: &[String]) -> String {
             differences.join("; ")
         ));
     }
+    s.push_str(&verdict_findings(study, differences));
+    for o in study
+        .cases
+        .iter()
+        .filter(|o| o.case.truth == TruthModel::Analytic)
+    {
+        s.push_str(&accuracy_sentence(study, o));
+        s.push_str(&deterministic_mean_error(o));
+        s.push(' ');
+    }
+    let untestable: Vec<String> = study
+        .cases
+        .iter()
+        .flat_map(untestable_list)
+        .map(String::from)
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    if !untestable.is_empty() {
+        s.push_str(&format!(
+            "At N = {} the {} checks cannot fail and are reported as untestable. ",
+            count(study.model.config.ensemble.realizations),
+            and_list(&untestable)
+        ));
+    }
+    s.trim_end().to_string()
+}
+
+/// Which cases pass every check and which fail what, in a sentence.
+fn verdict_findings(study: &Study, differences: &[String]) -> String {
+    let mut s = String::new();
     let consistent: Vec<String> = study
         .cases
         .iter()
@@ -214,47 +246,28 @@ pub fn abstract_findings(study: &Study, differences: &[String]) -> String {
             ". "
         });
     }
-    for o in study
-        .cases
-        .iter()
-        .filter(|o| o.case.truth == TruthModel::Analytic)
-    {
-        s.push_str(&accuracy_sentence(study, o));
-        if !o.verdicts.all_passed() && o.verdicts.get(CheckId::MEAN_ERROR).verdict == Verdict::Fail
-        {
-            s.push_str(&format!(
-                " Its mean error is deterministic: one noise-free pass of the filter predicts it {}.",
-                if explained(o) {
-                    format!(
-                        "to within {} standard errors, inside the check's bound",
-                        fixed(o.prediction.worst_se, 1)
-                    )
-                } else {
-                    format!(
-                        "only to within {} standard errors, beyond the check's bound",
-                        fixed(o.prediction.worst_se, 1)
-                    )
-                }
-            ));
+    s
+}
+
+/// " Its mean error is deterministic: …" when case `o` fails the mean-error check; else empty.
+fn deterministic_mean_error(o: &CaseOutcome) -> String {
+    if o.verdicts.all_passed() || o.verdicts.get(CheckId::MEAN_ERROR).verdict != Verdict::Fail {
+        return String::new();
+    }
+    format!(
+        " Its mean error is deterministic: one noise-free pass of the filter predicts it {}.",
+        if explained(o) {
+            format!(
+                "to within {} standard errors, inside the check's bound",
+                fixed(o.prediction.worst_se, 1)
+            )
+        } else {
+            format!(
+                "only to within {} standard errors, beyond the check's bound",
+                fixed(o.prediction.worst_se, 1)
+            )
         }
-        s.push(' ');
-    }
-    let untestable: Vec<String> = study
-        .cases
-        .iter()
-        .flat_map(untestable_list)
-        .map(String::from)
-        .collect::<std::collections::BTreeSet<_>>()
-        .into_iter()
-        .collect();
-    if !untestable.is_empty() {
-        s.push_str(&format!(
-            "At N = {} the {} checks cannot fail and are reported as untestable. ",
-            count(study.model.config.ensemble.realizations),
-            and_list(&untestable)
-        ));
-    }
-    s.trim_end().to_string()
+    )
 }
 
 /// The velocity lag of the Euler (left Riemann) sum behind the integral of a(t): about
@@ -276,120 +289,12 @@ pub fn conclusions(
     dynamics_eq: usize,
     accuracy_table: usize,
 ) -> Vec<String> {
-    let c = &study.model.config;
-    let r = &study.realization;
-    let last = r.fixes.last().expect("at least two fixes");
-    let claimed = claimed_sigma(study);
-    let prior = c.filter_bias_var_m2_s4().sqrt();
-    let mut out = Vec::new();
-    // The bias calibration, as achieved in the physically real consistent case if there is one.
-    let real = study
-        .cases
-        .iter()
-        .find(|o| o.case.truth == TruthModel::Analytic && o.verdicts.all_passed());
-    let bias_err = (last.post[2] - r.bias_m_s2) / last.sigma_post[2];
-    out.push(match real {
-        Some(o) => format!(
-            "The calibration reaches a bias RMS error of {} m/s² after {} s over the {} realizations of {}, {} times smaller than the prior {} m/s², and the filter's own σ, {} m/s², matches it. In the recorded realization the estimate {} m/s² lies {} σ from the true {} m/s².",
-            sig(o.achieved_rms_final()[2], 2),
-            fixed(last.t_s, 1),
-            count(o.run.stats.realizations),
-            named(study, o),
-            sig(prior / o.achieved_rms_final()[2], 2),
-            sig(prior, 2),
-            sig(claimed[2], 2),
-            sig(last.post[2], 3),
-            fixed(bias_err.abs(), 1),
-            sig(r.bias_m_s2, 3),
-        ),
-        None => format!(
-            "No physically real case is consistent in this run, so the filter's σ of {} m/s² for the bias after {} s is only its claim; the accuracy achieved is in Table {accuracy_table}.",
-            sig(claimed[2], 2),
-            fixed(last.t_s, 1),
-        ),
-    });
-    let consistent: Vec<&CaseOutcome> = study
-        .cases
-        .iter()
-        .filter(|o| o.verdicts.all_passed())
-        .collect();
-    if let Some(first) = consistent.first() {
-        let names: Vec<String> = consistent.iter().map(|o| named(study, o)).collect();
-        let (subject, these) = if consistent.len() == 1 {
-            (format!("With {}", names[0]), "this case")
-        } else {
-            (format!("With {}", and_list(&names)), "these cases")
-        };
-        out.push(format!(
-            "{subject}, every check passes over N = {} realizations each at a study-wide false-alarm rate of {}: the mean error is zero within its bounds, the ensemble variance matches P, errors are orthogonal to estimates, the residuals are white over {}, and NEES and NIS stay in their χ² bands. The filter is consistent with {these}.",
-            count(first.run.stats.realizations),
-            percent(first.verdicts.false_alarm_rate),
-            whiteness_pairs(first),
-        ));
-    }
+    let mut out = vec![bias_paragraph(study, accuracy_table)];
+    out.extend(consistent_paragraph(study));
     for o in study.cases.iter().filter(|o| !o.verdicts.all_passed()) {
-        let v = &o.verdicts;
-        let passed = v.checks.iter().filter(|c| c.passed()).count();
-        let fix_times_s: Vec<f64> = o.run.stats.fixes.iter().map(|f| f.time_s).collect();
-        let mut s = format!(
-            "With {}, {passed} of {} checks pass. ",
-            named(study, o),
-            v.checks.len()
-        );
-        let untestable: Vec<String> = v
-            .checks
-            .iter()
-            .filter(|c| matches!(c.verdict, Verdict::Untestable(_)))
-            .map(|c| {
-                format!(
-                    "{} (needs N ≥ {})",
-                    c.definition.title,
-                    count(c.min_realizations)
-                )
-            })
-            .collect();
-        if !untestable.is_empty() {
-            s.push_str(&format!(
-                "At N = {} the {} checks are untestable, so they say nothing about this filter. ",
-                count(o.run.stats.realizations),
-                and_list(&untestable),
-            ));
-        }
-        let sentences: Vec<String> = v
-            .failed()
-            .map(|c| failure_sentence(c, &fix_times_s))
-            .collect();
-        s.push_str(&sentences.join(" "));
-        if o.case.output == AccelerometerOutput::Sample
-            && o.case.truth == TruthModel::Analytic
-            && v.get(CheckId::MEAN_ERROR).verdict == Verdict::Fail
-            && explained(o)
-        {
-            s.push_str(&format!(
-                " The cause is the assumption behind eq. ({dynamics_eq}): the point-sampled accelerometer's Euler integration lags the closed-form integral by a deterministic amount, about (Δt/2)·a(t) in velocity and up to Δt·A/2 = {} m/s, which the filter partly mistakes for bias. One noise-free pass of the filter predicts the mean error to within {} standard errors.",
-                euler_velocity_drift(study),
-                fixed(o.prediction.worst_se, 1)
-            ));
-        }
-        out.push(s);
+        out.push(failing_paragraph(study, o, dynamics_eq));
     }
-    // What it means for a user, when the data shows it.
-    let sample = study.cases.iter().find(|o| {
-        o.case.truth == TruthModel::Analytic && o.case.output == AccelerometerOutput::Sample
-    });
-    let interval = study.cases.iter().find(|o| {
-        o.case.truth == TruthModel::Analytic && o.case.output == AccelerometerOutput::IntervalMean
-    });
-    if let (Some(b), Some(m)) = (sample, interval)
-        && !b.verdicts.all_passed()
-        && m.verdicts.all_passed()
-    {
-        let ratio = b.achieved_rms_final()[1] / claimed[1];
-        out.push(format!(
-            "For a user: an accelerometer that reports point samples, integrated by the Euler rule, leaves a velocity lag that the filter's model does not contain, and the filter's σ then understates the velocity error {} times. Either model the lag — the noise-free pass above computes it exactly and can be subtracted — or use an accelerometer's delta-velocity (interval-mean) output, with which every check passes and the claimed σ is the accuracy achieved.",
-            fixed(ratio, 2)
-        ));
-    }
+    out.extend(user_paragraph(study));
     if !differences.is_empty() {
         out.push(format!(
             "This run's filter was deliberately given statistics that differ from the truth ({}); the checks above measure the consequences.",
@@ -397,6 +302,131 @@ pub fn conclusions(
         ));
     }
     out
+}
+
+/// The bias calibration, as achieved in the physically real consistent case if there is one.
+fn bias_paragraph(study: &Study, accuracy_table: usize) -> String {
+    let b = ErrorState::BIAS;
+    let r = &study.realization;
+    let last = r.fixes.last().expect("at least two fixes");
+    let claimed = claimed_sigma(study);
+    let prior = study.model.config.filter_bias_var_m2_s4().sqrt();
+    let real = study
+        .cases
+        .iter()
+        .find(|o| o.case.truth == TruthModel::Analytic && o.verdicts.all_passed());
+    let bias_err = (last.post[b] - r.bias_m_s2) / last.sigma_post[b];
+    match real {
+        Some(o) => format!(
+            "The calibration reaches a bias RMS error of {} m/s² after {} s over the {} realizations of {}, {} times smaller than the prior {} m/s², and the filter's own σ, {} m/s², matches it. In the recorded realization the estimate {} m/s² lies {} σ from the true {} m/s².",
+            sig(o.achieved_rms_final()[b], 2),
+            fixed(last.t_s, 1),
+            count(o.run.stats.realizations),
+            named(study, o),
+            sig(prior / o.achieved_rms_final()[b], 2),
+            sig(prior, 2),
+            sig(claimed[b], 2),
+            sig(last.post[b], 3),
+            fixed(bias_err.abs(), 1),
+            sig(r.bias_m_s2, 3),
+        ),
+        None => format!(
+            "No physically real case is consistent in this run, so the filter's σ of {} m/s² for the bias after {} s is only its claim; the accuracy achieved is in Table {accuracy_table}.",
+            sig(claimed[b], 2),
+            fixed(last.t_s, 1),
+        ),
+    }
+}
+
+/// What the cases that pass every check show; `None` when none does.
+fn consistent_paragraph(study: &Study) -> Option<String> {
+    let consistent: Vec<&CaseOutcome> = study
+        .cases
+        .iter()
+        .filter(|o| o.verdicts.all_passed())
+        .collect();
+    let first = consistent.first()?;
+    let names: Vec<String> = consistent.iter().map(|o| named(study, o)).collect();
+    let (subject, these) = if consistent.len() == 1 {
+        (format!("With {}", names[0]), "this case")
+    } else {
+        (format!("With {}", and_list(&names)), "these cases")
+    };
+    Some(format!(
+        "{subject}, every check passes over N = {} realizations each at a study-wide false-alarm rate of {}: the mean error is zero within its bounds, the ensemble variance matches P, errors are orthogonal to estimates, the residuals are white over {}, and NEES and NIS stay in their χ² bands. The filter is consistent with {these}.",
+        count(first.run.stats.realizations),
+        percent(first.verdicts.false_alarm_rate),
+        whiteness_pairs(first),
+    ))
+}
+
+/// What failed in case `o` and why; `dynamics_eq` is the error-dynamics equation's number.
+fn failing_paragraph(study: &Study, o: &CaseOutcome, dynamics_eq: usize) -> String {
+    let v = &o.verdicts;
+    let passed = v.checks.iter().filter(|c| c.passed()).count();
+    let fix_times_s: Vec<f64> = o.run.stats.fixes.iter().map(|f| f.time_s).collect();
+    let mut s = format!(
+        "With {}, {passed} of {} checks pass. ",
+        named(study, o),
+        v.checks.len()
+    );
+    let untestable: Vec<String> = v
+        .checks
+        .iter()
+        .filter(|c| matches!(c.verdict, Verdict::Untestable(_)))
+        .map(|c| {
+            format!(
+                "{} (needs N ≥ {})",
+                c.definition.title,
+                count(c.min_realizations)
+            )
+        })
+        .collect();
+    if !untestable.is_empty() {
+        s.push_str(&format!(
+            "At N = {} the {} checks are untestable, so they say nothing about this filter. ",
+            count(o.run.stats.realizations),
+            and_list(&untestable),
+        ));
+    }
+    let sentences: Vec<String> = v
+        .failed()
+        .map(|c| failure_sentence(c, &fix_times_s))
+        .collect();
+    s.push_str(&sentences.join(" "));
+    if o.case.output == AccelerometerOutput::Sample
+        && o.case.truth == TruthModel::Analytic
+        && v.get(CheckId::MEAN_ERROR).verdict == Verdict::Fail
+        && explained(o)
+    {
+        s.push_str(&format!(
+            " The cause is the assumption behind eq. ({dynamics_eq}): the point-sampled accelerometer's Euler integration lags the closed-form integral by a deterministic amount, about (Δt/2)·a(t) in velocity and up to Δt·A/2 = {} m/s, which the filter partly mistakes for bias. One noise-free pass of the filter predicts the mean error to within {} standard errors.",
+            euler_velocity_drift(study),
+            fixed(o.prediction.worst_se, 1)
+        ));
+    }
+    s
+}
+
+/// What it means for a user, when the data shows it: point samples fail where interval means pass.
+fn user_paragraph(study: &Study) -> Option<String> {
+    let find = |output| {
+        study
+            .cases
+            .iter()
+            .find(|o| o.case.truth == TruthModel::Analytic && o.case.output == output)
+    };
+    let sample = find(AccelerometerOutput::Sample)?;
+    let interval = find(AccelerometerOutput::IntervalMean)?;
+    if sample.verdicts.all_passed() || !interval.verdicts.all_passed() {
+        return None;
+    }
+    let v = ErrorState::VELOCITY;
+    let ratio = sample.achieved_rms_final()[v] / claimed_sigma(study)[v];
+    Some(format!(
+        "For a user: an accelerometer that reports point samples, integrated by the Euler rule, leaves a velocity lag that the filter's model does not contain, and the filter's σ then understates the velocity error {} times. Either model the lag — the noise-free pass above computes it exactly and can be subtracted — or use an accelerometer's delta-velocity (interval-mean) output, with which every check passes and the claimed σ is the accuracy achieved.",
+        fixed(ratio, 2)
+    ))
 }
 
 /// The share of each of `checks` checks, in words: "0.14 %".

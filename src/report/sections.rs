@@ -5,10 +5,11 @@ use super::cases::{self, case_label, states};
 use super::figures;
 use super::math::Math;
 use super::outline::{Equation, Numbers, Section, Table};
-use super::view::{
-    AbstractView, AppendixView, CatalogueEntry, ConclusionsView, EquationNumbers, IntroductionView,
-    PerformanceView, ProblemView, ResultsView, SectionView, TheoryView,
+use super::page::{
+    AbstractView, AppendixView, ConclusionsView, IntroductionView, PerformanceView, ProblemView,
+    ResultsView, SectionView, TheoryView,
 };
+use super::view::{CatalogueEntry, EquationNumbers};
 use super::{RenderError, ReportInput, params, prose, rich, sensitivity};
 use crate::format::{count, fixed, percent, short, sig};
 use crate::state::ErrorState;
@@ -43,25 +44,25 @@ impl Context<'_> {
         Ok(match section {
             Section::Abstract => SectionView::Abstract(self.abstract_view()),
             Section::Introduction => SectionView::Introduction(IntroductionView {}),
-            Section::Problem => SectionView::Problem(self.problem()?),
-            Section::Theory => SectionView::Theory(self.theory()),
-            Section::Results => SectionView::Results(self.results()?),
+            Section::Problem => SectionView::Problem(Box::new(self.problem()?)),
+            Section::Theory => SectionView::Theory(Box::new(self.theory())),
+            Section::Results => SectionView::Results(Box::new(self.results()?)),
             Section::Case(i) => {
                 let o = &study.cases[i];
                 let n = self.numbers;
                 let tables = (n.table(Table::Checks(i)), n.table(Table::Pair(i)));
                 let figures = figures::check_figures(o, i, n)?;
                 let claimed = prose::claimed_sigma(study);
-                SectionView::Case(cases::case_view(o, i, tables, figures, claimed))
+                SectionView::Case(Box::new(cases::case_view(o, i, tables, figures, claimed)))
             }
             Section::Performance => SectionView::Performance(self.performance()),
-            Section::Sensitivity => SectionView::Sensitivity(sensitivity::view(
+            Section::Sensitivity => SectionView::Sensitivity(Box::new(sensitivity::view(
                 study
                     .sensitivity
                     .as_ref()
                     .expect("the outline shows sensitivity only when the study ran it"),
                 self.numbers,
-            )?),
+            )?)),
             Section::Conclusions => SectionView::Conclusions(self.conclusions()),
             Section::Appendix => SectionView::Appendix(AppendixView {
                 command: self.input.command.to_string(),

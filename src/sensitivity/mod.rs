@@ -11,6 +11,7 @@
 
 pub mod covariance;
 pub mod detection;
+mod prediction;
 pub mod sampler;
 
 use crate::checks::{self, Budget, CheckId, Verdict};
@@ -320,7 +321,7 @@ pub fn run(
     progress.start_in("predict", grid.len() as u64 * draws, "sampled ensembles");
     let mut cases = Vec::with_capacity(grid.len());
     for &(parameter, factor) in &grid {
-        let predictions = Predictions {
+        let predictions = prediction::Predictions {
             world: &world,
             plan,
             budget: &budget,
@@ -355,66 +356,6 @@ pub fn run(
         tuned_sigma_final: sigma(&tuned_schedule.fixes.last().expect("fixes").p_post),
         cases,
     })
-}
-
-/// What the predictions of every case share.
-struct Predictions<'a> {
-    world: &'a Config,
-    plan: &'a Plan,
-    budget: &'a Budget,
-    draws: u64,
-    seed: u64,
-}
-
-impl Predictions<'_> {
-    /// The exact and sampled predictions for `parameter` × `factor`, without simulation.
-    fn case(
-        &self,
-        parameter: AssumedStatistic,
-        factor: f64,
-    ) -> Result<SensitivityCase, SensitivityError> {
-        let (plan, budget, draws) = (self.plan, self.budget, self.draws);
-        let (model, schedule) = mistuned(self.world, parameter, factor)?;
-        let actual = actual_covariance(&model.timeline, &schedule, &model.truth_stats);
-        let (last_fix, last_actual) = (
-            schedule.fixes.last().expect("fixes"),
-            actual.last().expect("fixes"),
-        );
-        let bounds = CheckId::ALL
-            .iter()
-            .map(|&id| detection::predicted(id, &schedule, &actual, plan.realizations, budget))
-            .collect();
-        let predicted = if draws > 0 {
-            sampler::Sampler::new(
-                &model.timeline,
-                &schedule,
-                &model.truth_stats,
-                plan.realizations,
-                model.residual_pair,
-            )
-            .detection(
-                &schedule,
-                budget,
-                draws,
-                case_seed(self.seed, SAMPLED, parameter, factor),
-            )
-        } else {
-            vec![None; CheckId::ALL.len()]
-        };
-        Ok(SensitivityCase {
-            parameter,
-            factor,
-            claimed_sigma_final: sigma(&last_fix.p_post),
-            actual_sigma_final: sigma(&last_actual.post),
-            expected_nees_final: covariance::weights(&last_fix.p_post_inv, &last_actual.post).0,
-            expected_nis_final: covariance::weights(&last_fix.s_inv, &last_actual.innovation).0,
-            predicted,
-            draws,
-            bounds,
-            ensembles: plan.ensembles,
-            detected: None,
-        })
-    }
 }
 
 /// Runs the Monte Carlo ensembles of `case` and counts, per check in [`CheckId::ALL`] order,
