@@ -1,7 +1,8 @@
 //! The variance check: the ensemble variance equals the filter's P.
 
-use super::catalogue::{CheckId, Definition, FailureWords, Null};
+use super::catalogue::{CheckId, Definition, FailureWords, MemberId, Null};
 use super::members;
+use crate::ensemble::Statistics;
 use crate::format::sig;
 
 /// The ensemble variance equals the filter's.
@@ -22,7 +23,7 @@ pub const CHECK: Definition = Definition {
         dof: n - 1.0,
         scale: n - 1.0,
     },
-    for_each_member: |stats, f| members::for_each(CheckId::COVARIANCE_MATCH, stats, f),
+    for_each_member,
     failure: |c, w| {
         let FailureWords { outside, band, at } = w;
         format!(
@@ -31,3 +32,12 @@ pub const CHECK: Definition = Definition {
         )
     },
 };
+
+/// P_ave,kk / P_kk for every state of every stage at every fix.
+fn for_each_member(stats: &dyn Statistics, f: &mut dyn FnMut(f64, MemberId)) {
+    members::per_state(stats, &mut |i, stage, k, s| {
+        let value = s.ensemble_cov(k, k) / s.filter_cov(k, k);
+        let (fix, state) = (i as u32, k);
+        f(value, MemberId::State { fix, stage, state });
+    });
+}

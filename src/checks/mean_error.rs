@@ -1,7 +1,8 @@
 //! The mean-error check: the ensemble mean error is zero.
 
-use super::catalogue::{CheckId, Definition, FailureWords, Null};
+use super::catalogue::{CheckId, Definition, FailureWords, MemberId, Null};
 use super::members;
+use crate::ensemble::Statistics;
 use crate::format::fixed;
 
 /// The ensemble mean error is zero.
@@ -19,7 +20,7 @@ pub const CHECK: Definition = Definition {
                  mean error divided by it is a standard normal score.",
     formula: r"e^{\mathrm{ave}}(t_i) = \frac{1}{N} \sum_{l=1}^{N} e^l(t_i), \qquad z = \frac{e^{\mathrm{ave}}_k(t_i)}{\sqrt{P_{kk}(t_i)/N}} \sim \mathcal{N}(0, 1)",
     null: |_, _| Null::Normal,
-    for_each_member: |stats, f| members::for_each(CheckId::MEAN_ERROR, stats, f),
+    for_each_member,
     failure: |c, w| {
         let FailureWords { outside, at, .. } = w;
         format!(
@@ -29,3 +30,13 @@ pub const CHECK: Definition = Definition {
         )
     },
 };
+
+/// z for every state of every stage at every fix.
+fn for_each_member(stats: &dyn Statistics, f: &mut dyn FnMut(f64, MemberId)) {
+    let n = stats.realizations() as f64;
+    members::per_state(stats, &mut |i, stage, k, s| {
+        let value = s.mean_error[k] / (s.filter_cov(k, k) / n).sqrt();
+        let (fix, state) = (i as u32, k);
+        f(value, MemberId::State { fix, stage, state });
+    });
+}

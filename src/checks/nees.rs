@@ -1,7 +1,8 @@
 //! The NEES check: the average NEES is 3, the state dimension.
 
-use super::catalogue::{CheckId, Definition, FailureWords, Null};
+use super::catalogue::{CheckId, Definition, FailureWords, MemberId, Null};
 use super::members;
+use crate::ensemble::Statistics;
 use crate::format::sig;
 
 /// The average normalized estimation error squared is the state dimension.
@@ -21,7 +22,7 @@ pub const CHECK: Definition = Definition {
         dof: dims.states as f64 * n,
         scale: n,
     },
-    for_each_member: |stats, f| members::for_each(CheckId::NEES, stats, f),
+    for_each_member,
     failure: |c, w| {
         let FailureWords { outside, band, at } = w;
         format!(
@@ -30,3 +31,11 @@ pub const CHECK: Definition = Definition {
         )
     },
 };
+
+/// The average NEES of every stage at every fix.
+fn for_each_member(stats: &dyn Statistics, f: &mut dyn FnMut(f64, MemberId)) {
+    members::per_stage(stats, &mut |i, stage, s| {
+        let fix = i as u32;
+        f(s.nees_avg, MemberId::Nees { fix, stage });
+    });
+}

@@ -1,7 +1,7 @@
 //! The NIS check: the average NIS is 2, the measurement dimension.
 
-use super::catalogue::{CheckId, Definition, FailureWords, Null};
-use super::members;
+use super::catalogue::{CheckId, Definition, FailureWords, MemberId, Null};
+use crate::ensemble::Statistics;
 use crate::format::sig;
 
 /// The average normalized innovation squared is the measurement dimension.
@@ -20,7 +20,7 @@ pub const CHECK: Definition = Definition {
         dof: dims.measurements as f64 * n,
         scale: n,
     },
-    for_each_member: |stats, f| members::for_each(CheckId::NIS, stats, f),
+    for_each_member,
     failure: |c, w| {
         let FailureWords { outside, band, at } = w;
         format!(
@@ -29,3 +29,10 @@ pub const CHECK: Definition = Definition {
         )
     },
 };
+
+/// The average NIS at every fix.
+fn for_each_member(stats: &dyn Statistics, f: &mut dyn FnMut(f64, MemberId)) {
+    for i in 0..stats.fix_count() {
+        f(stats.nis_avg(i), MemberId::Nis { fix: i as u32 });
+    }
+}

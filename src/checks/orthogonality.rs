@@ -1,7 +1,8 @@
 //! The orthogonality check: the error is orthogonal to the estimate.
 
-use super::catalogue::{CheckId, Definition, FailureWords, Null};
+use super::catalogue::{CheckId, Definition, FailureWords, MemberId, Null};
 use super::members;
+use crate::ensemble::Statistics;
 use crate::format::fixed;
 
 /// The error is uncorrelated with the estimate.
@@ -20,7 +21,7 @@ pub const CHECK: Definition = Definition {
                  deviation 1/√N; the score cannot exceed √N, so small ensembles cannot fail it.",
     formula: r"C(t_i) = \frac{1}{N} \sum_{l=1}^{N} \left(e^l(t_i) - e^{\mathrm{ave}}(t_i)\right) \dxhat^l(t_i)\T, \qquad z_{jk} = \sqrt{N}\, \frac{C_{jk}}{\sigma(e_j)\, \sigma(\widehat{\delta x}_k)} \approx \mathcal{N}(0, 1)",
     null: |_, _| Null::CorrelationScore,
-    for_each_member: |stats, f| members::for_each(CheckId::ORTHOGONALITY, stats, f),
+    for_each_member,
     failure: |c, w| {
         let FailureWords { outside, at, .. } = w;
         format!(
@@ -30,3 +31,29 @@ pub const CHECK: Definition = Definition {
         )
     },
 };
+
+/// √N·corr(e_j, δx̂_k) for every error and estimate state of every stage at every fix.
+fn for_each_member(stats: &dyn Statistics, f: &mut dyn FnMut(f64, MemberId)) {
+    let n = stats.realizations() as f64;
+    let states = stats.dims().states;
+    members::per_stage(stats, &mut |i, stage, s| {
+        for error in 0..states {
+            for estimate in 0..states {
+                let c = s.orthogonality_corr(error, estimate);
+                // NaN marks an estimate component that does not vary: nothing to test. Two
+                // constant states' a priori pair is the previous fix's a posteriori one.
+                let copy = stats.is_copy(i, stage, error) && stats.is_constant(estimate);
+                if c.is_finite() && !copy {
+                    let fix = i as u32;
+                    let member = MemberId::ErrorEstimate {
+                        fix,
+                        stage,
+                        error,
+                        estimate,
+                    };
+                    f(n.sqrt() * c, member);
+                }
+            }
+        }
+    });
+}

@@ -1,7 +1,8 @@
 //! The residual-whiteness check: residuals at different fixes are uncorrelated.
 
-use super::catalogue::{CheckId, Definition, FailureWords, Null};
+use super::catalogue::{CheckId, Definition, FailureWords, MemberId, Null};
 use super::members;
+use crate::ensemble::Statistics;
 use crate::format::fixed;
 
 /// Residuals at different fixes are uncorrelated.
@@ -20,7 +21,7 @@ pub const CHECK: Definition = Definition {
                  normalized the same way; its score cannot exceed √N either.",
     formula: r"z_{jk} = \sqrt{N}\, \frac{\sum_l r^l_j(t_i)\, r^l_k(t_m)}{\sqrt{\sum_l r^l_j(t_i)^2 \sum_l r^l_k(t_m)^2}} \approx \mathcal{N}(0, 1), \quad t_m < t_i",
     null: |_, _| Null::CorrelationScore,
-    for_each_member: |stats, f| members::for_each(CheckId::RESIDUAL_WHITENESS, stats, f),
+    for_each_member,
     failure: |c, w| {
         let FailureWords { outside, at, .. } = w;
         format!(
@@ -30,3 +31,26 @@ pub const CHECK: Definition = Definition {
         )
     },
 };
+
+/// z of every kept pair of residual components at two different fixes.
+fn for_each_member(stats: &dyn Statistics, f: &mut dyn FnMut(f64, MemberId)) {
+    let layout = stats.residual_layout();
+    let width = stats.dims().measurements;
+    for later in 1..stats.fix_count() {
+        for earlier in (0..later).filter(|&m| layout.keeps(later, m)) {
+            for at_later in 0..width {
+                for at_earlier in 0..width {
+                    let a = width * later + at_later;
+                    let b = width * earlier + at_earlier;
+                    let member = MemberId::ResidualPair {
+                        later: later as u32,
+                        earlier: earlier as u32,
+                        at_later,
+                        at_earlier,
+                    };
+                    f(members::residual_z(stats, a, b), member);
+                }
+            }
+        }
+    }
+}
