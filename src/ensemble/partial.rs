@@ -10,9 +10,9 @@ use std::io::{Read, Write};
 
 use serde::{Deserialize, Serialize};
 
-use super::Engine;
 use super::layout::ResidualLayout;
 use super::sums::{Accumulator, FixSums, StageSums};
+use super::{Engine, Partition, Shard};
 use crate::config::Config;
 
 /// The first line of every partial file.
@@ -75,9 +75,11 @@ pub enum PartialError {
 }
 
 /// Floats of one stage's sums.
-const STAGE_LEN: usize = 25;
-/// Floats of one fix's sums.
-const FIX_LEN: usize = 2 * STAGE_LEN + 1;
+const STAGE_LEN: usize = StageSums::FLOATS;
+/// Floats of one fix's sums: the a priori stage's, the a posteriori stage's, Σ NIS.
+const FIX_LEN: usize = FixSums::FLOATS;
+/// Floats of the single residual pair's products.
+const PAIR_LEN: usize = 4;
 
 fn stage_floats(s: &StageSums, out: &mut Vec<f64>) {
     out.extend(s.e.iter());
@@ -116,7 +118,7 @@ pub fn write_header(w: &mut impl Write, header: &PartialHeader) -> std::io::Resu
 /// The writer's error.
 pub fn write_block(w: &mut impl Write, index: u64, acc: &Accumulator) -> std::io::Result<()> {
     let mut floats =
-        Vec::with_capacity(acc.fixes.len() * FIX_LEN + acc.residual_products.len() + 4);
+        Vec::with_capacity(acc.fixes.len() * FIX_LEN + acc.residual_products.len() + PAIR_LEN);
     for f in &acc.fixes {
         stage_floats(&f.prior, &mut floats);
         stage_floats(&f.post, &mut floats);
@@ -184,7 +186,7 @@ pub fn read_block(
         .map_err(|_| truncated("a block count is cut"))?;
     let count = u64::from_le_bytes(word);
     let layout = ResidualLayout::new(header.fixes, header.max_lag);
-    let len = header.fixes * FIX_LEN + layout.len() + 4;
+    let len = header.fixes * FIX_LEN + layout.len() + PAIR_LEN;
     let mut bytes = vec![0u8; 8 * len];
     r.read_exact(&mut bytes)
         .map_err(|_| truncated(&format!("block {index} is cut")))?;
@@ -257,127 +259,27 @@ pub fn merge<R: std::io::BufRead>(files: Vec<(String, R)>) -> Result<Merged, Par
     let mut opened = Vec::with_capacity(files.len());
     for (name, mut r) in files {
         let header = read_header(&mut r, &name)?;
-        opened.push((name, header, r));
+        opened.push(Opened { name, header, r });
     }
-    let Some((first_name, first, _)) = opened.first() else {
-        return Err(PartialError::Mismatch {
-            file: "(none)".to_string(),
-            why: "no partial file given".to_string(),
-        });
+    let Some(first) = opened.first() else {
+        return Err(mismatch("(none)", "no partial file given".to_string()));
     };
-    let (first_name, first) = (first_name.clone(), first.clone());
-    let mismatch = |file: &str, why: String| PartialError::Mismatch {
-        file: file.to_string(),
-        why,
-    };
-    for (name, h, _) in &opened {
-        if h.config != first.config {
-            let what = if h.config.ensemble.seed != first.config.ensemble.seed {
-                format!(
-                    "seed {} differs from {first_name}'s {}",
-                    h.config.ensemble.seed, first.config.ensemble.seed
-                )
-            } else if h.config.ensemble.realizations != first.config.ensemble.realizations {
-                format!(
-                    "N = {} differs from {first_name}'s {}",
-                    h.config.ensemble.realizations, first.config.ensemble.realizations
-                )
-            } else {
-                format!(
-                    "its configuration differs from {first_name}'s at `{}`",
-                    first_difference(&h.config, &first.config)
-                )
-            };
-            return Err(mismatch(name, format!("another ensemble: {what}")));
-        }
-        if h.engine != first.engine {
-            return Err(mismatch(
-                name,
-                format!(
-                    "simulated by the {} engine, {first_name} by the {} engine",
-                    h.engine, first.engine
-                ),
-            ));
-        }
-        if h.shards != first.shards {
-            return Err(mismatch(
-                name,
-                format!(
-                    "shard {}/{} of another split than {first_name}'s /{}",
-                    h.shard, h.shards, first.shards
-                ),
-            ));
-        }
-        if h.accelcal_version != first.accelcal_version {
-            return Err(mismatch(
-                name,
-                format!(
-                    "written by accelcal {}, {first_name} by {}",
-                    h.accelcal_version, first.accelcal_version
-                ),
-            ));
+    let (first_name, first) = (first.name.clone(), first.header.clone());
+    for o in &opened {
+        if let Some(why) = same_ensemble(&o.header, &first, &first_name) {
+            return Err(mismatch(&o.name, why));
         }
     }
-    opened.sort_by_key(|(_, h, _)| h.shard);
-    for pair in opened.windows(2) {
-        if pair[0].1.shard == pair[1].1.shard {
-            return Err(mismatch(
-                &pair[1].0,
-                format!(
-                    "shard {}/{} is given twice (also {})",
-                    pair[1].1.shard, first.shards, pair[0].0
-                ),
-            ));
-        }
-    }
-    let present: Vec<u64> = opened.iter().map(|(_, h, _)| h.shard).collect();
-    if let Some(missing) = (1..=first.shards).find(|k| !present.contains(k)) {
-        return Err(mismatch(
-            &first_name,
-            format!("shard {missing}/{} is missing", first.shards),
-        ));
-    }
-    let n = first.config.ensemble.realizations;
-    let partition = super::Partition::new(n);
+    opened.sort_by_key(|o| o.header.shard);
+    every_shard_once(&opened, &first_name, first.shards)?;
+    let partition = Partition::new(first.config.ensemble.realizations);
     let layout = ResidualLayout::new(first.fixes, first.max_lag);
     let mut sums = Accumulator::new(&layout, first.pair);
     let mut elapsed_s = 0.0;
-    for (name, h, mut r) in opened {
-        let expected = partition.shard_blocks(h.shard, h.shards);
-        if h.blocks != [expected.start, expected.end]
-            || (h.fixes, h.max_lag, h.pair) != (first.fixes, first.max_lag, first.pair)
-        {
-            return Err(mismatch(
-                &name,
-                "its blocks are not those of its shard".to_string(),
-            ));
-        }
-        for b in expected {
-            let Some((index, block)) = read_block(&mut r, &h, &name)? else {
-                return Err(PartialError::Truncated {
-                    file: name,
-                    why: format!("block {b} is missing"),
-                });
-            };
-            let count = partition.realizations_in(&(b..b + 1));
-            if index != b || block.count != count {
-                return Err(mismatch(
-                    &name,
-                    format!(
-                        "block {index} with {} realizations where block {b} with {count} belongs",
-                        block.count
-                    ),
-                ));
-            }
-            sums.merge(&block);
-        }
-        if read_block(&mut r, &h, &name)?.is_some() {
-            return Err(mismatch(
-                &name,
-                "more blocks than its shard holds".to_string(),
-            ));
-        }
-        elapsed_s += h.elapsed_s;
+    for o in opened {
+        let same_sums = (o.header.fixes, o.header.max_lag, o.header.pair)
+            == (first.fixes, first.max_lag, first.pair);
+        elapsed_s += fold_shard(o, &partition, same_sums, &mut sums)?;
     }
     Ok(Merged {
         config: first.config,
@@ -387,11 +289,144 @@ pub fn merge<R: std::io::BufRead>(files: Vec<(String, R)>) -> Result<Merged, Par
     })
 }
 
+/// A partial file whose header is read.
+struct Opened<R> {
+    name: String,
+    header: PartialHeader,
+    r: R,
+}
+
+fn mismatch(file: &str, why: String) -> PartialError {
+    PartialError::Mismatch {
+        file: file.to_string(),
+        why,
+    }
+}
+
+/// Why the shard `h` is not of the ensemble of `first` (the header of `first_name`), if it is not.
+fn same_ensemble(h: &PartialHeader, first: &PartialHeader, first_name: &str) -> Option<String> {
+    if h.config != first.config {
+        let what = if h.config.ensemble.seed != first.config.ensemble.seed {
+            format!(
+                "seed {} differs from {first_name}'s {}",
+                h.config.ensemble.seed, first.config.ensemble.seed
+            )
+        } else if h.config.ensemble.realizations != first.config.ensemble.realizations {
+            format!(
+                "N = {} differs from {first_name}'s {}",
+                h.config.ensemble.realizations, first.config.ensemble.realizations
+            )
+        } else {
+            format!(
+                "its configuration differs from {first_name}'s at `{}`",
+                first_difference(&h.config, &first.config)
+            )
+        };
+        Some(format!("another ensemble: {what}"))
+    } else if h.engine != first.engine {
+        Some(format!(
+            "simulated by the {} engine, {first_name} by the {} engine",
+            h.engine, first.engine
+        ))
+    } else if h.shards != first.shards {
+        Some(format!(
+            "shard {}/{} of another split than {first_name}'s /{}",
+            h.shard, h.shards, first.shards
+        ))
+    } else if h.accelcal_version != first.accelcal_version {
+        Some(format!(
+            "written by accelcal {}, {first_name} by {}",
+            h.accelcal_version, first.accelcal_version
+        ))
+    } else {
+        None
+    }
+}
+
+/// Checks that the files `opened`, sorted by shard, hold each of the `shards` shards once.
+fn every_shard_once<R>(
+    opened: &[Opened<R>],
+    first_name: &str,
+    shards: u64,
+) -> Result<(), PartialError> {
+    for pair in opened.windows(2) {
+        if pair[0].header.shard == pair[1].header.shard {
+            return Err(mismatch(
+                &pair[1].name,
+                format!(
+                    "shard {}/{shards} is given twice (also {})",
+                    pair[1].header.shard, pair[0].name
+                ),
+            ));
+        }
+    }
+    let present: Vec<u64> = opened.iter().map(|o| o.header.shard).collect();
+    match (1..=shards).find(|k| !present.contains(k)) {
+        Some(missing) => Err(mismatch(
+            first_name,
+            format!("shard {missing}/{shards} is missing"),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Adds the blocks of the shard `o` to `sums`, in block order, checking that they are the blocks
+/// of its shard of `partition`, each with its realizations, and that its sums have the same
+/// shape as the others' (`same_sums`); its run time.
+fn fold_shard<R: std::io::BufRead>(
+    o: Opened<R>,
+    partition: &Partition,
+    same_sums: bool,
+    sums: &mut Accumulator,
+) -> Result<f64, PartialError> {
+    let Opened {
+        name,
+        header,
+        mut r,
+    } = o;
+    let expected = partition.shard_blocks(Shard {
+        index: header.shard,
+        of: header.shards,
+    });
+    if header.blocks != [expected.start, expected.end] || !same_sums {
+        return Err(mismatch(
+            &name,
+            "its blocks are not those of its shard".to_string(),
+        ));
+    }
+    for b in expected {
+        let Some((index, block)) = read_block(&mut r, &header, &name)? else {
+            return Err(PartialError::Truncated {
+                file: name,
+                why: format!("block {b} is missing"),
+            });
+        };
+        let count = partition.realizations_in(&(b..b + 1));
+        if index != b || block.count != count {
+            return Err(mismatch(
+                &name,
+                format!(
+                    "block {index} with {} realizations where block {b} with {count} belongs",
+                    block.count
+                ),
+            ));
+        }
+        sums.merge(&block);
+    }
+    if read_block(&mut r, &header, &name)?.is_some() {
+        return Err(mismatch(
+            &name,
+            "more blocks than its shard holds".to_string(),
+        ));
+    }
+    Ok(header.elapsed_s)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::config::Config;
-    use crate::ensemble::accumulate;
+    use crate::ensemble::Ensemble;
     use crate::filter::FilterSchedule;
     use crate::model::Model;
 
@@ -402,7 +437,7 @@ mod tests {
         c.checks.residual_max_lag = Some(3);
         let m = Model::new(&c).unwrap();
         let s = FilterSchedule::new(&m.timeline, &m.filter_stats).unwrap();
-        let acc = accumulate(&m, &s, 3, 0..20);
+        let acc = Ensemble::new(&m, &s).with_seed(3).sums_of(0..20);
         let header = PartialHeader {
             accelcal_version: "test".to_string(),
             config: c.clone(),

@@ -1,5 +1,5 @@
 //! Running sums of an ensemble: everything the statistics need, added one realization at a time
-//! and merged chunk by chunk, with no per-realization storage.
+//! and merged block by block, with no per-realization storage.
 
 use super::layout::ResidualLayout;
 use crate::filter::{Matrix3, Vector3};
@@ -25,6 +25,10 @@ pub struct StageSums {
 const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
 
 impl StageSums {
+    /// Floats of one stage's sums: Σe, the upper triangle of Σe·eᵀ, Σe·δx̂ᵀ, Σδx̂, Σδx̂² and
+    /// Σ NEES, stored as they are in memory (and in a partial file).
+    pub const FLOATS: usize = floats_of::<Self>();
+
     /// Σ e·eᵀ as a full matrix.
     pub fn ee_matrix(&self) -> Matrix3 {
         let mut m = Matrix3::zeros();
@@ -57,6 +61,22 @@ pub struct FixSums {
     /// Σ rᵀ·S⁻¹·r (the normalized innovation squared).
     pub nis: f64,
 }
+
+impl FixSums {
+    /// Floats of one fix's sums: the two stages' and Σ NIS.
+    pub const FLOATS: usize = floats_of::<Self>();
+}
+
+/// Floats in a `T` made of `f64`s only (checked at compile time: no padding, nothing else).
+const fn floats_of<T>() -> usize {
+    let (size, float) = (std::mem::size_of::<T>(), std::mem::size_of::<f64>());
+    assert!(size % float == 0, "sums are made of f64s only");
+    size / float
+}
+
+const _: () = assert!(FixSums::FLOATS == 2 * StageSums::FLOATS + 1);
+// The configuration's memory budget counts the sums with the model's figure.
+const _: () = assert!(FixSums::FLOATS == crate::model::SUM_FLOATS_PER_FIX);
 
 /// Running sums of an ensemble, or of part of one.
 #[derive(Clone, Debug, PartialEq)]

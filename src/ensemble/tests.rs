@@ -15,9 +15,10 @@ fn small() -> (Model, FilterSchedule) {
 #[test]
 fn merged_chunks_equal_one_pass_up_to_rounding() {
     let (m, s) = small();
-    let whole = accumulate(&m, &s, 5, 0..300);
-    let mut parts = accumulate(&m, &s, 5, 0..100);
-    parts.merge(&accumulate(&m, &s, 5, 100..300));
+    let e = Ensemble::new(&m, &s).with_seed(5);
+    let whole = e.sums_of(0..300);
+    let mut parts = e.sums_of(0..100);
+    parts.merge(&e.sums_of(100..300));
     assert_eq!(whole.count, parts.count);
     // The residual products are summed in single precision within a chunk, and the two runs
     // have different chunks: each is within PRODUCT_RELATIVE_ERROR of the exact sum.
@@ -58,8 +59,9 @@ fn parallel_run_is_independent_of_the_thread_count() {
         .num_threads(3)
         .build()
         .unwrap();
-    let a = one.install(|| run(&m, &s, 9, 1000, |_| {}));
-    let b = three.install(|| run(&m, &s, 9, 1000, |_| {}));
+    let e = Ensemble::new(&m, &s).with_seed(9).with_realizations(1000);
+    let a = one.install(|| e.sums(|_| {}));
+    let b = three.install(|| e.sums(|_| {}));
     assert_eq!(a, b);
 }
 
@@ -73,7 +75,7 @@ fn streaming_moments_match_a_two_pass_computation() {
     }
     let (m, s) = small();
     let n = 200u64;
-    let stats = EnsembleStats::from_sums(&accumulate(&m, &s, 3, 0..n), &s);
+    let stats = EnsembleStats::from_sums(&Ensemble::new(&m, &s).with_seed(3).sums_of(0..n), &s);
     let runs: Vec<Vec<FixState>> = (0..n)
         .map(|l| {
             let mut k = Keep(Vec::new());
@@ -133,18 +135,16 @@ fn a_panicking_block_ends_the_run_with_the_panic() {
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             two.install(|| {
                 // 40 blocks of one chunk: far more than the window of blocks in flight.
-                run_blocks_prepared(
-                    &Prepared::new(Engine::Epoch, &m, &s),
-                    &m,
-                    &s,
-                    1,
-                    40 * CHUNK,
-                    0..40,
-                    |_| {},
-                    |b, _| {
-                        assert!(b != 0, "a failing block");
-                    },
-                )
+                Ensemble::new(&m, &s)
+                    .with_engine(Engine::Epoch)
+                    .with_seed(1)
+                    .with_realizations(40 * CHUNK)
+                    .blocks(
+                        |_| {},
+                        |b, _| {
+                            assert!(b != 0, "a failing block");
+                        },
+                    )
             })
         }));
         tx.send(result.is_err()).unwrap();

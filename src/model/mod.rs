@@ -11,10 +11,17 @@ use validate::{validate, whole};
 pub const MAX_STEPS: usize = 10_000_000;
 /// Largest number of GPS fixes in a run.
 pub const MAX_FIXES: usize = 1_000_000;
-/// Largest memory the running sums of one chunk of realizations may take, bytes: 51 floats per
-/// fix and the kept residual products. A run needs a few of them at once (one per thread in
-/// flight, one per open block, the total).
+/// Largest memory the running sums of one block of realizations may take, bytes:
+/// [`SUM_FLOATS_PER_FIX`] floats per fix and the kept residual products. A run holds a few of
+/// them at once (two per thread at most, and the total).
 pub const MAX_SUMS_BYTES: usize = 256 << 20;
+/// Floats of an ensemble's running sums at one fix (`ensemble::FixSums`, which checks at compile
+/// time that it has this size): for the a priori and the a posteriori stage each
+/// [`SUM_FLOATS_PER_STAGE`], then Σ NIS.
+pub const SUM_FLOATS_PER_FIX: usize = 2 * SUM_FLOATS_PER_STAGE + 1;
+/// Floats of an ensemble's running sums of one stage at one fix (`ensemble::StageSums`), for the
+/// three states: Σe (3), the upper triangle of Σe·eᵀ (6), Σe·δx̂ᵀ (9), Σδx̂ (3), Σδx̂² (3), Σ NEES.
+pub const SUM_FLOATS_PER_STAGE: usize = 3 + 6 + 9 + 3 + 3 + 1;
 /// Runs with at most this many fixes test the residual whiteness of every pair of fixes by
 /// default; longer runs test lags up to [`DEFAULT_MAX_LAG`] (every pair costs O(fixes²)).
 pub const ALL_PAIRS_MAX_FIXES: usize = 1_000;

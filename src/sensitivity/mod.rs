@@ -15,7 +15,7 @@ pub mod sampler;
 
 use crate::checks::{self, Budget, CheckId, Verdict};
 use crate::config::{Case, Config};
-use crate::ensemble::{self, Engine, EnsembleStats};
+use crate::ensemble::{Engine, Ensemble, EnsembleStats};
 use crate::error::{ConfigError, FilterError};
 use crate::filter::FilterSchedule;
 use crate::model::Model;
@@ -373,18 +373,14 @@ pub fn run(
             // Built again rather than kept from the first pass: one covariance pass, against
             // memory that would grow with cases × fixes.
             let (model, schedule) = mistuned(&world, case.parameter, case.factor)?;
-            let prepared = ensemble::Prepared::new(plan.engine, &model, &schedule);
+            let mut ensemble = Ensemble::new(&model, &schedule)
+                .with_engine(plan.engine)
+                .with_realizations(plan.realizations);
             let mut failures = [0u64; 7];
             for k in 0..plan.ensembles {
                 let seed = mix(case_seed(seed, ENSEMBLES, case.parameter, case.factor), k);
-                let acc = ensemble::run_prepared(
-                    &prepared,
-                    &model,
-                    &schedule,
-                    seed,
-                    plan.realizations,
-                    |d| progress.advance(done + d),
-                );
+                ensemble = ensemble.with_seed(seed);
+                let acc = ensemble.sums(|d| progress.advance(done + d));
                 done += plan.realizations;
                 let stats = EnsembleStats::from_sums(&acc, &schedule);
                 let v = checks::evaluate(&stats, &budget);
