@@ -56,7 +56,7 @@ impl std::fmt::Display for Engine {
 
 /// What an engine needs besides the model, built once per ensemble.
 #[derive(Clone, Debug)]
-pub enum Prepared {
+pub(super) enum Prepared {
     /// The per-sample engine needs nothing more.
     Sample,
     /// The epoch engine's plan.
@@ -82,7 +82,8 @@ impl Prepared {
 }
 
 /// Scratch space of [`accumulate_into`], reused from call to call: the residual-product tiles of
-/// the sums being made, the panels of a chunk's stacked residuals and the lane sums.
+/// the sums being made, the panels of a pass's stacked residuals, the lane sums and the single
+/// pair's residuals.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Scratch {
     tiles: Vec<f64>,

@@ -154,3 +154,53 @@ fn a_panicking_block_ends_the_run_with_the_panic() {
         .expect("the run returned");
     assert!(panicked);
 }
+
+/// The shards of an ensemble, folded in shard order, give its sums number for number; a shard
+/// runs its own blocks only.
+#[test]
+fn shards_fold_to_the_whole_ensemble() {
+    let (m, s) = small();
+    // 40 chunks: 40 blocks of one chunk, cut into three uneven shards.
+    let e = Ensemble::new(&m, &s)
+        .with_engine(Engine::Epoch)
+        .with_seed(4)
+        .with_realizations(40 * CHUNK - 5);
+    let whole = e.sums(|_| {});
+    let mut folded = e.empty_sums();
+    let mut blocks = Vec::new();
+    for k in 1..=3 {
+        let shard = e.clone().with_shard(Shard { index: k, of: 3 });
+        shard.blocks(
+            |_| {},
+            |b, acc| {
+                blocks.push(b);
+                folded.merge(acc);
+            },
+        );
+    }
+    assert_eq!(blocks, (0..40).collect::<Vec<_>>());
+    assert_eq!(folded, whole);
+    assert_eq!(whole.count, 40 * CHUNK - 5);
+}
+
+/// `with_truth` simulates the other truth: the same sums as an ensemble of the model with that
+/// truth, and not those of the model's own.
+#[test]
+fn with_truth_runs_the_other_truth() {
+    let (m, s) = small();
+    let euler = m.with_truth(crate::config::TruthModel::Euler);
+    for engine in [Engine::Sample, Engine::Epoch] {
+        let of_model = Ensemble::new(&euler, &s).with_engine(engine).with_seed(2);
+        let switched = Ensemble::new(&m, &s)
+            .with_engine(engine)
+            .with_seed(2)
+            .with_truth(crate::config::TruthModel::Euler);
+        let own = Ensemble::new(&m, &s).with_engine(engine).with_seed(2);
+        let range = 0..100;
+        assert_eq!(
+            switched.sums_of(range.clone()),
+            of_model.sums_of(range.clone())
+        );
+        assert_ne!(own.sums_of(range.clone()), of_model.sums_of(range));
+    }
+}
