@@ -5,8 +5,8 @@
 //! - the random-number bound: only the 6 303 standard normal draws a realization needs
 //!   (3 initial values, 6 000 accelerometer noises, 2 per fix), in lane groups;
 //! - the bare per-sample kernel (simulation and filter, no statistics);
-//! - the full per-sample ensemble (`ensemble::run_with(Engine::Sample, …)`);
-//! - the full epoch ensemble (`Engine::Epoch`), and its own random-number bound (603 normals:
+//! - the full per-sample ensemble (`Ensemble::new(…).sums(…)`, the per-sample engine);
+//! - the full epoch ensemble (`with_engine(Engine::Epoch)`), and its own random-number bound (603 normals:
 //!   3 initial values, 2 per GPS interval, 2 per fix);
 //!
 //! and their ratios, so the remaining gap shows. `--numpy R` adds each figure's ratio to a numpy
@@ -19,7 +19,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use accelcal::config::{Config, TruthModel};
-use accelcal::ensemble::{self, Engine, kernel};
+use accelcal::ensemble::{Engine, Ensemble, kernel};
 use accelcal::filter::FilterSchedule;
 use accelcal::lanes::LANES;
 use accelcal::model::Model;
@@ -76,96 +76,89 @@ fn groups(n: u64) -> impl ParallelIterator<Item = (u64, usize)> {
     })
 }
 
+/// What the command line asks for.
+struct Options {
+    /// Realizations per run.
+    n: u64,
+    repeats: usize,
+    /// The numpy reference's rate, realizations/s, measured in the same session.
+    numpy: Option<f64>,
+    truth: TruthModel,
+}
+
+impl Options {
+    fn parse() -> Self {
+        Self {
+            n: arg("--realizations")
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(100_000),
+            repeats: arg("--repeats").and_then(|v| v.parse().ok()).unwrap_or(9),
+            numpy: arg("--numpy").and_then(|v| v.parse().ok()),
+            truth: match arg("--truth").as_deref() {
+                Some("euler") => TruthModel::Euler,
+                _ => TruthModel::Analytic,
+            },
+        }
+    }
+
+    /// The median rate of `once`, a run of `n` realizations, labelled `label`.
+    fn measure(&self, label: &str, once: impl FnMut()) -> f64 {
+        measure(label, self.repeats, self.n, self.numpy, once)
+    }
+}
+
+/// The rate of drawing `draws` standard normals for each of `n` realizations.
+fn random_numbers(o: &Options, key: u64, draws: usize) -> f64 {
+    o.measure(&format!("random numbers only ({draws} normals)"), || {
+        let s: f64 = groups(o.n)
+            .map(|(first, _)| normals_sum(key, first, draws))
+            .sum();
+        black_box(s);
+    })
+}
+
 fn main() {
-    let n: u64 = arg("--realizations")
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(100_000);
-    let repeats: usize = arg("--repeats").and_then(|v| v.parse().ok()).unwrap_or(9);
-    let numpy: Option<f64> = arg("--numpy").and_then(|v| v.parse().ok());
-    let truth = match arg("--truth").as_deref() {
-        Some("euler") => TruthModel::Euler,
-        _ => TruthModel::Analytic,
-    };
-    println!("threads: {}, truth: {truth}", rayon::current_num_threads());
+    let o = Options::parse();
+    println!(
+        "threads: {}, truth: {}",
+        rayon::current_num_threads(),
+        o.truth
+    );
     let config = Config::default();
     let model = Model::new(&config)
         .expect("default configuration is valid")
-        .with_truth(truth);
+        .with_truth(o.truth);
     let schedule =
         FilterSchedule::new(&model.timeline, &model.filter_stats).expect("positive definite");
     let key = stream_key(1, model.case());
-    let draws = 3 + model.timeline.steps + 2 * model.timeline.fixes();
-    let rng = measure(
-        &format!("random numbers only ({draws} normals)"),
-        repeats,
-        n,
-        numpy,
-        || {
-            let s: f64 = groups(n)
-                .map(|(first, _)| normals_sum(key, first, draws))
-                .sum();
-            black_box(s);
-        },
+    let rng = random_numbers(
+        &o,
+        key,
+        3 + model.timeline.steps + 2 * model.timeline.fixes(),
     );
-    let bare = measure(
-        "per-sample kernel, no statistics",
-        repeats,
-        n,
-        numpy,
-        || {
-            let s: f64 = groups(n)
-                .map(|(first, active)| kernel::bare_group(&model, &schedule, key, first, active))
-                .sum();
-            black_box(s);
-        },
-    );
-    let full = measure("per-sample ensemble", repeats, n, numpy, || {
-        black_box(ensemble::run_with(
-            Engine::Sample,
-            &model,
-            &schedule,
-            1,
-            n,
-            |_| {},
-        ));
+    let bare = o.measure("per-sample kernel, no statistics", || {
+        let s: f64 = groups(o.n)
+            .map(|(first, active)| kernel::bare_group(&model, &schedule, key, first, active))
+            .sum();
+        black_box(s);
     });
-    let epoch_draws = 3 + 4 * model.timeline.fixes();
-    let epoch_rng = measure(
-        &format!("random numbers only ({epoch_draws} normals)"),
-        repeats,
-        n,
-        numpy,
-        || {
-            let s: f64 = groups(n)
-                .map(|(first, _)| normals_sum(key, first, epoch_draws))
-                .sum();
-            black_box(s);
-        },
-    );
-    let epoch = measure("epoch ensemble", repeats, n, numpy, || {
-        black_box(ensemble::run_with(
-            Engine::Epoch,
-            &model,
-            &schedule,
-            1,
-            n,
-            |_| {},
-        ));
+    let sample = Ensemble::new(&model, &schedule)
+        .with_seed(1)
+        .with_realizations(o.n);
+    let full = o.measure("per-sample ensemble", || {
+        black_box(sample.sums(|_| {}));
     });
-    println!("{:<34} {:.2}", "ratio kernel / random numbers", bare / rng);
-    println!(
-        "{:<34} {:.2}",
-        "ratio per-sample ensemble / kernel",
-        full / bare
-    );
-    println!(
-        "{:<34} {:.2}",
-        "ratio epoch / per-sample ensemble",
-        epoch / full
-    );
-    println!(
-        "{:<34} {:.2}",
-        "ratio epoch / its random numbers",
-        epoch / epoch_rng
-    );
+    let epoch_rng = random_numbers(&o, key, 3 + 4 * model.timeline.fixes());
+    let epoch_ensemble = sample.clone().with_engine(Engine::Epoch);
+    let epoch = o.measure("epoch ensemble", || {
+        black_box(epoch_ensemble.sums(|_| {}));
+    });
+    for (what, ratio) in [
+        ("kernel / random numbers", bare / rng),
+        ("per-sample ensemble / kernel", full / bare),
+        ("epoch / per-sample ensemble", epoch / full),
+        ("epoch / its random numbers", epoch / epoch_rng),
+    ] {
+        println!("{:<34} {ratio:.2}", format!("ratio {what}"));
+    }
 }

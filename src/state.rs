@@ -14,7 +14,22 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::model::NoiseStats;
+/// Noise statistics of the error-state system: the truth's, or the ones the filter assumes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoiseStats {
+    /// Accelerometer white-noise variance W, (m/s²)².
+    pub accel_noise_var_m2_s4: f64,
+    /// Bias prior variance, (m/s²)².
+    pub bias_var_m2_s4: f64,
+    /// GPS position noise σ, m.
+    pub gps_position_sigma_m: f64,
+    /// GPS velocity noise σ, m/s.
+    pub gps_velocity_sigma_m_s: f64,
+    /// Initial position σ, m.
+    pub initial_position_sigma_m: f64,
+    /// Initial velocity σ, m/s.
+    pub initial_velocity_sigma_m_s: f64,
+}
 
 /// One variable of a state or of a measurement.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

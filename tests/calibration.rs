@@ -14,7 +14,7 @@ mod common;
 
 use accelcal::checks::{self, Budget, CheckId};
 use accelcal::config::{Config, TruthModel};
-use accelcal::ensemble;
+use accelcal::ensemble::{self, Ensemble};
 
 /// Independent ensembles.
 const K: u64 = 1000;
@@ -36,7 +36,10 @@ fn members_outside_their_bands_average_exactly_the_false_alarm_share() {
 
     let mut counts = vec![Vec::with_capacity(K as usize); CheckId::ALL.len()];
     for k in 0..K {
-        let acc = ensemble::run(&model, &schedule, 1_000 + k, N, |_| {});
+        let acc = Ensemble::new(&model, &schedule)
+            .with_seed(1_000 + k)
+            .with_realizations(N)
+            .sums(|_| {});
         let stats = ensemble::EnsembleStats::from_sums(&acc, &schedule);
         let v = checks::evaluate(&stats, &budget);
         for check in &v.checks {

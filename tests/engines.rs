@@ -15,7 +15,7 @@ mod common;
 use accelcal::checks::{Budget, evaluate};
 use accelcal::config::{AccelerometerOutput, Case, Config, TruthModel};
 use accelcal::ensemble::epoch::{EpochPlan, interval_noise, interval_noise_by_steps};
-use accelcal::ensemble::{self, Engine, EnsembleStats, Prepared, StageStats, kernel};
+use accelcal::ensemble::{Engine, Ensemble, EnsembleStats, StageStats, kernel};
 use accelcal::filter::{FilterSchedule, Matrix3, Stage};
 use accelcal::model::Model;
 use accelcal::simulation::{FixState, Observer, run_realization, stream_key};
@@ -120,8 +120,12 @@ fn both_engines_give_the_same_sums_on_one_and_two_threads() {
         for case in [ALL_CASES[0], ALL_CASES[2]] {
             let (m, s) = model(&c, case);
             // 1 000 realizations: 16 chunks, the last one partial, in more than one window.
-            let a = one.install(|| ensemble::run_with(engine, &m, &s, 5, 1000, |_| {}));
-            let b = two.install(|| ensemble::run_with(engine, &m, &s, 5, 1000, |_| {}));
+            let e = Ensemble::new(&m, &s)
+                .with_engine(engine)
+                .with_seed(5)
+                .with_realizations(1000);
+            let a = one.install(|| e.sums(|_| {}));
+            let b = two.install(|| e.sums(|_| {}));
             assert_eq!(a, b, "{engine}, {case}");
             assert_eq!(a.count, 1000);
         }
@@ -152,7 +156,11 @@ fn the_epoch_engine_passes_every_check_where_the_model_matches() {
     let c = Config::default();
     for case in ALL_CASES {
         let (m, s) = model(&c, case);
-        let acc = ensemble::run_with(Engine::Epoch, &m, &s, 2017, 20_000, |_| {});
+        let acc = Ensemble::new(&m, &s)
+            .with_engine(Engine::Epoch)
+            .with_seed(2017)
+            .with_realizations(20_000)
+            .sums(|_| {});
         let v = evaluate(
             &EnsembleStats::from_sums(&acc, &s),
             &Budget::study(c.checks.false_alarm_rate),
@@ -217,8 +225,13 @@ fn bound(members: usize) -> f64 {
     accelcal::stats::normal_bound(1e-3 / members as f64)
 }
 
-fn stats(prepared: &Prepared, m: &Model, s: &FilterSchedule, seed: u64, n: u64) -> EnsembleStats {
-    EnsembleStats::from_sums(&ensemble::run_prepared(prepared, m, s, seed, n, |_| {}), s)
+/// The statistics of `ensemble` with `n` realizations under `seed`.
+fn stats(ensemble: Ensemble, seed: u64, n: u64) -> EnsembleStats {
+    ensemble
+        .with_seed(seed)
+        .with_realizations(n)
+        .run(|_| {})
+        .stats
 }
 
 /// N = 100 000 per engine and case. 4 cases × 150 fixes × 2 stages × 10 scores = 12 000 members;
@@ -232,8 +245,8 @@ fn the_engines_agree_in_distribution() {
     let mut scores = Vec::new();
     for case in ALL_CASES {
         let (m, s) = model(&c, case);
-        let sample = stats(&Prepared::Sample, &m, &s, 3, n);
-        let epoch = stats(&Prepared::new(Engine::Epoch, &m, &s), &m, &s, 3, n);
+        let sample = stats(Ensemble::new(&m, &s), 3, n);
+        let epoch = stats(Ensemble::new(&m, &s).with_engine(Engine::Epoch), 3, n);
         scores.extend(
             two_sample_scores(&sample, &epoch, &s)
                 .into_iter()
@@ -264,9 +277,9 @@ fn the_comparison_detects_a_wrong_interval_covariance() {
     let c = Config::default();
     let n = 200_000;
     let (m, s) = model(&c, ALL_CASES[0]);
-    let sample = stats(&Prepared::Sample, &m, &s, 4, n);
-    let wrong = Prepared::Epoch(EpochPlan::new(&m, &s).with_noise_scaled(1.1));
-    let epoch = stats(&wrong, &m, &s, 4, n);
+    let sample = stats(Ensemble::new(&m, &s), 4, n);
+    let wrong = EpochPlan::new(&m, &s).with_noise_scaled(1.1);
+    let epoch = stats(Ensemble::new(&m, &s).with_epoch_plan(wrong), 4, n);
     let scores = two_sample_scores(&sample, &epoch, &s);
     let limit = bound(12_000);
     let worst = scores

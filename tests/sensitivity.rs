@@ -6,7 +6,7 @@ mod common;
 
 use accelcal::checks::CheckId;
 use accelcal::config::{Config, TruthModel};
-use accelcal::ensemble::{self, Engine, EnsembleStats};
+use accelcal::ensemble::{Engine, Ensemble, EnsembleStats};
 use accelcal::sensitivity::{self, AssumedStatistic, Plan, actual_covariance};
 use accelcal::stats::clopper_pearson;
 use accelcal::study::Silent;
@@ -170,7 +170,10 @@ fn actual_covariance_matches_the_monte_carlo_of_a_mistuned_filter() {
     let (model, schedule) = common::model_of(&c);
     let model = model.with_truth(TruthModel::Euler);
     let n = 4000;
-    let acc = ensemble::run(&model, &schedule, 77, n, |_| {});
+    let acc = Ensemble::new(&model, &schedule)
+        .with_seed(77)
+        .with_realizations(n)
+        .sums(|_| {});
     let stats = EnsembleStats::from_sums(&acc, &schedule);
     let actual = actual_covariance(&model.timeline, &schedule, &model.truth_stats);
     // (N − 1)·P_ave/P_actual ~ χ²(N − 1) for every diagonal member: 30 fixes × 3, two-sided

@@ -1,7 +1,6 @@
 use super::*;
 use crate::config::Config;
-use crate::ensemble;
-use crate::ensemble::EnsembleStats;
+use crate::ensemble::{Ensemble, EnsembleStats};
 use crate::filter::{FilterSchedule, Stage};
 use crate::model::Model;
 
@@ -13,7 +12,10 @@ fn stats_of(duration_s: f64, n: u64) -> EnsembleStats {
         .unwrap()
         .with_truth(crate::config::TruthModel::Euler);
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats).unwrap();
-    let acc = ensemble::run(&model, &schedule, 11, n, |_| {});
+    let acc = Ensemble::new(&model, &schedule)
+        .with_seed(11)
+        .with_realizations(n)
+        .sums(|_| {});
     EnsembleStats::from_sums(&acc, &schedule)
 }
 

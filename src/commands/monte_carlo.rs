@@ -6,7 +6,7 @@ use std::path::Path;
 use super::{Bar, load_model, verdict_lines, write};
 use crate::cli::{CaseArgs, EnsembleArgs, MergeArgs, ReportArgs, SensitivityArgs};
 use accelcal::config::{Config, SensitivityConfig};
-use accelcal::ensemble::{self, EnsembleRun, EnsembleStats, Partition, partial};
+use accelcal::ensemble::{Engine, Ensemble, EnsembleRun, EnsembleStats, Partition, Shard, partial};
 use accelcal::error::ConfigError;
 use accelcal::filter::FilterSchedule;
 use accelcal::model::Model;
@@ -76,19 +76,10 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
             args.model.quiet,
         );
     }
-    let outcome = match args.engine {
-        ensemble::Engine::Sample => {
-            study::run_case(&model, &schedule, &mut Bar::new(args.model.quiet))
-        }
-        engine => {
-            use accelcal::progress::Progress;
-            let mut bar = Bar::new(args.model.quiet);
-            bar.start(&model.case().id(), model.config.ensemble.realizations);
-            let run = ensemble::run_model_with(engine, &model, &schedule, |d| bar.advance(d));
-            bar.finish();
-            study::judge_case(&model, &schedule, run)
-        }
-    };
+    let outcome = study::run_case(
+        &Ensemble::new(&model, &schedule).with_engine(args.engine),
+        &mut Bar::new(args.model.quiet),
+    );
     let doc = export::ensemble_doc(&model.config, &schedule, &outcome);
     let json = export::ensemble_json(&model.config, &doc);
     match &args.json {
@@ -157,8 +148,8 @@ pub(super) fn run_sensitivity(args: &SensitivityArgs) -> Result<()> {
     Ok(())
 }
 
-/// "K/M" as (K, M), with 1 ≤ K ≤ M ≤ the blocks of `partition`.
-fn parse_shard(text: &str, partition: &Partition) -> Result<(u64, u64), ConfigError> {
+/// "K/M" as shard K of M, with 1 ≤ K ≤ M ≤ the blocks of `partition`.
+fn parse_shard(text: &str, partition: &Partition) -> Result<Shard, ConfigError> {
     let expected = format!(
         "must be K/M with whole numbers 1 ≤ K ≤ M ≤ {} (the blocks of N = {})",
         partition.blocks, partition.realizations
@@ -167,7 +158,7 @@ fn parse_shard(text: &str, partition: &Partition) -> Result<(u64, u64), ConfigEr
         .split_once('/')
         .and_then(|(k, m)| Some((k.trim().parse::<u64>().ok()?, m.trim().parse::<u64>().ok()?)));
     match parsed {
-        Some((k, m)) if 1 <= k && k <= m && m <= partition.blocks => Ok((k, m)),
+        Some((k, m)) if 1 <= k && k <= m && m <= partition.blocks => Ok(Shard { index: k, of: m }),
         _ => Err(ConfigError::invalid("--shard", text, expected)),
     }
 }
@@ -175,46 +166,27 @@ fn parse_shard(text: &str, partition: &Partition) -> Result<(u64, u64), ConfigEr
 fn run_shard(
     model: &Model,
     schedule: &FilterSchedule,
-    engine: ensemble::Engine,
+    engine: Engine,
     shard: &str,
     path: &Path,
     quiet: bool,
 ) -> Result<()> {
-    let e = &model.config.ensemble;
-    let partition = Partition::new(e.realizations);
-    let (k, m) = parse_shard(shard, &partition)?;
-    let blocks = partition.shard_blocks(k, m);
-    let layout = ensemble::layout_of(model);
+    let ensemble = Ensemble::new(model, schedule).with_engine(engine);
+    let partition = ensemble.partition();
+    let shard = parse_shard(shard, &partition)?;
+    let ensemble = ensemble.with_shard(shard);
+    let blocks = ensemble.block_range();
+    let realizations = partition.realizations_in(&blocks);
+    let (k, m) = (shard.index, shard.of);
     let mut file = accelcal::output::AtomicFile::create(path)?;
-    let mut header = partial::PartialHeader {
-        accelcal_version: env!("CARGO_PKG_VERSION").to_string(),
-        config: model.config.clone(),
-        shard: k,
-        shards: m,
-        blocks: [blocks.start, blocks.end],
-        fixes: layout.fixes(),
-        max_lag: layout.max_lag(),
-        pair: model.residual_pair,
-        elapsed_s: 0.0,
-        engine,
-    };
     let mut bar = Bar::new(quiet);
-    bar.start(
-        &format!("shard {k}/{m}"),
-        partition.realizations_in(&blocks),
-    );
+    bar.start(&format!("shard {k}/{m}"), realizations);
     let start = std::time::Instant::now();
     let mut written = Ok(());
     // The header carries the run time, so blocks wait in a second temporary until the run ends.
     let spool = tempfile_beside(path)?;
     let mut spool_w = std::io::BufWriter::new(std::fs::File::create(&spool)?);
-    ensemble::run_blocks_prepared(
-        &ensemble::Prepared::new(engine, model, schedule),
-        model,
-        schedule,
-        e.seed,
-        e.realizations,
-        blocks.clone(),
+    ensemble.blocks(
         |done| bar.advance(done),
         |index, acc| {
             if written.is_ok() {
@@ -223,7 +195,19 @@ fn run_shard(
         },
     );
     bar.finish();
-    header.elapsed_s = start.elapsed().as_secs_f64();
+    let layout = ensemble.layout();
+    let header = partial::PartialHeader {
+        accelcal_version: env!("CARGO_PKG_VERSION").to_string(),
+        config: model.config.clone(),
+        shard: k,
+        shards: m,
+        blocks: [blocks.start, blocks.end],
+        fixes: layout.fixes(),
+        max_lag: layout.max_lag(),
+        pair: model.residual_pair,
+        elapsed_s: start.elapsed().as_secs_f64(),
+        engine,
+    };
     let result = (|| -> Result<()> {
         written?;
         use std::io::Write;
@@ -238,10 +222,9 @@ fn run_shard(
     result?;
     if !quiet {
         println!(
-            "shard {k}/{m}: blocks {}..{} ({} realizations) written to {}",
+            "shard {k}/{m}: blocks {}..{} ({realizations} realizations) written to {}",
             blocks.start,
             blocks.end,
-            partition.realizations_in(&blocks),
             path.display()
         );
     }

@@ -1,12 +1,14 @@
-//! The engines and the sums of one chunk: its lane groups advanced fix by fix, their lane sums
-//! reduced per fix, its residual rows added to the packed triangle at the end.
+//! The engines, and the sums of a range of realizations (a block): pass after pass of [`PASS`]
+//! realizations, chunk after chunk within a pass; a chunk's lane groups are advanced fix by fix
+//! and their lane sums added up at every fix, its residuals written into the pass's panels; a
+//! pass's residual products are added to the tiles, unpacked into the sums when the range is done.
 
-use super::CHUNK;
 use super::epoch::{self, EpochGroup, EpochPlan};
 use super::kernel::{LaneGroup, SampleGroup};
 use super::lane_sums::LaneSums;
 use super::sums::Accumulator;
-use super::tiles;
+use super::tiles::{self, PASS};
+use super::{CHUNK, Ensemble};
 use crate::config::TruthModel;
 use crate::filter::FilterSchedule;
 use crate::lanes::{LANES, Lanes};
@@ -45,7 +47,7 @@ impl std::fmt::Display for Engine {
 
 /// What an engine needs besides the model, built once per ensemble.
 #[derive(Clone, Debug)]
-pub enum Prepared {
+pub(super) enum Prepared {
     /// The per-sample engine needs nothing more.
     Sample,
     /// The epoch engine's plan.
@@ -70,20 +72,11 @@ impl Prepared {
     }
 }
 
-/// Sums realizations `range` of `model` into a fresh accumulator, with the per-sample engine.
-pub fn accumulate(
-    model: &Model,
-    schedule: &FilterSchedule,
-    seed: u64,
-    range: std::ops::Range<u64>,
-) -> Accumulator {
-    accumulate_with(&Prepared::Sample, model, schedule, seed, range)
-}
-
 /// Scratch space of [`accumulate_into`], reused from call to call: the residual-product tiles of
-/// the sums being made, the panels of a chunk's stacked residuals and the lane sums.
+/// the sums being made, the panels of a pass's stacked residuals, the lane sums and the single
+/// pair's residuals.
 #[derive(Clone, Debug, Default)]
-pub struct Scratch {
+pub(super) struct Scratch {
     tiles: Vec<f64>,
     panels: Vec<f32>,
     lanes: LaneSums,
@@ -93,55 +86,29 @@ pub struct Scratch {
 }
 
 crate::lanes::vectorized! {
-    /// Sums realizations `range` of `model` into `acc` (emptied first) with the engine
-    /// `prepared`, in chunks of [`CHUNK`] consecutive indices from `range.start`, in order.
-    /// A chunk's realizations go in lane groups of [`LANES`], all advanced fix by fix: at each
-    /// fix every lane adds its realization into its own sums, and the lanes are added up in lane
-    /// order, onto the sums so far, when every group has passed the fix. The chunk's residual
-    /// products are then added in one pass over its stacked residuals (see `ensemble::tiles`).
-    pub fn accumulate_into(
-        prepared: &Prepared,
-        model: &Model,
-        schedule: &FilterSchedule,
-        seed: u64,
+    /// Sums realizations `range` of `ensemble` (its model, engine and seed) into `acc`, whose
+    /// previous numbers are all overwritten, in passes of [`PASS`] realizations from
+    /// `range.start` and chunks of [`CHUNK`] within a pass, in order. A chunk's realizations go
+    /// in lane groups of [`LANES`], all advanced fix by fix: at each fix every lane adds its
+    /// realization into its own sums, and the lanes are added up in lane order, onto the sums
+    /// so far, when every group has passed the fix. A pass's residual products are then added
+    /// in one sweep over its stacked residuals (see `tiles`).
+    pub(super) fn accumulate_into(
+        ensemble: &Ensemble<'_>,
         range: std::ops::Range<u64>,
         acc: &mut Accumulator,
         scratch: &mut Scratch,
     ) -> () => accumulate_lanes
 }
 
-/// Sums realizations `range` of `model` into a fresh accumulator with the engine `prepared`
-/// (see [`accumulate_into`]).
-pub fn accumulate_with(
-    prepared: &Prepared,
-    model: &Model,
-    schedule: &FilterSchedule,
-    seed: u64,
-    range: std::ops::Range<u64>,
-) -> Accumulator {
-    let mut acc = Accumulator::new(&super::layout_of(model), model.residual_pair);
-    accumulate_into(
-        prepared,
-        model,
-        schedule,
-        seed,
-        range,
-        &mut acc,
-        &mut Scratch::default(),
-    );
-    acc
-}
-
 #[inline(always)]
 fn accumulate_lanes(
-    prepared: &Prepared,
-    model: &Model,
-    schedule: &FilterSchedule,
-    seed: u64,
+    ensemble: &Ensemble<'_>,
     range: std::ops::Range<u64>,
     acc: &mut Accumulator,
     scratch: &mut Scratch,
 ) {
+    let (model, schedule) = (ensemble.model(), ensemble.schedule);
     acc.clear_but_products();
     let Scratch {
         tiles,
@@ -149,16 +116,16 @@ fn accumulate_lanes(
         lanes,
         pair,
     } = scratch;
-    // The first chunk overwrites the tiles; with no chunk at all they must read zero.
+    // The first pass overwrites the tiles; with no pass at all they must read zero.
     tiles.resize(tiles::tiles_len(&acc.layout), 0.0);
     if range.is_empty() {
         tiles.fill(0.0);
     }
     lanes.set_weights(schedule);
     let m = 2 * schedule.fixes.len();
-    let key = stream_key(seed, model.case());
-    for pass_start in range.clone().step_by(tiles::PASS as usize) {
-        let pass = pass_start..(pass_start + tiles::PASS).min(range.end);
+    let key = stream_key(ensemble.seed, model.case());
+    for pass_start in range.clone().step_by(PASS as usize) {
+        let pass = pass_start..(pass_start + PASS).min(range.end);
         let count = (pass.end - pass.start).div_ceil(LANES as u64) as usize * LANES;
         // Every entry is written below but the padding beyond component m − 1, zeroed here.
         panels.resize(tiles::panels_len(m, count), 0.0);
@@ -170,30 +137,60 @@ fn accumulate_lanes(
                 first: (start - pass.start) as usize,
                 count,
             };
-            let groups = chunk.clone().step_by(LANES).map(|first| {
-                let active = (chunk.end - first).min(LANES as u64) as usize;
-                (first, active)
-            });
-            match (prepared, model.truth()) {
-                (Prepared::Sample, TruthModel::Euler) => {
-                    let g = groups.map(|(f, a)| SampleGroup::<true>::new(model, key, f, a));
-                    sum_groups(g.collect(), schedule, acc, lanes, out, pair);
-                }
-                (Prepared::Sample, TruthModel::Analytic) => {
-                    let g = groups.map(|(f, a)| SampleGroup::<false>::new(model, key, f, a));
-                    sum_groups(g.collect(), schedule, acc, lanes, out, pair);
-                }
-                (Prepared::Epoch(plan), _) => {
-                    let key = epoch::epoch_key(key);
-                    let g = groups.map(|(f, a)| EpochGroup::new(plan, model, key, f, a));
-                    sum_groups(g.collect(), schedule, acc, lanes, out, pair);
-                }
-            }
+            let sums = ChunkSums {
+                schedule,
+                acc: &mut *acc,
+                lanes: &mut *lanes,
+                out,
+                pair: &mut *pair,
+            };
+            sum_chunk(&ensemble.prepared, model, key, chunk, sums);
         }
         tiles::add_products(&acc.layout, tiles, panels, count, pass_start == range.start);
     }
     acc.count = range.end - range.start;
     tiles::unpack(&acc.layout, tiles, &mut acc.residual_products);
+}
+
+/// Sums the realizations `chunk` of `model` under the stream key `key`, simulated by `prepared`,
+/// into `sums`.
+#[inline(always)]
+fn sum_chunk(
+    prepared: &Prepared,
+    model: &Model,
+    key: u64,
+    chunk: std::ops::Range<u64>,
+    sums: ChunkSums,
+) {
+    let groups = chunk.clone().step_by(LANES).map(|first| {
+        let active = (chunk.end - first).min(LANES as u64) as usize;
+        (first, active)
+    });
+    match (prepared, model.truth()) {
+        (Prepared::Sample, TruthModel::Euler) => {
+            let g = groups.map(|(f, a)| SampleGroup::<true>::new(model, key, f, a));
+            sum_groups(g.collect(), sums);
+        }
+        (Prepared::Sample, TruthModel::Analytic) => {
+            let g = groups.map(|(f, a)| SampleGroup::<false>::new(model, key, f, a));
+            sum_groups(g.collect(), sums);
+        }
+        (Prepared::Epoch(plan), _) => {
+            let key = epoch::epoch_key(key);
+            let g = groups.map(|(f, a)| EpochGroup::new(plan, model, key, f, a));
+            sum_groups(g.collect(), sums);
+        }
+    }
+}
+
+/// Where a chunk's sums go: the per-fix sums and the single pair's products of `acc` (through
+/// the lane sums `lanes`), its residuals into the panels `out` and, for the single pair, `pair`.
+struct ChunkSums<'s> {
+    schedule: &'s FilterSchedule,
+    acc: &'s mut Accumulator,
+    lanes: &'s mut LaneSums,
+    out: Panels<'s>,
+    pair: &'s mut Vec<[[Lanes; 2]; 2]>,
 }
 
 /// Where a chunk's residuals go: the panels of a pass of `count` realizations, from the pass's
@@ -204,17 +201,17 @@ struct Panels<'a> {
     count: usize,
 }
 
-/// Adds one chunk, the lane groups `groups`, to the per-fix sums of `acc` and to its single
-/// residual pair's products, and writes its residuals into `out`, in single precision.
+/// Adds one chunk, the lane groups `groups`, to the per-fix sums and to the single residual
+/// pair's products of `sums`, and writes its residuals into its panels, in single precision.
 #[inline(always)]
-fn sum_groups<G: LaneGroup>(
-    mut groups: Vec<G>,
-    schedule: &FilterSchedule,
-    acc: &mut Accumulator,
-    lanes: &mut LaneSums,
-    out: Panels,
-    pair: &mut Vec<[[Lanes; 2]; 2]>,
-) {
+fn sum_groups<G: LaneGroup>(mut groups: Vec<G>, sums: ChunkSums) {
+    let ChunkSums {
+        schedule,
+        acc,
+        lanes,
+        out,
+        pair,
+    } = sums;
     let count = groups.len() * LANES;
     pair.resize(groups.len(), Default::default());
     let [pm, pi] = acc.pair;

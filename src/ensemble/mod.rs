@@ -1,10 +1,27 @@
-//! The Monte Carlo ensemble: N realizations run in parallel and accumulated as they are produced.
+//! The Monte Carlo ensemble: N realizations simulated in parallel and summed as they are
+//! produced into the running sums ([`Accumulator`]) that the statistics ([`EnsembleStats`]) and the
+//! checks read. Memory does not grow with N.
 //!
-//! Memory does not grow with N: realizations are grouped into chunks of [`CHUNK`] consecutive
-//! indices and blocks of consecutive chunks; each block is summed into its own [`Accumulator`]
-//! by one worker, chunk after chunk, and the blocks are merged into the total in block order.
-//! The boundaries depend on N alone, so the result is bit-for-bit the same on one thread or
-//! many.
+//! [`Ensemble`] is the one way to run an ensemble: built from the model and the filter schedule,
+//! then given, where the defaults (the model's configuration, the per-sample engine, the whole
+//! ensemble) do not fit, a truth, an engine, a number of realizations, a seed or a shard; it
+//! returns the statistics ([`Ensemble::run`]), the sums ([`Ensemble::sums`]) or each block's sums
+//! in block order ([`Ensemble::blocks`], for a shard's partial file), and reports progress to a
+//! callback.
+//!
+//! How the work is cut, by N alone ([`Partition`]): chunks of [`CHUNK`] consecutive realizations,
+//! whose lane groups pass every fix together (`engine`), and at most [`MAX_BLOCKS`] blocks of
+//! consecutive chunks. One worker per thread sums a block, chunk after chunk, into one
+//! [`Accumulator`] (`workers`); finished blocks are handed over in block order, folded into the
+//! total or written to a partial file. A block's sums depend on its realizations alone, so one
+//! run gives the same numbers on any number of threads, and shards merged in block order give the
+//! numbers of one run.
+//!
+//! The files: `engine` sums a block with either engine, `kernel` (per-sample) and `epoch` simulate
+//! lane groups, `lane_sums` adds a fix across lanes, `tiles` adds the residual products in single
+//! precision, `layout` says which residual products are kept, `sums` and `stats` hold the sums and
+//! the statistics made of them, `workers` runs the blocks in parallel, `partial` writes and merges
+//! shards.
 
 mod engine;
 pub mod epoch;
@@ -16,35 +33,36 @@ pub mod partial;
 mod stats;
 mod sums;
 mod tiles;
+mod workers;
 
+use std::borrow::Cow;
+use std::ops::Range;
 use std::time::Instant;
 
+use crate::config::TruthModel;
 use crate::filter::FilterSchedule;
 use crate::model::Model;
-pub use engine::{Engine, Prepared, Scratch, accumulate, accumulate_into, accumulate_with};
+pub use engine::Engine;
+use engine::Prepared;
+use epoch::EpochPlan;
 pub use lane_sums::LaneFix;
 pub use layout::ResidualLayout;
 pub use stats::{EnsembleStats, FixStats, StageStats, StageView, Statistics};
 pub use sums::{Accumulator, FixSums, StageSums};
 pub use tiles::{PASS, PRODUCT_RELATIVE_ERROR};
 
-/// Realizations summed sequentially into one accumulator before it is merged.
+/// Realizations of a chunk: its lane groups of [`LANES`](crate::lanes::LANES) pass every fix
+/// together, so that the per-lane sums of a fix are added across lanes once per chunk
+/// (`lane_sums`). It is also the unit [`Partition`] cuts blocks from: changing it changes the
+/// order of every sum, and so the last bits of the statistics.
 pub const CHUNK: u64 = 64;
-
-/// Memory the chunk accumulators in flight may take together, bytes.
-const WINDOW_BYTES: u64 = 256 << 20;
-
-/// The residual layout of `model`'s ensemble.
-pub fn layout_of(model: &Model) -> ResidualLayout {
-    ResidualLayout::new(model.timeline.fixes(), model.residual_max_lag())
-}
 
 /// Largest number of blocks an ensemble is folded in. Blocks are the unit of sharding.
 pub const MAX_BLOCKS: u64 = 256;
 
 /// How the N realizations of an ensemble are grouped, by N alone: chunks of [`CHUNK`]
 /// consecutive indices; blocks of consecutive chunks, each summed chunk after chunk in a fixed
-/// order (see [`accumulate_into`]); the ensemble is the fold of its blocks in order. A
+/// order (see `engine`); the ensemble is the fold of its blocks in order. A
 /// shard runs whole blocks, so shards merged in block order give the sums of one run, number
 /// for number.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,17 +91,23 @@ impl Partition {
     }
 
     /// The chunks of block `b`.
-    pub fn block_chunks(&self, b: u64) -> std::ops::Range<u64> {
+    pub fn block_chunks(&self, b: u64) -> Range<u64> {
         b * self.chunks_per_block..((b + 1) * self.chunks_per_block).min(self.chunks)
     }
 
     /// The realization indices of chunk `c`.
-    pub fn chunk_realizations(&self, c: u64) -> std::ops::Range<u64> {
+    pub fn chunk_realizations(&self, c: u64) -> Range<u64> {
         c * CHUNK..((c + 1) * CHUNK).min(self.realizations)
     }
 
+    /// The realization indices of block `b`.
+    pub fn block_realizations(&self, b: u64) -> Range<u64> {
+        let chunks = self.block_chunks(b);
+        self.chunk_realizations(chunks.start).start..self.chunk_realizations(chunks.end - 1).end
+    }
+
     /// The realizations of blocks `blocks`.
-    pub fn realizations_in(&self, blocks: &std::ops::Range<u64>) -> u64 {
+    pub fn realizations_in(&self, blocks: &Range<u64>) -> u64 {
         if blocks.is_empty() {
             return 0;
         }
@@ -92,207 +116,199 @@ impl Partition {
         self.chunk_realizations(last - 1).end - self.chunk_realizations(first).start
     }
 
-    /// The blocks of shard `k` of `m`, k counted from 1: blocks ⌊(k − 1)·B/m⌋ up to ⌊k·B/m⌋.
-    pub fn shard_blocks(&self, k: u64, m: u64) -> std::ops::Range<u64> {
+    /// The blocks of `shard` k of m: blocks ⌊(k − 1)·B/m⌋ up to ⌊k·B/m⌋ of the B blocks.
+    pub fn shard_blocks(&self, shard: Shard) -> Range<u64> {
+        let Shard { index: k, of: m } = shard;
         (k - 1) * self.blocks / m..k * self.blocks / m
     }
 }
 
-/// Finished blocks waiting for their turn, and the callbacks that take them in block order.
-struct Emitter<P, B> {
-    /// The next block to hand over.
-    next: u64,
-    waiting: std::collections::BTreeMap<u64, Accumulator>,
-    /// Sums handed over, kept for the next blocks: a block overwrites every number of them.
-    spare: Vec<Accumulator>,
-    done: u64,
-    /// A worker panicked: the others stop instead of waiting for its block.
-    failed: bool,
-    progress: P,
-    on_block: B,
+/// Shard k of m of an ensemble: the k-th of m runs of consecutive blocks, whose partial sums,
+/// merged in block order, give the sums of one run (see [`Partition::shard_blocks`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    /// k, counted from 1.
+    pub index: u64,
+    /// m, the number of shards.
+    pub of: u64,
 }
 
-/// Set in each worker: if the worker panics, it marks the run failed, lets no further block be
-/// taken and wakes the waiting workers, so that every worker ends and `rayon::broadcast` hands
-/// the panic to the caller (rather than the others waiting forever for the lost block).
-struct Abort<'a, P, B> {
-    emitter: &'a std::sync::Mutex<Emitter<P, B>>,
-    turn: &'a std::sync::Condvar,
-    claimed: &'a std::sync::atomic::AtomicU64,
-    end: u64,
+impl Shard {
+    /// The whole ensemble, shard 1 of 1.
+    pub const WHOLE: Shard = Shard { index: 1, of: 1 };
 }
 
-impl<P, B> Drop for Abort<'_, P, B> {
-    fn drop(&mut self) {
-        if std::thread::panicking() {
-            self.claimed
-                .store(self.end, std::sync::atomic::Ordering::SeqCst);
-            self.emitter
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .failed = true;
-            self.turn.notify_all();
+/// One ensemble to run: the model and its truth, the filter schedule, the engine, the number of
+/// realizations N, the seed and the shard. [`Ensemble::new`] takes N and the seed from the model's
+/// configuration, the per-sample engine and the whole ensemble; the `with_` methods change them.
+///
+/// ```
+/// # use accelcal::{config::Config, model::Model, filter::FilterSchedule};
+/// use accelcal::ensemble::{Engine, Ensemble};
+/// let mut config = Config::default();
+/// config.profile.duration_s = 2.0;
+/// let model = Model::new(&config).unwrap();
+/// let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats).unwrap();
+/// let run = Ensemble::new(&model, &schedule)
+///     .with_engine(Engine::Epoch)
+///     .with_realizations(200)
+///     .with_seed(7)
+///     .run(|_done| {});
+/// assert_eq!(run.stats.realizations, 200);
+/// ```
+#[derive(Clone, Debug)]
+pub struct Ensemble<'a> {
+    model: Cow<'a, Model>,
+    schedule: &'a FilterSchedule,
+    prepared: Prepared,
+    seed: u64,
+    realizations: u64,
+    shard: Shard,
+}
+
+impl<'a> Ensemble<'a> {
+    /// The ensemble of `model` (its truth, N and seed) filtered with `schedule`, with the
+    /// per-sample engine, whole.
+    pub fn new(model: &'a Model, schedule: &'a FilterSchedule) -> Self {
+        let e = &model.config.ensemble;
+        Self {
+            seed: e.seed,
+            realizations: e.realizations,
+            model: Cow::Borrowed(model),
+            schedule,
+            prepared: Prepared::Sample,
+            shard: Shard::WHOLE,
         }
     }
-}
 
-/// Runs blocks `blocks` of the `n` realizations of `model` under `seed` in parallel with the
-/// engine `prepared`, and hands each block's sums to `on_block` as it is finished, in block
-/// order. `progress` is called with the number of realizations of these blocks finished so far.
-///
-/// Each block is summed by one thread, chunk after chunk (see [`accumulate_into`]): its sums
-/// depend on the block's realizations alone, never on the thread count. One worker per thread
-/// takes the next block as it finishes one; finished blocks are handed over in block order, and
-/// a worker waits rather than run more than a window of blocks ahead of the oldest unfinished
-/// one, so that at most about WINDOW_BYTES of sums are alive at once.
-#[allow(clippy::too_many_arguments)]
-pub fn run_blocks_prepared(
-    prepared: &Prepared,
-    model: &Model,
-    schedule: &FilterSchedule,
-    seed: u64,
-    n: u64,
-    blocks: std::ops::Range<u64>,
-    progress: impl FnMut(u64) + Send,
-    on_block: impl FnMut(u64, &Accumulator) + Send,
-) {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    use std::sync::{Condvar, Mutex};
+    /// The same ensemble with the truth `truth` (the filter and its schedule unchanged).
+    pub fn with_truth(mut self, truth: TruthModel) -> Self {
+        self.model = Cow::Owned(self.model.with_truth(truth));
+        // The epoch engine's plan holds the truth's noise-free error: made again.
+        let engine = self.engine();
+        self.with_engine(engine)
+    }
 
-    let partition = Partition::new(n);
-    let layout = layout_of(model);
-    let acc_bytes = 8 * (2 * layout.len() + 51 * layout.fixes()).max(1) as u64;
-    let threads = rayon::current_num_threads() as u64;
-    let window = (2 * threads)
-        .min((WINDOW_BYTES / acc_bytes).max(threads))
-        .max(1);
-    let claimed = AtomicU64::new(blocks.start);
-    let emitter = Mutex::new(Emitter {
-        next: blocks.start,
-        waiting: Default::default(),
-        spare: Vec::new(),
-        done: 0,
-        failed: false,
-        progress,
-        on_block,
-    });
-    let turn = Condvar::new();
-    let lock = || emitter.lock().unwrap_or_else(|e| e.into_inner());
-    let worker = || {
-        let _abort = Abort {
-            emitter: &emitter,
-            turn: &turn,
-            claimed: &claimed,
-            end: blocks.end,
-        };
-        let mut scratch = Scratch::default();
-        loop {
-            let b = claimed.fetch_add(1, Ordering::Relaxed);
-            if b >= blocks.end {
-                return;
-            }
-            // Every block before b is claimed by a running worker, so the wait ends (or a
-            // worker failed, and the run with it).
-            let mut e = turn
-                .wait_while(lock(), |e| !e.failed && b >= e.next + window)
-                .unwrap_or_else(|e| e.into_inner());
-            if e.failed {
-                return;
-            }
-            let mut acc = e
-                .spare
-                .pop()
-                .unwrap_or_else(|| Accumulator::new(&layout, model.residual_pair));
-            drop(e);
-            let chunks = partition.block_chunks(b);
-            let range = partition.chunk_realizations(chunks.start).start
-                ..partition.chunk_realizations(chunks.end - 1).end;
-            accumulate_into(
-                prepared,
-                model,
-                schedule,
-                seed,
-                range,
-                &mut acc,
-                &mut scratch,
-            );
-            let mut e = lock();
-            if e.failed {
-                return;
-            }
-            e.waiting.insert(b, acc);
-            let mut advanced = false;
-            loop {
-                let next = e.next;
-                let Some(acc) = e.waiting.remove(&next) else {
-                    break;
-                };
-                e.done += acc.count;
-                (e.on_block)(next, &acc);
-                e.spare.push(acc);
-                e.next += 1;
-                advanced = true;
-            }
-            if advanced {
-                let done = e.done;
-                (e.progress)(done);
-                drop(e);
-                turn.notify_all();
-            }
+    /// The same ensemble simulated by `engine`.
+    pub fn with_engine(mut self, engine: Engine) -> Self {
+        self.prepared = Prepared::new(engine, &self.model, self.schedule);
+        self
+    }
+
+    /// The same ensemble simulated by the epoch engine with `plan` in place of the model's own (a
+    /// deliberately wrong plan shows that the engines' comparison can fail).
+    pub fn with_epoch_plan(mut self, plan: EpochPlan) -> Self {
+        self.prepared = Prepared::Epoch(plan);
+        self
+    }
+
+    /// The same ensemble with `n` realizations.
+    pub fn with_realizations(mut self, n: u64) -> Self {
+        self.realizations = n;
+        self
+    }
+
+    /// The same ensemble under `seed`.
+    pub fn with_seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Only `shard` of the ensemble.
+    ///
+    /// # Panics
+    /// Unless 1 ≤ k ≤ m.
+    pub fn with_shard(mut self, shard: Shard) -> Self {
+        assert!(
+            1 <= shard.index && shard.index <= shard.of,
+            "shard {}/{} is not k/m with 1 ≤ k ≤ m",
+            shard.index,
+            shard.of
+        );
+        self.shard = shard;
+        self
+    }
+
+    /// The simulated model (with the truth of [`Ensemble::with_truth`]).
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The filter's schedule.
+    pub fn schedule(&self) -> &FilterSchedule {
+        self.schedule
+    }
+
+    /// The engine.
+    pub fn engine(&self) -> Engine {
+        self.prepared.engine()
+    }
+
+    /// The seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// How the N realizations are cut into chunks and blocks.
+    pub fn partition(&self) -> Partition {
+        Partition::new(self.realizations)
+    }
+
+    /// The blocks this ensemble runs: its shard's.
+    pub fn block_range(&self) -> Range<u64> {
+        self.partition().shard_blocks(self.shard)
+    }
+
+    /// Which residual products the sums keep.
+    pub fn layout(&self) -> ResidualLayout {
+        ResidualLayout::new(self.model.timeline.fixes(), self.model.residual_max_lag())
+    }
+
+    /// Empty sums of this ensemble.
+    fn empty_sums(&self) -> Accumulator {
+        Accumulator::new(&self.layout(), self.model.residual_pair)
+    }
+
+    /// Runs the blocks of the shard in parallel and hands each block's sums to `on_block` with its
+    /// index, in block order. `progress` is called with the number of realizations of the shard
+    /// finished so far.
+    pub fn blocks(
+        &self,
+        progress: impl FnMut(u64) + Send,
+        on_block: impl FnMut(u64, &Accumulator) + Send,
+    ) {
+        workers::run_blocks(self, progress, on_block);
+    }
+
+    /// The sums of the shard's realizations, the fold of its blocks in block order; `progress` as
+    /// in [`Ensemble::blocks`].
+    pub fn sums(&self, progress: impl FnMut(u64) + Send) -> Accumulator {
+        let mut total = self.empty_sums();
+        self.blocks(progress, |_, block| total.merge(block));
+        total
+    }
+
+    /// The statistics of the shard's realizations and how fast they ran; `progress` as in
+    /// [`Ensemble::blocks`].
+    pub fn run(&self, progress: impl FnMut(u64) + Send) -> EnsembleRun {
+        let start = Instant::now();
+        let sums = self.sums(progress);
+        let elapsed_s = start.elapsed().as_secs_f64();
+        EnsembleRun {
+            stats: EnsembleStats::from_sums(&sums, self.schedule),
+            elapsed_s,
+            engine: self.engine(),
         }
-    };
-    rayon::broadcast(|_| worker());
-}
+    }
 
-/// Runs `n` realizations of `model` under `seed` in parallel and returns their sums, the fold
-/// of every block in order. `progress` is called with the number of realizations finished so
-/// far.
-pub fn run(
-    model: &Model,
-    schedule: &FilterSchedule,
-    seed: u64,
-    n: u64,
-    progress: impl FnMut(u64) + Send,
-) -> Accumulator {
-    run_with(Engine::Sample, model, schedule, seed, n, progress)
+    /// The sums of realizations `range` in one piece, on this thread.
+    #[cfg(test)]
+    fn sums_of(&self, range: Range<u64>) -> Accumulator {
+        let mut sums = self.empty_sums();
+        engine::accumulate_into(self, range, &mut sums, &mut engine::Scratch::default());
+        sums
+    }
 }
-
-/// [`run`] with the engine `engine`.
-pub fn run_with(
-    engine: Engine,
-    model: &Model,
-    schedule: &FilterSchedule,
-    seed: u64,
-    n: u64,
-    progress: impl FnMut(u64) + Send,
-) -> Accumulator {
-    let prepared = Prepared::new(engine, model, schedule);
-    run_prepared(&prepared, model, schedule, seed, n, progress)
-}
-
-/// [`run`] with the engine `prepared`.
-pub fn run_prepared(
-    prepared: &Prepared,
-    model: &Model,
-    schedule: &FilterSchedule,
-    seed: u64,
-    n: u64,
-    progress: impl FnMut(u64) + Send,
-) -> Accumulator {
-    let mut total = Accumulator::new(&layout_of(model), model.residual_pair);
-    run_blocks_prepared(
-        prepared,
-        model,
-        schedule,
-        seed,
-        n,
-        0..Partition::new(n).blocks,
-        progress,
-        |_, block| total.merge(block),
-    );
-    total
-}
-
 /// A finished ensemble: its statistics and how fast it ran.
 #[derive(Clone, Debug)]
 pub struct EnsembleRun {
@@ -308,33 +324,6 @@ impl EnsembleRun {
     /// Realizations per second.
     pub fn realizations_per_s(&self) -> f64 {
         self.stats.realizations as f64 / self.elapsed_s
-    }
-}
-
-/// Runs the ensemble of `model` with its configured size and seed.
-pub fn run_model(
-    model: &Model,
-    schedule: &FilterSchedule,
-    progress: impl FnMut(u64) + Send,
-) -> EnsembleRun {
-    run_model_with(Engine::Sample, model, schedule, progress)
-}
-
-/// [`run_model`] with the engine `engine`.
-pub fn run_model_with(
-    engine: Engine,
-    model: &Model,
-    schedule: &FilterSchedule,
-    progress: impl FnMut(u64) + Send,
-) -> EnsembleRun {
-    let e = &model.config.ensemble;
-    let start = Instant::now();
-    let acc = run_with(engine, model, schedule, e.seed, e.realizations, progress);
-    let elapsed_s = start.elapsed().as_secs_f64();
-    EnsembleRun {
-        stats: EnsembleStats::from_sums(&acc, schedule),
-        elapsed_s,
-        engine,
     }
 }
 

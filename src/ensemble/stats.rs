@@ -132,6 +132,10 @@ impl<const N: usize, const M: usize> EnsembleStats<N, M> {
     }
 }
 
+/// An estimate component whose variance is below this share of its mean square is taken as
+/// constant: its one-pass variance Σx̂²/N − x̂̄² is then rounding, not spread.
+const CONSTANT_VAR_SHARE: f64 = 1e-24;
+
 fn stage_stats<const N: usize>(s: &StageSums<N>, p: &SMatrix<f64, N, N>, n: f64) -> StageStats<N> {
     let mean_e = s.e / n;
     let mean_x = s.x / n;
@@ -144,8 +148,8 @@ fn stage_stats<const N: usize>(s: &StageSums<N>, p: &SMatrix<f64, N, N>, n: f64)
     let corr = SMatrix::<f64, N, N>::from_fn(|j, k| {
         let d = var_e[j] * var_x[k];
         // An estimate component that does not vary (e.g. the a priori estimate at a fix at t = 0)
-        // has no correlation to speak of; relative tolerance because of rounding in the sums.
-        if var_x[k] > 1e-24 * (s.xx[k] / n).max(f64::MIN_POSITIVE) && d > 0.0 {
+        // has no correlation to speak of.
+        if var_x[k] > CONSTANT_VAR_SHARE * (s.xx[k] / n).max(f64::MIN_POSITIVE) && d > 0.0 {
             ortho[(j, k)] / d.sqrt()
         } else {
             f64::NAN

@@ -1,5 +1,5 @@
 //! Running sums of an ensemble: everything the statistics need, added one realization at a time
-//! and merged chunk by chunk, with no per-realization storage.
+//! and merged block by block, with no per-realization storage.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -125,6 +125,23 @@ pub struct FixSums<const N: usize = { ErrorState::DIM }> {
     /// Σ rᵀ·S⁻¹·r (the normalized innovation squared).
     pub nis: f64,
 }
+
+impl<const N: usize> FixSums<N> {
+    /// Floats of one fix's sums in a file: the two stages' and Σ NIS.
+    pub const FLOATS: usize = 2 * StageSums::<N>::FLOATS + 1;
+    /// Floats of one fix's sums in memory (Σ e·eᵀ kept whole).
+    pub const MEMORY_FLOATS: usize = floats_of::<Self>();
+}
+
+/// Floats in a `T` made of `f64`s only (checked at compile time: no padding, nothing else).
+const fn floats_of<T>() -> usize {
+    let (size, float) = (std::mem::size_of::<T>(), std::mem::size_of::<f64>());
+    assert!(size % float == 0, "sums are made of f64s only");
+    size / float
+}
+
+// The configuration's memory budget counts the sums with the model's figure.
+const _: () = assert!(<FixSums>::MEMORY_FLOATS == crate::model::SUM_FLOATS_PER_FIX);
 
 /// Running sums of an ensemble, or of part of one, for a state of `N` variables and a
 /// measurement of `M` components.

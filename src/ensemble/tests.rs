@@ -15,9 +15,10 @@ fn small() -> (Model, FilterSchedule) {
 #[test]
 fn merged_chunks_equal_one_pass_up_to_rounding() {
     let (m, s) = small();
-    let whole = accumulate(&m, &s, 5, 0..300);
-    let mut parts = accumulate(&m, &s, 5, 0..100);
-    parts.merge(&accumulate(&m, &s, 5, 100..300));
+    let e = Ensemble::new(&m, &s).with_seed(5);
+    let whole = e.sums_of(0..300);
+    let mut parts = e.sums_of(0..100);
+    parts.merge(&e.sums_of(100..300));
     assert_eq!(whole.count, parts.count);
     // The residual products are summed in single precision within a chunk, and the two runs
     // have different chunks: each is within PRODUCT_RELATIVE_ERROR of the exact sum.
@@ -58,8 +59,9 @@ fn parallel_run_is_independent_of_the_thread_count() {
         .num_threads(3)
         .build()
         .unwrap();
-    let a = one.install(|| run(&m, &s, 9, 1000, |_| {}));
-    let b = three.install(|| run(&m, &s, 9, 1000, |_| {}));
+    let e = Ensemble::new(&m, &s).with_seed(9).with_realizations(1000);
+    let a = one.install(|| e.sums(|_| {}));
+    let b = three.install(|| e.sums(|_| {}));
     assert_eq!(a, b);
 }
 
@@ -73,7 +75,7 @@ fn streaming_moments_match_a_two_pass_computation() {
     }
     let (m, s) = small();
     let n = 200u64;
-    let stats = EnsembleStats::from_sums(&accumulate(&m, &s, 3, 0..n), &s);
+    let stats = EnsembleStats::from_sums(&Ensemble::new(&m, &s).with_seed(3).sums_of(0..n), &s);
     let runs: Vec<Vec<FixState>> = (0..n)
         .map(|l| {
             let mut k = Keep(Vec::new());
@@ -133,18 +135,16 @@ fn a_panicking_block_ends_the_run_with_the_panic() {
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             two.install(|| {
                 // 40 blocks of one chunk: far more than the window of blocks in flight.
-                run_blocks_prepared(
-                    &Prepared::new(Engine::Epoch, &m, &s),
-                    &m,
-                    &s,
-                    1,
-                    40 * CHUNK,
-                    0..40,
-                    |_| {},
-                    |b, _| {
-                        assert!(b != 0, "a failing block");
-                    },
-                )
+                Ensemble::new(&m, &s)
+                    .with_engine(Engine::Epoch)
+                    .with_seed(1)
+                    .with_realizations(40 * CHUNK)
+                    .blocks(
+                        |_| {},
+                        |b, _| {
+                            assert!(b != 0, "a failing block");
+                        },
+                    )
             })
         }));
         tx.send(result.is_err()).unwrap();
@@ -153,4 +153,54 @@ fn a_panicking_block_ends_the_run_with_the_panic() {
         .recv_timeout(std::time::Duration::from_secs(60))
         .expect("the run returned");
     assert!(panicked);
+}
+
+/// The shards of an ensemble, folded in shard order, give its sums number for number; a shard
+/// runs its own blocks only.
+#[test]
+fn shards_fold_to_the_whole_ensemble() {
+    let (m, s) = small();
+    // 40 chunks: 40 blocks of one chunk, cut into three uneven shards.
+    let e = Ensemble::new(&m, &s)
+        .with_engine(Engine::Epoch)
+        .with_seed(4)
+        .with_realizations(40 * CHUNK - 5);
+    let whole = e.sums(|_| {});
+    let mut folded = e.empty_sums();
+    let mut blocks = Vec::new();
+    for k in 1..=3 {
+        let shard = e.clone().with_shard(Shard { index: k, of: 3 });
+        shard.blocks(
+            |_| {},
+            |b, acc| {
+                blocks.push(b);
+                folded.merge(acc);
+            },
+        );
+    }
+    assert_eq!(blocks, (0..40).collect::<Vec<_>>());
+    assert_eq!(folded, whole);
+    assert_eq!(whole.count, 40 * CHUNK - 5);
+}
+
+/// `with_truth` simulates the other truth: the same sums as an ensemble of the model with that
+/// truth, and not those of the model's own.
+#[test]
+fn with_truth_runs_the_other_truth() {
+    let (m, s) = small();
+    let euler = m.with_truth(crate::config::TruthModel::Euler);
+    for engine in [Engine::Sample, Engine::Epoch] {
+        let of_model = Ensemble::new(&euler, &s).with_engine(engine).with_seed(2);
+        let switched = Ensemble::new(&m, &s)
+            .with_engine(engine)
+            .with_seed(2)
+            .with_truth(crate::config::TruthModel::Euler);
+        let own = Ensemble::new(&m, &s).with_engine(engine).with_seed(2);
+        let range = 0..100;
+        assert_eq!(
+            switched.sums_of(range.clone()),
+            of_model.sums_of(range.clone())
+        );
+        assert_ne!(own.sums_of(range.clone()), of_model.sums_of(range));
+    }
 }

@@ -115,10 +115,7 @@ pub(super) fn add_products(
         panels,
         count,
         first,
-        tile_add::<0>,
-        tile_add::<4>,
-        tile_add::<8>,
-        tile_add::<12>,
+        [tile_add::<0>, tile_add::<4>, tile_add::<8>, tile_add::<12>],
     );
 }
 
@@ -127,8 +124,10 @@ pub(super) fn add_products(
 /// multiply-add), then added to the tile's double-precision sums.
 type Kernel = fn(&mut [f64; TILE], &[f32], &[f32]);
 
-/// The tiles of `layout` in storage order, each given to the kernel for its row offset.
-#[allow(clippy::too_many_arguments)]
+/// The tile kernels of the row offsets within a panel, 0, [`ROWS`], 2·[`ROWS`], …, in order.
+type Kernels = [Kernel; PANEL / ROWS];
+
+/// The tiles of `layout` in storage order, each given to the kernel of its row offset.
 #[inline(always)]
 fn add_products_with(
     layout: &ResidualLayout,
@@ -136,10 +135,7 @@ fn add_products_with(
     panels: &[f32],
     count: usize,
     first: bool,
-    k0: Kernel,
-    k4: Kernel,
-    k8: Kernel,
-    k12: Kernel,
+    kernels: Kernels,
 ) {
     let width = PANEL * count;
     let m = 2 * layout.fixes();
@@ -147,12 +143,8 @@ fn add_products_with(
     for a0 in (0..m).step_by(ROWS) {
         let last = (a0 + ROWS - 1).min(m - 1);
         let rows = &panels[(a0 / PANEL) * width..][..width];
-        let kernel = match a0 % PANEL {
-            0 => k0,
-            4 => k4,
-            8 => k8,
-            _ => k12,
-        };
+        // a0 is a multiple of ROWS: the kernel of its offset within its panel.
+        let kernel = kernels[(a0 % PANEL) / ROWS];
         for pb in layout.first_col(a0) / PANEL..=last / PANEL {
             let cols = &panels[pb * width..][..width];
             let tile = tiles.next().expect("a tile for every (a0, pb)");
@@ -204,10 +196,12 @@ mod avx2 {
             panels,
             count,
             first,
-            |t, r, c| tile_add::<0>(t, r, c),
-            |t, r, c| tile_add::<4>(t, r, c),
-            |t, r, c| tile_add::<8>(t, r, c),
-            |t, r, c| tile_add::<12>(t, r, c),
+            [
+                |t, r, c| tile_add::<0>(t, r, c),
+                |t, r, c| tile_add::<4>(t, r, c),
+                |t, r, c| tile_add::<8>(t, r, c),
+                |t, r, c| tile_add::<12>(t, r, c),
+            ],
         );
     }
 
@@ -398,10 +392,7 @@ mod tests {
             &panels,
             count,
             false,
-            tile_add::<0>,
-            tile_add::<4>,
-            tile_add::<8>,
-            tile_add::<12>,
+            [tile_add::<0>, tile_add::<4>, tile_add::<8>, tile_add::<12>],
         );
         add_products(&layout, &mut fast, &panels, count, false);
         assert!(

@@ -7,14 +7,28 @@ use crate::config::{AccelerometerOutput, Case, Config, TruthModel};
 use crate::error::ConfigError;
 use validate::{validate, whole};
 
+use crate::state::ErrorState;
+pub use crate::state::NoiseStats;
+
 /// Largest number of accelerometer samples in a run.
 pub const MAX_STEPS: usize = 10_000_000;
 /// Largest number of GPS fixes in a run.
 pub const MAX_FIXES: usize = 1_000_000;
-/// Largest memory the running sums of one chunk of realizations may take, bytes: 51 floats per
-/// fix and the kept residual products. A run needs a few of them at once (one per thread in
-/// flight, one per open block, the total).
+/// Largest memory the running sums of one block of realizations may take, bytes:
+/// [`SUM_FLOATS_PER_FIX`] floats per fix and the kept residual products. A run holds a few of
+/// them at once (two per thread at most, and the total).
 pub const MAX_SUMS_BYTES: usize = 256 << 20;
+/// Floats of an ensemble's running sums at one fix in memory (`ensemble::FixSums`, which checks
+/// at compile time that it has this size): for the a priori and the a posteriori stage each
+/// [`SUM_FLOATS_PER_STAGE`], then Σ NIS.
+pub const SUM_FLOATS_PER_FIX: usize = 2 * SUM_FLOATS_PER_STAGE + 1;
+/// Floats of an ensemble's running sums of one stage at one fix in memory (`ensemble::StageSums`)
+/// for the n states of the error state: Σe (n), Σe·eᵀ (n²), Σe·δx̂ᵀ (n²), Σδx̂ (n), Σδx̂² (n),
+/// Σ NEES.
+pub const SUM_FLOATS_PER_STAGE: usize = {
+    let n = ErrorState::DIM;
+    n + n * n + n * n + n + n + 1
+};
 /// Runs with at most this many fixes test the residual whiteness of every pair of fixes by
 /// default; longer runs test lags up to [`DEFAULT_MAX_LAG`] (every pair costs O(fixes²)).
 pub const ALL_PAIRS_MAX_FIXES: usize = 1_000;
@@ -68,23 +82,6 @@ impl Timeline {
     pub fn fix_time_s(&self, i: usize) -> f64 {
         self.time_s(self.fix_steps[i])
     }
-}
-
-/// Noise statistics of the error-state system: the truth's, or the ones the filter assumes.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NoiseStats {
-    /// Accelerometer white-noise variance W, (m/s²)².
-    pub accel_noise_var_m2_s4: f64,
-    /// Bias prior variance, (m/s²)².
-    pub bias_var_m2_s4: f64,
-    /// GPS position noise σ, m.
-    pub gps_position_sigma_m: f64,
-    /// GPS velocity noise σ, m/s.
-    pub gps_velocity_sigma_m_s: f64,
-    /// Initial position σ, m.
-    pub initial_position_sigma_m: f64,
-    /// Initial velocity σ, m/s.
-    pub initial_velocity_sigma_m_s: f64,
 }
 
 /// The validated model of one study.

@@ -3,7 +3,7 @@
 
 use super::{
     ALL_PAIRS_MAX_FIXES, DEFAULT_MAX_LAG, FILTER_FLOOR, MAX_FIXES, MAX_REALIZATIONS, MAX_STEPS,
-    MAX_SUMS_BYTES, WHOLE_TOL,
+    MAX_SUMS_BYTES, SUM_FLOATS_PER_FIX, WHOLE_TOL,
 };
 use crate::config::Config;
 use crate::error::ConfigError;
@@ -212,21 +212,26 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
             "must be a whole number of fixes ≥ 1 (or left out)",
         ));
     }
-    // The running sums of one chunk of realizations must fit the memory budget: 51 floats per
-    // fix and the kept residual products (every pair, or a band of lags).
+    // The running sums of one block of realizations must fit the memory budget: the per-fix sums
+    // and the kept residual products (every pair, or a band of lags).
     let f = fixes as f64;
+    let sum_floats = SUM_FLOATS_PER_FIX as f64;
     let lag = match k.residual_max_lag {
         Some(l) => Some(f64::from(l)),
         None if fixes as usize <= ALL_PAIRS_MAX_FIXES => None,
         None => Some(DEFAULT_MAX_LAG as f64),
     };
+    // The stacked residuals have 2·fixes components: a band keeps at most 2·(lag + 1) of each
+    // row, every pair keeps the whole lower triangle (see `ensemble::ResidualLayout`).
     let products = match lag {
         Some(l) if l + 1.0 < f => 2.0 * f * (2.0 * l + 2.0),
         _ => f * (2.0 * f + 1.0),
     };
-    let bytes = 8.0 * (51.0 * f + products);
+    let float_bytes = std::mem::size_of::<f64>() as f64;
+    let bytes = float_bytes * (sum_floats * f + products);
     if bytes > MAX_SUMS_BYTES as f64 {
-        let budget = MAX_SUMS_BYTES as f64 / 8.0 - 51.0 * f;
+        let budget = MAX_SUMS_BYTES as f64 / float_bytes - sum_floats * f;
+        // The largest lag whose band fits: 2·f·(2·lag + 2) ≤ budget.
         let most = ((budget / (2.0 * f) - 2.0) / 2.0).floor();
         let mib = |b: f64| format!("{:.0} MiB", b / 1048576.0);
         return Err(match k.residual_max_lag {
@@ -234,7 +239,7 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
                 "checks.residual_max_lag",
                 l,
                 format!(
-                    "with {fixes} fixes the running sums would take {} per chunk of realizations; \
+                    "with {fixes} fixes the running sums would take {} per block of realizations; \
                      at most {} lags keep them within {}",
                     mib(bytes),
                     most,
@@ -245,7 +250,7 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
                 "gps.sample_rate_hz",
                 g.sample_rate_hz,
                 format!(
-                    "the run would hold {fixes} fixes, whose running sums would take {} per chunk \
+                    "the run would hold {fixes} fixes, whose running sums would take {} per block \
                      of realizations (at most {}): lower the GPS rate or shorten the run",
                     mib(bytes),
                     mib(MAX_SUMS_BYTES as f64)

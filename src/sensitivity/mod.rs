@@ -16,7 +16,7 @@ pub mod sampler;
 
 use crate::checks::{self, Budget, CheckId, Verdict};
 use crate::config::{Case, Config};
-use crate::ensemble::{self, Engine, EnsembleStats};
+use crate::ensemble::{Engine, Ensemble, EnsembleStats};
 use crate::error::{ConfigError, FilterError};
 use crate::filter::FilterSchedule;
 use crate::model::Model;
@@ -372,15 +372,15 @@ fn monte_carlo(
     // Built again rather than kept from the first pass: one covariance pass, against
     // memory that would grow with cases × fixes.
     let (model, schedule) = mistuned(world, case.parameter, case.factor)?;
-    let prepared = ensemble::Prepared::new(plan.engine, &model, &schedule);
+    let mut ensemble = Ensemble::new(&model, &schedule)
+        .with_engine(plan.engine)
+        .with_realizations(plan.realizations);
     let mut failures = vec![0u64; CheckId::ALL.len()];
     let mut done = before;
     for k in 0..plan.ensembles {
         let seed = mix(case_seed(seed, ENSEMBLES, case.parameter, case.factor), k);
-        let acc =
-            ensemble::run_prepared(&prepared, &model, &schedule, seed, plan.realizations, |d| {
-                progress.advance(done + d)
-            });
+        ensemble = ensemble.with_seed(seed);
+        let acc = ensemble.sums(|d| progress.advance(done + d));
         done += plan.realizations;
         let stats = EnsembleStats::from_sums(&acc, &schedule);
         let v = checks::evaluate(&stats, budget);

@@ -9,7 +9,7 @@ pub mod analysis;
 
 use crate::checks::{self, Budget, Verdicts};
 use crate::config::Case;
-use crate::ensemble::{self, EnsembleRun};
+use crate::ensemble::{Ensemble, EnsembleRun};
 use crate::error::FilterError;
 use crate::filter::FilterSchedule;
 use crate::model::Model;
@@ -46,16 +46,13 @@ impl CaseOutcome {
     }
 }
 
-/// Runs the ensemble of `model` (its configured case, size and seed) and judges it.
-pub fn run_case(
-    model: &Model,
-    schedule: &FilterSchedule,
-    progress: &mut dyn Progress,
-) -> CaseOutcome {
-    progress.start(&model.case().id(), model.config.ensemble.realizations);
-    let run = ensemble::run_model(model, schedule, |done| progress.advance(done));
+/// Runs `ensemble` and judges it.
+pub fn run_case(ensemble: &Ensemble, progress: &mut dyn Progress) -> CaseOutcome {
+    let model = ensemble.model();
+    progress.start(&model.case().id(), ensemble.partition().realizations);
+    let run = ensemble.run(|done| progress.advance(done));
     progress.finish();
-    judge_case(model, schedule, run)
+    judge_case(model, ensemble.schedule(), run)
 }
 
 /// Judges the finished ensemble `run` of `model`: verdicts, predicted mean error, achieved
@@ -107,7 +104,10 @@ impl Study {
         }
         let cases: Vec<CaseOutcome> = cases
             .into_iter()
-            .map(|case| run_case(&model.with_case(case), &schedule, progress))
+            .map(|case| {
+                let model = model.with_case(case);
+                run_case(&Ensemble::new(&model, &schedule), progress)
+            })
             .collect();
         let preferred = [Case::INTERVAL_MEANS, Case::MODEL_WORLD];
         let realization_case = preferred

@@ -22,12 +22,8 @@ pub fn model_of(config: &Config) -> (Model, FilterSchedule) {
 /// Runs the ensemble of `config` with `truth` and evaluates its checks.
 pub fn verdicts_of(config: &Config, truth: TruthModel) -> Verdicts {
     let (model, schedule) = model_of(config);
-    accelcal::study::run_case(
-        &model.with_truth(truth),
-        &schedule,
-        &mut accelcal::study::Silent,
-    )
-    .verdicts
+    let ensemble = accelcal::ensemble::Ensemble::new(&model, &schedule).with_truth(truth);
+    accelcal::study::run_case(&ensemble, &mut accelcal::study::Silent).verdicts
 }
 
 /// Path of the built binary.
