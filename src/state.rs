@@ -258,28 +258,33 @@ impl StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }> for ErrorState {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::Config;
-    use crate::model::Model;
 
     type Matrix2x3Lit = SMatrix<f64, 2, 3>;
+
+    /// The default configuration's statistics.
+    const STATS: NoiseStats = NoiseStats {
+        accel_noise_var_m2_s4: 4e-4,
+        bias_var_m2_s4: 0.01,
+        gps_position_sigma_m: 1.0,
+        gps_velocity_sigma_m_s: 0.04,
+        initial_position_sigma_m: 10.0,
+        initial_velocity_sigma_m_s: 1.0,
+    };
 
     /// The model's matrices are the problem statement's, bit for bit.
     #[test]
     fn matrices_equal_the_filters() {
-        let m = Model::new(&Config::default()).unwrap();
-        let model = ErrorState {
-            stats: m.filter_stats,
-        };
-        let dt = m.timeline.dt_s;
+        let model = ErrorState { stats: STATS };
+        let dt = 0.005;
         // eq. (5) written out.
         let phi = StateMatrix::new(1.0, dt, -0.5 * dt * dt, 0.0, 1.0, -dt, 0.0, 0.0, 1.0);
         assert_eq!(model.transition(0.0, dt), phi);
         let gamma = StateVector::new(-0.5 * dt * dt, -dt, 0.0);
-        let q = gamma * gamma.transpose() * m.filter_stats.accel_noise_var_m2_s4;
+        let q = gamma * gamma.transpose() * STATS.accel_noise_var_m2_s4;
         assert_eq!(model.process_noise(0.0, dt), q);
         let h = Matrix2x3Lit::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0);
         assert_eq!(model.observation(), h);
-        let s = &m.filter_stats;
+        let s = &STATS;
         let r = MeasVector::new(
             s.gps_position_sigma_m.powi(2),
             s.gps_velocity_sigma_m_s.powi(2),
@@ -300,10 +305,7 @@ mod tests {
         assert_eq!(states[ErrorState::BIAS].key, "bias");
         assert_eq!(states[ErrorState::POSITION].unit, "m");
         assert_eq!(states[ErrorState::VELOCITY].unit, "m/s");
-        let h = ErrorState {
-            stats: Model::new(&Config::default()).unwrap().filter_stats,
-        }
-        .observation();
+        let h = ErrorState { stats: STATS }.observation();
         assert_eq!(
             h.column(ErrorState::BIAS).norm(),
             0.0,
@@ -314,8 +316,7 @@ mod tests {
     /// Only the bias is constant between fixes.
     #[test]
     fn the_bias_is_the_constant_state() {
-        let stats = Model::new(&Config::default()).unwrap().filter_stats;
-        let constant = ErrorState { stats }.constant_states();
+        let constant = ErrorState { stats: STATS }.constant_states();
         let expected: [bool; ErrorState::DIM] = std::array::from_fn(|k| k == ErrorState::BIAS);
         assert_eq!(constant, expected);
     }
