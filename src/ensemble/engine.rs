@@ -14,6 +14,7 @@ use crate::filter::FilterSchedule;
 use crate::lanes::{LANES, Lanes};
 use crate::model::Model;
 use crate::simulation::stream_key;
+use crate::state::ErrorState;
 
 /// How an ensemble's realizations are simulated.
 #[derive(
@@ -82,7 +83,7 @@ pub(super) struct Scratch {
     lanes: LaneSums,
     /// Per lane group, the residuals at the fixes i and m of the single pair (see
     /// [`Accumulator::pair`]).
-    pair: Vec<[[Lanes; 2]; 2]>,
+    pair: Vec<[[Lanes; ErrorState::MEAS]; 2]>,
 }
 
 crate::lanes::vectorized! {
@@ -122,7 +123,7 @@ fn accumulate_lanes(
         tiles.fill(0.0);
     }
     lanes.set_weights(schedule);
-    let m = 2 * schedule.fixes.len();
+    let m = ErrorState::MEAS * schedule.fixes.len();
     let key = stream_key(ensemble.seed, model.case());
     for pass_start in range.clone().step_by(PASS as usize) {
         let pass = pass_start..(pass_start + PASS).min(range.end);
@@ -190,7 +191,7 @@ struct ChunkSums<'s> {
     acc: &'s mut Accumulator,
     lanes: &'s mut LaneSums,
     out: Panels<'s>,
-    pair: &'s mut Vec<[[Lanes; 2]; 2]>,
+    pair: &'s mut Vec<[[Lanes; ErrorState::MEAS]; 2]>,
 }
 
 /// Where a chunk's residuals go: the panels of a pass of `count` realizations, from the pass's
@@ -223,7 +224,8 @@ fn sum_groups<G: LaneGroup>(mut groups: Vec<G>, sums: ChunkSums) {
             } else {
                 lanes.add::<false>(i, &f);
             }
-            for (c, r) in [2 * i, 2 * i + 1].into_iter().zip(&f.residual) {
+            let first = ErrorState::MEAS * i;
+            for (c, r) in (first..first + ErrorState::MEAS).zip(&f.residual) {
                 for k in 0..LANES {
                     let q = out.first + g * LANES + k;
                     out.panels[tiles::panel_index(c, q, out.count)] = r.0[k] as f32;

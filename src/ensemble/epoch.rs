@@ -24,6 +24,10 @@ use crate::lanes::{Lanes, Real};
 use crate::model::Model;
 use crate::random::LaneStreams;
 use crate::simulation::{FixState, Observer, run_noise_free};
+use crate::state::ErrorState;
+
+// The interval draw below is the error state written out component by component.
+const _: () = assert!(ErrorState::DIM == 3 && ErrorState::MEAS == 2);
 
 /// What the epoch engine needs of a model, computed once per ensemble.
 #[derive(Clone, Debug, PartialEq)]
@@ -54,7 +58,10 @@ struct Offsets(Vec<[f64; 2]>);
 
 impl Observer for Offsets {
     fn fix(&mut self, f: &FixState) {
-        self.0.push([f.delta_x[0], f.delta_x[1]]);
+        self.0.push([
+            f.delta_x[ErrorState::POSITION],
+            f.delta_x[ErrorState::VELOCITY],
+        ]);
     }
 }
 
@@ -126,10 +133,10 @@ pub struct EpochGroup<'a> {
     dp0: Lanes,
     dv0: Lanes,
     b: Lanes,
-    eta_sigma: [f64; 2],
+    eta_sigma: [f64; ErrorState::MEAS],
     /// The accumulated accelerometer noise (N_p, N_v).
     noise: [Lanes; 2],
-    estimate: [Lanes; 3],
+    estimate: [Lanes; ErrorState::DIM],
 }
 
 impl<'a> EpochGroup<'a> {
@@ -151,7 +158,7 @@ impl<'a> EpochGroup<'a> {
             b,
             eta_sigma: [ts.gps_position_sigma_m, ts.gps_velocity_sigma_m_s],
             noise: [Lanes::default(); 2],
-            estimate: [Lanes::default(); 3],
+            estimate: [Lanes::default(); ErrorState::DIM],
         }
     }
 }
@@ -174,10 +181,13 @@ impl LaneGroup for EpochGroup<'_> {
         let mask = self.mask;
         let delta_x = [dp * mask, dv * mask, b * mask];
         let eta = [
-            s(self.eta_sigma[0]) * self.rng.normal(),
-            s(self.eta_sigma[1]) * self.rng.normal(),
+            s(self.eta_sigma[ErrorState::GPS_POSITION]) * self.rng.normal(),
+            s(self.eta_sigma[ErrorState::GPS_VELOCITY]) * self.rng.normal(),
         ];
-        let dz = [(dp + eta[0]) * mask, (dv + eta[1]) * mask];
+        let dz = [
+            (dp + eta[ErrorState::GPS_POSITION]) * mask,
+            (dv + eta[ErrorState::GPS_VELOCITY]) * mask,
+        ];
         let (prior, post, residual) = fix.step(&self.estimate, &dz);
         self.estimate = post;
         LaneFix {

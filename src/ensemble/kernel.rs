@@ -9,6 +9,10 @@ use crate::filter::{FilterSchedule, FixCovariance};
 use crate::lanes::{Lanes, Real};
 use crate::model::Model;
 use crate::random::LaneStreams;
+use crate::state::ErrorState;
+
+// The truth below is the error state written out component by component.
+const _: () = assert!(ErrorState::DIM == 3 && ErrorState::MEAS == 2);
 
 /// The lane mask of a group with `active` realizations: 1 for the active lanes, 0 for the rest.
 pub(super) fn lane_mask(active: usize) -> Lanes {
@@ -33,7 +37,7 @@ pub struct SampleGroup<'a, const EULER: bool> {
     b: Lanes,
     /// (p_c, v_c, p_E, v_E), eqs. (3) and (4).
     state: [Lanes; 4],
-    estimate: [Lanes; 3],
+    estimate: [Lanes; ErrorState::DIM],
     /// The next sample to integrate.
     j: usize,
 }
@@ -63,7 +67,7 @@ impl<'a, const EULER: bool> SampleGroup<'a, EULER> {
                 p0,
                 v0,
             ],
-            estimate: [Lanes::default(); 3],
+            estimate: [Lanes::default(); ErrorState::DIM],
             j: 0,
         }
     }
@@ -111,12 +115,16 @@ impl<const EULER: bool> LaneGroup for SampleGroup<'_, EULER> {
             )
         };
         let mask = self.mask;
+        // δx = (δp, δv, b) in ErrorState order; z = (z_p, z_v) in measurement order.
         let delta_x = [(tp - pc) * mask, (tv - vc) * mask, b * mask];
         let z = [
             tp + s(ts.gps_position_sigma_m) * self.rng.normal(),
             tv + s(ts.gps_velocity_sigma_m_s) * self.rng.normal(),
         ];
-        let dz = [(z[0] - pc) * mask, (z[1] - vc) * mask];
+        let dz = [
+            (z[ErrorState::GPS_POSITION] - pc) * mask,
+            (z[ErrorState::GPS_VELOCITY] - vc) * mask,
+        ];
         let (prior, post, residual) = fix.step(&self.estimate, &dz);
         self.estimate = post;
         LaneFix {
@@ -172,7 +180,9 @@ fn bare_group_lanes(
     active: usize,
 ) -> f64 {
     let mut acc = Lanes::default();
-    run_group(model, schedule, key, first, active, |_, f| acc += f.post[2]);
+    run_group(model, schedule, key, first, active, |_, f| {
+        acc += f.post[ErrorState::BIAS]
+    });
     acc.sum()
 }
 

@@ -4,25 +4,68 @@
 // Lane loops index several arrays by the lane k; iterators would hide that.
 #![allow(clippy::needless_range_loop)]
 
-use super::sums::{FixSums, StageSums};
-use crate::filter::{FilterSchedule, Matrix3};
-use crate::lanes::Lanes;
+use nalgebra::SMatrix;
 
-/// Upper-triangle index pairs of a symmetric 3×3 matrix, in [`StageSums::ee`] order.
-const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+use super::sums::{FixSums, StageSums};
+use crate::filter::FilterSchedule;
+use crate::lanes::{Lanes, Real};
+use crate::state::ErrorState;
+
+/// States of the error state.
+const DIM: usize = ErrorState::DIM;
+/// Components of a GPS residual.
+const MEAS: usize = ErrorState::MEAS;
+
+/// Upper-triangle index pairs (r, c), r ≤ c, of a symmetric D×D matrix, row by row; `L` is
+/// D(D + 1)/2.
+const fn upper<const D: usize, const L: usize>() -> [(usize, usize); L] {
+    let mut pairs = [(0, 0); L];
+    let (mut r, mut k) = (0, 0);
+    while r < D {
+        let mut c = r;
+        while c < D {
+            pairs[k] = (r, c);
+            k += 1;
+            c += 1;
+        }
+        r += 1;
+    }
+    pairs
+}
+
+/// Entries of the upper triangle of a state-space matrix.
+const UPPER_LEN: usize = DIM * (DIM + 1) / 2;
+/// Upper-triangle index pairs of a symmetric state-space matrix.
+const UPPER: [(usize, usize); UPPER_LEN] = upper::<DIM, UPPER_LEN>();
+/// Entries of the upper triangle of a measurement-space matrix.
+const MEAS_UPPER_LEN: usize = MEAS * (MEAS + 1) / 2;
+/// Upper-triangle index pairs of a symmetric measurement-space matrix.
+const MEAS_UPPER: [(usize, usize); MEAS_UPPER_LEN] = upper::<MEAS, MEAS_UPPER_LEN>();
+
+/// The weights of the quadratic form xᵀ·A·x over the upper triangle of symmetric A: the
+/// diagonal once, the off-diagonal terms twice.
+fn form_weights<const D: usize, const L: usize>(
+    a: &SMatrix<f64, D, D>,
+    pairs: &[(usize, usize); L],
+) -> [f64; L] {
+    std::array::from_fn(|k| {
+        let (r, c) = pairs[k];
+        if r == c { a[(r, c)] } else { 2.0 * a[(r, c)] }
+    })
+}
 
 /// What every engine hands over at one fix, for a lane group: the true error state, the
 /// estimates and the residual (inactive lanes all zero).
 #[derive(Clone, Copy, Debug)]
 pub struct LaneFix {
     /// δx(t_i).
-    pub delta_x: [Lanes; 3],
+    pub delta_x: [Lanes; DIM],
     /// δx̂(t_i⁻).
-    pub prior: [Lanes; 3],
+    pub prior: [Lanes; DIM],
     /// δx̂(t_i⁺).
-    pub post: [Lanes; 3],
+    pub post: [Lanes; DIM],
     /// r(t_i).
-    pub residual: [Lanes; 2],
+    pub residual: [Lanes; MEAS],
 }
 
 /// One stage's sums per lane; fields as in [`StageSums`]. The normalized estimation error
@@ -30,12 +73,12 @@ pub struct LaneFix {
 /// formed from the lanes' Σ e·eᵀ when they are added up.
 #[derive(Clone, Copy, Debug, Default)]
 struct LaneStage {
-    e: [Lanes; 3],
-    ee: [Lanes; 6],
+    e: [Lanes; DIM],
+    ee: [Lanes; UPPER_LEN],
     /// Σ e·δx̂ᵀ, column-major like [`Matrix3`].
-    ex: [Lanes; 9],
-    x: [Lanes; 3],
-    xx: [Lanes; 3],
+    ex: [Lanes; DIM * DIM],
+    x: [Lanes; DIM],
+    xx: [Lanes; DIM],
 }
 
 /// `*s = v` for the first lane group of a fix (`FIRST`), `*s += v` for the others: the sums of
@@ -52,14 +95,17 @@ fn put<const FIRST: bool>(s: &mut Lanes, v: Lanes) {
 impl LaneStage {
     /// Adds e = δx − δx̂ for the estimate `x` (see [`put`] for `FIRST`).
     #[inline(always)]
-    fn add<const FIRST: bool>(&mut self, delta_x: &[Lanes; 3], x: &[Lanes; 3]) {
-        let e = [delta_x[0] - x[0], delta_x[1] - x[1], delta_x[2] - x[2]];
+    fn add<const FIRST: bool>(&mut self, delta_x: &[Lanes; DIM], x: &[Lanes; DIM]) {
+        let mut e = [Lanes::default(); DIM];
+        for k in 0..DIM {
+            e[k] = delta_x[k] - x[k];
+        }
         for (s, &(r, c)) in self.ee.iter_mut().zip(UPPER.iter()) {
             put::<FIRST>(s, e[r] * e[c]);
         }
-        for c in 0..3 {
-            for r in 0..3 {
-                put::<FIRST>(&mut self.ex[3 * c + r], e[r] * x[c]);
+        for c in 0..DIM {
+            for r in 0..DIM {
+                put::<FIRST>(&mut self.ex[DIM * c + r], e[r] * x[c]);
             }
             put::<FIRST>(&mut self.e[c], e[c]);
             put::<FIRST>(&mut self.x[c], x[c]);
@@ -70,8 +116,8 @@ impl LaneStage {
     /// Adds the lanes' totals (see [`Lanes::sum`]) to `s`, and Σ eᵀP⁻¹e formed from them
     /// with the weights `w` of eᵀP⁻¹e over the upper triangle (off-diagonal terms doubled).
     #[inline(always)]
-    fn reduce_into(&self, s: &mut StageSums, w: &[f64; 6]) {
-        for k in 0..3 {
+    fn reduce_into(&self, s: &mut StageSums, w: &[f64; UPPER_LEN]) {
+        for k in 0..DIM {
             s.e[k] += self.e[k].sum();
             s.x[k] += self.x[k].sum();
             s.xx[k] += self.xx[k].sum();
@@ -88,7 +134,7 @@ impl LaneStage {
         s.nees += nees;
         // Column-major, like the lane layout; no closure, so that it is compiled into the caller.
         for (k, v) in self.ex.iter().enumerate() {
-            s.ex[(k % 3, k / 3)] += v.sum();
+            s.ex[(k % DIM, k / DIM)] += v.sum();
         }
     }
 }
@@ -103,10 +149,10 @@ struct LaneFixSums {
 /// The weights of the quadratic forms at one fix.
 #[derive(Clone, Copy, Debug)]
 struct Weights {
-    prior: [f64; 6],
-    post: [f64; 6],
-    /// S⁻¹ as (00, 2·01, 11).
-    s: [f64; 3],
+    prior: [f64; UPPER_LEN],
+    post: [f64; UPPER_LEN],
+    /// S⁻¹ over its upper triangle, off-diagonal terms doubled: (00, 2·01, 11).
+    s: [f64; MEAS_UPPER_LEN],
 }
 
 /// The per-lane sums of the fix being summed, and the weights of every fix's quadratic forms
@@ -120,18 +166,12 @@ pub struct LaneSums {
 impl LaneSums {
     /// Takes the weights of the quadratic forms from `schedule`, with empty sums.
     pub fn set_weights(&mut self, schedule: &FilterSchedule) {
-        let upper = |m: &Matrix3| {
-            std::array::from_fn(|k| {
-                let (r, c) = UPPER[k];
-                if r == c { m[(r, c)] } else { 2.0 * m[(r, c)] }
-            })
-        };
         self.current = LaneFixSums::default();
         self.weights.clear();
         self.weights.extend(schedule.fixes.iter().map(|f| Weights {
-            prior: upper(&f.p_prior_inv),
-            post: upper(&f.p_post_inv),
-            s: [f.s_inv[(0, 0)], 2.0 * f.s_inv[(0, 1)], f.s_inv[(1, 1)]],
+            prior: form_weights(&f.p_prior_inv, &UPPER),
+            post: form_weights(&f.p_post_inv, &UPPER),
+            s: form_weights(&f.s_inv, &MEAS_UPPER),
         }));
     }
 
@@ -142,10 +182,13 @@ impl LaneSums {
         let sums = &mut self.current;
         sums.prior.add::<FIRST>(&f.delta_x, &f.prior);
         sums.post.add::<FIRST>(&f.delta_x, &f.post);
-        let [r0, r1] = f.residual;
-        let nis = Lanes([w.s[0]; 8]) * r0 * r0
-            + Lanes([w.s[1]; 8]) * r0 * r1
-            + Lanes([w.s[2]; 8]) * r1 * r1;
+        let r = &f.residual;
+        // rᵀ·S⁻¹·r over the upper triangle, added in its order.
+        let (a, b) = MEAS_UPPER[0];
+        let mut nis = Lanes::splat(w.s[0]) * r[a] * r[b];
+        for (k, &(a, b)) in MEAS_UPPER.iter().enumerate().skip(1) {
+            nis += Lanes::splat(w.s[k]) * r[a] * r[b];
+        }
         put::<FIRST>(&mut sums.nis, nis);
     }
 
