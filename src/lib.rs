@@ -10,6 +10,7 @@
 //! [`study`], [`sensitivity`], [`calibrate`], [`export`] and [`report`].
 #![warn(missing_docs)]
 
+pub mod allan;
 pub mod calibrate;
 pub mod checks;
 pub mod config;
