@@ -19,6 +19,7 @@ pub mod edf;
 pub mod export;
 pub mod figure;
 pub mod fit;
+pub mod log;
 pub mod noise_id;
 pub mod page;
 pub mod simulate;

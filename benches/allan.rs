@@ -1,0 +1,110 @@
+//! Speed of `accelcal allan` on a synthetic static log (white noise plus a random walk of the
+//! bias, 100 Hz): the whole command on the CSV, the whole analysis in memory, and the deviation
+//! alone (cumulative sums, octave τ), each the median of repeated runs with the minimum and
+//! maximum. It also writes the samples as raw little-endian f64 (`samples.f64`) for
+//! `benches/allan_oadev.py`, which times allantools' `oadev` on the same numbers.
+//!
+//! Run with `cargo build --release && cargo bench --bench allan` (options: `-- --samples N
+//! --repeats R --dir DIR`; defaults N = 10 000 000, R = 5, DIR = target/allan-bench).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use accelcal::allan::simulate::StaticLog;
+use accelcal::allan::{analyse, deviation};
+use accelcal::logs::write::{header, push_row};
+
+const LOG: StaticLog = StaticLog {
+    sample_period_s: 0.01,
+    velocity_random_walk_m_s_per_sqrt_s: 2e-3,
+    acceleration_random_walk_m_s2_per_sqrt_s: 1e-4,
+    offset_m_s2: 9.80665,
+};
+
+fn arg(name: &str) -> Option<String> {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1).cloned())
+}
+
+/// (median, min, max) of `f`'s wall time over `repeats` runs, s.
+fn time(repeats: usize, mut f: impl FnMut()) -> (f64, f64, f64) {
+    let mut t: Vec<f64> = (0..repeats)
+        .map(|_| {
+            let start = Instant::now();
+            f();
+            start.elapsed().as_secs_f64()
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    (t[t.len() / 2], t[0], t[t.len() - 1])
+}
+
+fn write_inputs(dir: &Path, y: &[f64]) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let csv = dir.join("static.csv");
+    let mut out = std::io::BufWriter::new(std::fs::File::create(&csv).unwrap());
+    out.write_all(header(&["t_s", "accel_m_s2"]).as_bytes())
+        .unwrap();
+    let mut row = String::new();
+    for (i, v) in y.iter().enumerate() {
+        row.clear();
+        push_row(&mut row, &[i as f64 * LOG.sample_period_s, *v]);
+        out.write_all(row.as_bytes()).unwrap();
+    }
+    out.flush().unwrap();
+    let raw: Vec<u8> = y.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(dir.join("samples.f64"), raw).unwrap();
+    csv
+}
+
+fn report(label: &str, (median, min, max): (f64, f64, f64)) {
+    println!("{label:<44} median {median:8.3} s  (min {min:.3}, max {max:.3})");
+}
+
+fn main() {
+    let samples: usize = arg("--samples").map_or(10_000_000, |s| s.parse().unwrap());
+    let repeats: usize = arg("--repeats").map_or(5, |s| s.parse().unwrap());
+    let dir = PathBuf::from(arg("--dir").unwrap_or_else(|| "target/allan-bench".to_string()));
+    let y = LOG.samples(samples, 1);
+    let csv = write_inputs(&dir, &y);
+    println!(
+        "{samples} samples at {} Hz, {} threads; inputs in {}",
+        1.0 / LOG.sample_period_s,
+        rayon::current_num_threads(),
+        dir.display()
+    );
+    let factors = deviation::octave_factors(samples);
+    report(
+        &format!("deviation in memory ({} octave τ)", factors.len()),
+        time(repeats, || {
+            std::hint::black_box(deviation::oadev(&y, &factors));
+        }),
+    );
+    report(
+        "analysis in memory (deviation, noise, EDF, fit)",
+        time(repeats, || {
+            std::hint::black_box(analyse(&y, LOG.sample_period_s, 0.683).unwrap());
+        }),
+    );
+    let exe = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/release/accelcal");
+    let exe = std::env::var_os("CARGO_TARGET_DIR")
+        .map_or(exe, |d| PathBuf::from(d).join("release/accelcal"));
+    report(
+        "accelcal allan on the CSV (whole process)",
+        time(repeats, || {
+            let status = Command::new(&exe)
+                .args(["allan", "--quiet", "--accel"])
+                .arg(&csv)
+                .arg("--out")
+                .arg(dir.join("out"))
+                .stdout(std::process::Stdio::null())
+                .status()
+                .expect("run target/release/accelcal (cargo build --release first)");
+            assert!(status.success());
+        }),
+    );
+}
