@@ -12,8 +12,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
+use accelcal::allan::log::read_static_log;
 use accelcal::allan::simulate::StaticLog;
 use accelcal::allan::{analyse, deviation};
+use accelcal::logs::read::LogFile;
 use accelcal::logs::write::{header, push_row};
 
 const LOG: StaticLog = StaticLog {
@@ -78,6 +80,19 @@ fn main() {
         dir.display()
     );
     let factors = deviation::octave_factors(samples);
+    let source = LogFile::new(&csv);
+    report(
+        "reading the CSV (log reader, step checks)",
+        time(repeats, || {
+            std::hint::black_box(read_static_log(&source, "accel_m_s2").unwrap());
+        }),
+    );
+    report(
+        "phase (mean, cumulative sum)",
+        time(repeats, || {
+            std::hint::black_box(deviation::phase(&y));
+        }),
+    );
     report(
         &format!("deviation in memory ({} octave τ)", factors.len()),
         time(repeats, || {

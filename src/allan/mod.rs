@@ -22,6 +22,7 @@ pub mod fit;
 pub mod log;
 pub mod noise_id;
 pub mod page;
+pub mod section;
 pub mod simulate;
 
 use rayon::prelude::*;
@@ -106,14 +107,16 @@ impl Analysis {
 fn points(x: &[f64], tau0_s: f64, confidence: f64) -> Vec<AllanPoint> {
     let n = x.len() - 1;
     let factors = deviation::octave_factors(n);
+    let avars = deviation::overlapping_avars(x, &factors);
     let mut out: Vec<AllanPoint> = factors
         .par_iter()
-        .map(|&m| {
+        .zip(avars)
+        .map(|(&m, avar)| {
             let noise = noise_id::identify(&noise_id::block_means(x, m));
             AllanPoint {
                 m,
                 tau_s: m as f64 * tau0_s,
-                adev: deviation::overlapping_avar(x, m).sqrt(),
+                adev: avar.sqrt(),
                 noise,
                 identified_here: noise.is_some(),
                 edf: None,
