@@ -26,23 +26,48 @@ pub fn octave_factors(samples: usize) -> Vec<usize> {
     out
 }
 
-/// The mean of `y`, summed in blocks (pairwise-like accuracy).
+/// The mean of `y`, summed in blocks (pairwise-like accuracy) on all threads, the blocks added
+/// in order.
 pub fn mean(y: &[f64]) -> f64 {
-    let total: f64 = y.chunks(BLOCK).map(|c| c.iter().sum::<f64>()).sum();
-    total / y.len() as f64
+    use rayon::prelude::*;
+    let sums: Vec<f64> = y.par_chunks(BLOCK).map(|c| c.iter().sum::<f64>()).collect();
+    sums.iter().sum::<f64>() / y.len() as f64
 }
+
+/// Samples per stretch of the cumulative sum in [`phase`].
+const PHASE_STRETCH: usize = 1 << 16;
 
 /// The phase of rate samples `y` in units of samples: x_0 = 0, x_{i+1} = x_i + (y_i − ȳ) (the
 /// factor τ₀ is applied by [`overlapping_avar`]).
+///
+/// The running sum is taken in stretches of 65 536 samples on all threads: each stretch's total
+/// first, then each stretch from the sum of those before it (fixed stretches: the same bits on
+/// any thread count).
 pub fn phase(y: &[f64]) -> Vec<f64> {
+    use rayon::prelude::*;
     let ybar = mean(y);
-    let mut x = Vec::with_capacity(y.len() + 1);
+    let totals: Vec<f64> = y
+        .par_chunks(PHASE_STRETCH)
+        .map(|c| c.iter().map(|v| v - ybar).sum::<f64>())
+        .collect();
+    let mut starts = Vec::with_capacity(totals.len());
     let mut s = 0.0;
-    x.push(0.0);
-    for &v in y {
-        s += v - ybar;
-        x.push(s);
+    for t in &totals {
+        starts.push(s);
+        s += t;
     }
+    let mut x = vec![0.0; y.len() + 1];
+    x[1..]
+        .par_chunks_mut(PHASE_STRETCH)
+        .zip(y.par_chunks(PHASE_STRETCH))
+        .zip(starts)
+        .for_each(|((out, chunk), start)| {
+            let mut s = start;
+            for (o, v) in out.iter_mut().zip(chunk) {
+                s += v - ybar;
+                *o = s;
+            }
+        });
     x
 }
 
@@ -92,7 +117,8 @@ pub fn overlapping_avar(x: &[f64], m: usize) -> f64 {
 /// Phase points k per stretch of [`overlapping_avars`]: the unit of work of one thread.
 pub const STRETCH: usize = 1 << 16;
 
-/// Σ over one block of k of the squared second differences at m, with four running sums.
+/// Σ over one block of k of the squared second differences at m, with eight running sums.
+#[inline(always)]
 fn block_sum(x: &[f64], m: usize, start: usize, end: usize) -> f64 {
     let len = end - start;
     let (a, b, c) = (
@@ -100,15 +126,15 @@ fn block_sum(x: &[f64], m: usize, start: usize, end: usize) -> f64 {
         &x[start + m..end + m],
         &x[start + 2 * m..end + 2 * m],
     );
-    let mut lanes = [0.0f64; 4];
-    let whole = len / 4 * 4;
-    for ((a4, b4), c4) in a[..whole]
-        .chunks_exact(4)
-        .zip(b[..whole].chunks_exact(4))
-        .zip(c[..whole].chunks_exact(4))
+    let mut lanes = [0.0f64; 8];
+    let whole = len / 8 * 8;
+    for ((a8, b8), c8) in a[..whole]
+        .chunks_exact(8)
+        .zip(b[..whole].chunks_exact(8))
+        .zip(c[..whole].chunks_exact(8))
     {
-        for l in 0..4 {
-            let d = c4[l] - 2.0 * b4[l] + a4[l];
+        for l in 0..8 {
+            let d = c8[l] - 2.0 * b8[l] + a8[l];
             lanes[l] += d * d;
         }
     }
@@ -116,7 +142,35 @@ fn block_sum(x: &[f64], m: usize, start: usize, end: usize) -> f64 {
         let d = c[i] - 2.0 * b[i] + a[i];
         lanes[0] += d * d;
     }
-    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3])
+    ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3]))
+        + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]))
+}
+
+/// The sums of one stretch [from, to) of k at every factor, block by block.
+#[inline(always)]
+fn stretch_sums_plain(
+    x: &[f64],
+    factors: &[usize],
+    terms: &[usize],
+    from: usize,
+    to: usize,
+) -> Vec<f64> {
+    let mut sums = vec![0.0; factors.len()];
+    for start in (from..to).step_by(BLOCK) {
+        for (j, &m) in factors.iter().enumerate() {
+            let end = (start + BLOCK).min(to).min(terms[j]);
+            if start < end {
+                sums[j] += block_sum(x, m, start, end);
+            }
+        }
+    }
+    sums
+}
+
+crate::lanes::vectorized! {
+    /// [`stretch_sums_plain`], compiled for AVX2 when the processor has it (the same bits:
+    /// Rust contracts no product and sum into an FMA).
+    fn stretch_sums(x: &[f64], factors: &[usize], terms: &[usize], from: usize, to: usize) -> Vec<f64> => stretch_sums_plain
 }
 
 /// The overlapping Allan variance at every factor of `factors` from the phase `x` (in
@@ -138,16 +192,7 @@ pub fn overlapping_avars(x: &[f64], factors: &[usize]) -> Vec<f64> {
         .into_par_iter()
         .map(|s| {
             let (from, to) = (s * STRETCH, ((s + 1) * STRETCH).min(longest));
-            let mut sums = vec![0.0; factors.len()];
-            for start in (from..to).step_by(BLOCK) {
-                for (j, &m) in factors.iter().enumerate() {
-                    let end = (start + BLOCK).min(to).min(terms[j]);
-                    if start < end {
-                        sums[j] += block_sum(x, m, start, end);
-                    }
-                }
-            }
-            sums
+            stretch_sums(x, factors, &terms, from, to)
         })
         .collect();
     factors
