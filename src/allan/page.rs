@@ -147,7 +147,7 @@ pub fn view(a: &Analysis, source: &str, command: &str) -> AllanView {
             sig(1.0 / a.sample_period_s, 6),
             sig(a.samples as f64 * a.sample_period_s, 4)
         ),
-        confidence: format!("{}", sig(100.0 * a.confidence, 3)),
+        confidence: sig(100.0 * a.confidence, 3),
         svg: allan_plot(a),
         terms: a.fit.terms.iter().map(term_row).collect(),
         points: point_rows(a),
