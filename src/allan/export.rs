@@ -120,6 +120,12 @@ fn num(x: f64) -> String {
     }
 }
 
+/// `x` rounded to ten significant digits: a rate from a median step carries the time stamps'
+/// rounding (10⁻¹¹ s on a day-long log), which a configuration should not.
+fn ten_digits(x: f64) -> f64 {
+    format!("{x:.9e}").parse().unwrap_or(x)
+}
+
 /// The value of `term` for a file another tool reads: the estimate, else the upper bound, with
 /// a comment saying which.
 fn value_or_bound(a: &Analysis, term: Term) -> (f64, &'static str) {
@@ -147,14 +153,14 @@ pub fn noise_toml(a: &Analysis, source: &str) -> String {
     let per_sample_var = n * n / a.sample_period_s;
     let rate_hz = 1.0 / a.sample_period_s;
     let mut s = format!(
-        "# Noise terms measured by `accelcal allan` from {source} ({} samples, τ₀ = {} s).\n\
+        "# Noise terms measured by `accelcal allan` from {source}: {} samples, τ₀ = {} s.\n\
          # Per-sample variance = N²/τ₀ with N = {} m/s/√s{n_note}.\n\n\
          [accelerometer]\nsample_rate_hz = {}\nnoise_var_m2_s4 = {}\n\n\
          [filter]\naccel_noise_var_m2_s4 = {}\n",
         a.samples,
         num(a.sample_period_s),
         sig(n, 4),
-        num(rate_hz),
+        num(ten_digits(rate_hz)),
         num(per_sample_var),
         num(per_sample_var)
     );
@@ -178,7 +184,9 @@ pub fn noise_toml(a: &Analysis, source: &str) -> String {
         _ => {
             let (k_value, k_note) = value_or_bound(a, Term::AccelerationRandomWalk);
             s.push_str(&format!(
-                "# K{k_note}.\nbias_model = \"random_walk\"\nbias_random_walk_m_s2_per_sqrt_s = {}\n",
+                "# A random walk of the bias with K = {} m/s²/√s{k_note}.\n\
+                 bias_model = \"random_walk\"\nbias_random_walk_m_s2_per_sqrt_s = {}\n",
+                sig(k_value, 4),
                 num(k_value)
             ));
         }
@@ -191,7 +199,7 @@ pub fn imu_yaml(a: &Analysis, source: &str) -> String {
     let (n, n_note) = value_or_bound(a, Term::VelocityRandomWalk);
     let (k, k_note) = value_or_bound(a, Term::AccelerationRandomWalk);
     format!(
-        "# Accelerometer noise measured by `accelcal allan` from {source} ({} samples).\n\
+        "# Accelerometer noise measured by `accelcal allan` from {source}: {} samples.\n\
          # Continuous-time densities: noise density N in m/s²/√Hz (= m/s/√s), random walk K in\n\
          # m/s³/√Hz (= m/s²/√s).\n\
          accelerometer_noise_density: {}{}\n\
@@ -202,7 +210,7 @@ pub fn imu_yaml(a: &Analysis, source: &str) -> String {
         comment(n_note),
         num(k),
         comment(k_note),
-        num(1.0 / a.sample_period_s)
+        num(ten_digits(1.0 / a.sample_period_s))
     )
 }
 

@@ -129,12 +129,11 @@ fn term_label(term: Term) -> &'static str {
 }
 
 fn term_lines(svg: &mut String, f: &Frame, a: &Analysis) {
-    let colours = [REDDISH_PURPLE, BLUE, BLUISH_GREEN, VERMILLION];
-    for (t, colour) in a.fit.terms.iter().zip(colours) {
+    for t in &a.fit.terms {
         if t.value.is_none() {
             continue;
         }
-        let c = hex(colour);
+        let c = hex(term_colour(t.term));
         let theta = t.squared;
         let sigma = |tau: f64| (theta * t.term.coefficient(tau)).sqrt();
         curve(
@@ -147,13 +146,24 @@ fn term_lines(svg: &mut String, f: &Frame, a: &Analysis) {
         let tau = 10f64.powf(f.x.0 + (f.x.1 - f.x.0) * label_position(t.term));
         if f.contains(sigma(tau)) {
             let (x, y) = f.px(tau, sigma(tau));
+            // Above a falling line, below a rising one: clear of the data either way.
+            let dy = if t.term.slope() > 0.0 { 26.0 } else { -10.0 };
             let _ = write!(
                 svg,
                 r#"<text x="{x:.1}" y="{:.1}" fill="{c}" font-size="{TICK_LABEL_PX}">{}</text>"#,
-                y - 8.0,
+                y + dy,
                 term_label(t.term)
             );
         }
+    }
+}
+
+fn term_colour(term: Term) -> RGBColor {
+    match term {
+        Term::Quantization => VERMILLION,
+        Term::VelocityRandomWalk => REDDISH_PURPLE,
+        Term::BiasInstability => BLUE,
+        Term::AccelerationRandomWalk => BLUISH_GREEN,
     }
 }
 
@@ -162,7 +172,7 @@ fn label_position(term: Term) -> f64 {
         Term::Quantization => 0.05,
         Term::VelocityRandomWalk => 0.2,
         Term::BiasInstability => 0.5,
-        Term::AccelerationRandomWalk => 0.85,
+        Term::AccelerationRandomWalk => 0.75,
     }
 }
 
