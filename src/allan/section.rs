@@ -40,6 +40,15 @@ pub struct Coverage {
     pub k_nominal_covered: u64,
     /// Logs whose K was unresolved.
     pub k_unresolved: u64,
+    /// Mean of (N̂² − N²)² over the mean sandwich variance of N̂²: near 1 when the claimed
+    /// scatter is the actual one (a check of both sides: too wide as well as too narrow).
+    pub n_scatter_ratio: f64,
+    /// The same for K².
+    pub k_scatter_ratio: f64,
+    /// The same for N² with the nominal variance.
+    pub n_nominal_scatter_ratio: f64,
+    /// The same for K² with the nominal variance.
+    pub k_nominal_scatter_ratio: f64,
 }
 
 /// The two-sided band of the number of successes among `n` trials of probability `p` at
@@ -84,35 +93,57 @@ pub fn coverage(
         log.velocity_random_walk_m_s_per_sqrt_s,
         log.acceleration_random_walk_m_s2_per_sqrt_s,
     );
-    let per_seed: Vec<[u64; 5]> = (0..seeds)
+    let per_seed: Vec<[f64; 11]> = (0..seeds)
         .into_par_iter()
         .map(|seed| {
             let a = analyse(&log.samples(samples, seed), log.sample_period_s, confidence)?;
-            let unresolved = a
-                .fit
-                .term(Term::AccelerationRandomWalk)
-                .is_some_and(|t| t.value.is_none());
+            let (tn, tk) = (
+                a.fit.term(Term::VelocityRandomWalk),
+                a.fit.term(Term::AccelerationRandomWalk),
+            );
+            let unresolved = tk.is_some_and(|t| t.value.is_none());
+            let error = |t: Option<&super::TermEstimate>, truth: f64| {
+                t.map_or([f64::NAN; 3], |t| {
+                    [
+                        (t.squared - truth * truth).powi(2),
+                        t.squared_sigma.powi(2),
+                        t.squared_sigma_nominal.powi(2),
+                    ]
+                })
+            };
+            let (en, ek) = (error(tn, n), error(tk, k));
+            let flag = |b: bool| b as u64 as f64;
             Ok([
-                covers(&a, Term::VelocityRandomWalk, n, false) as u64,
-                covers(&a, Term::AccelerationRandomWalk, k, false) as u64,
-                covers(&a, Term::VelocityRandomWalk, n, true) as u64,
-                covers(&a, Term::AccelerationRandomWalk, k, true) as u64,
-                unresolved as u64,
+                flag(covers(&a, Term::VelocityRandomWalk, n, false)),
+                flag(covers(&a, Term::AccelerationRandomWalk, k, false)),
+                flag(covers(&a, Term::VelocityRandomWalk, n, true)),
+                flag(covers(&a, Term::AccelerationRandomWalk, k, true)),
+                flag(unresolved),
+                en[0],
+                en[1],
+                en[2],
+                ek[0],
+                ek[1],
+                ek[2],
             ])
         })
         .collect::<Result<_, AllanError>>()?;
-    let sum = |i: usize| per_seed.iter().map(|c| c[i]).sum();
+    let sum = |i: usize| per_seed.iter().map(|c| c[i]).sum::<f64>();
     Ok(Coverage {
         seeds,
         samples,
         confidence,
         false_alarm_rate,
         band: binomial_band(seeds, confidence, false_alarm_rate),
-        n_covered: sum(0),
-        k_covered: sum(1),
-        n_nominal_covered: sum(2),
-        k_nominal_covered: sum(3),
-        k_unresolved: sum(4),
+        n_covered: sum(0) as u64,
+        k_covered: sum(1) as u64,
+        n_nominal_covered: sum(2) as u64,
+        k_nominal_covered: sum(3) as u64,
+        k_unresolved: sum(4) as u64,
+        n_scatter_ratio: sum(5) / sum(6),
+        k_scatter_ratio: sum(8) / sum(9),
+        n_nominal_scatter_ratio: sum(5) / sum(7),
+        k_nominal_scatter_ratio: sum(8) / sum(10),
     })
 }
 
@@ -274,7 +305,9 @@ pub fn section(
         coverage_words: format!(
             "{} such logs of {} samples (seeds 0 to {}), {} % intervals; a construction that \
              covers as claimed lands inside the binomial band [{}, {}] with probability at least \
-             {} % (false-alarm rate {} %); K was unresolved in {} of them",
+             {} % (false-alarm rate {} %); K was unresolved in {} of them. The actual mean \
+             squared error of N̂² is {} times the variance the fit claims and that of K̂² {} \
+             times (nominal variances: {} and {})",
             count(coverage.seeds),
             count(coverage.samples as u64),
             coverage.seeds.saturating_sub(1),
@@ -283,7 +316,11 @@ pub fn section(
             coverage.band.1,
             sig(100.0 * (1.0 - coverage.false_alarm_rate), 3),
             sig(100.0 * coverage.false_alarm_rate, 2),
-            coverage.k_unresolved
+            coverage.k_unresolved,
+            sig(coverage.n_scatter_ratio, 3),
+            sig(coverage.k_scatter_ratio, 3),
+            sig(coverage.n_nominal_scatter_ratio, 3),
+            sig(coverage.k_nominal_scatter_ratio, 3)
         ),
         coverage: coverage_rows(coverage),
         confidence: sig(100.0 * coverage.confidence, 3),
