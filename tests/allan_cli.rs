@@ -161,3 +161,42 @@ fn bad_input_exits_2_naming_the_file_and_line() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("at least"));
 }
+
+#[test]
+fn the_same_numbers_on_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = StaticLog {
+        sample_period_s: 0.005,
+        velocity_random_walk_m_s_per_sqrt_s: 1e-3,
+        acceleration_random_walk_m_s2_per_sqrt_s: 1e-3,
+        offset_m_s2: -9.80665,
+    };
+    // Long enough for several stretches of the phase (65 536 samples) and of the text (8 MiB).
+    let y = log.samples(600_000, 2);
+    let csv = dir.path().join("static.csv");
+    write_log(
+        &csv,
+        &["t_s", "accel_m_s2"],
+        y.iter()
+            .enumerate()
+            .map(|(i, v)| vec![i as f64 * 0.005, *v]),
+    );
+    let run = |threads: &str| {
+        let out = dir.path().join(format!("out{threads}"));
+        let o = Command::new(env!("CARGO_BIN_EXE_accelcal"))
+            .env("RAYON_NUM_THREADS", threads)
+            .args([
+                "allan",
+                "--quiet",
+                "--accel",
+                csv.to_str().unwrap(),
+                "--out",
+            ])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(out.join("allan.json")).unwrap()
+    };
+    assert_eq!(run("1"), run("3"));
+}

@@ -24,6 +24,11 @@ const LOG: StaticLog = StaticLog {
 };
 
 #[test]
+fn the_report_simulates_this_log() {
+    assert_eq!(accelcal::allan::section::REPORT_LOG, LOG);
+}
+
+#[test]
 fn the_band_is_the_binomial_one() {
     // Bin(100, 0.95): P(X ≤ 88) = 0.0043 ≤ 0.005 < P(X ≤ 89) = 0.0115; P(X = 100) = 0.0059.
     assert_eq!(binomial_band(100, 0.95, 0.01), (89, 100));
