@@ -55,6 +55,9 @@ pub enum AllanError {
     /// The confidence is outside (0, 1).
     #[error("the confidence is {0}; expected a number strictly between 0 and 1")]
     Confidence(f64),
+    /// A simulated log written as CSV text did not read back (a defect, not bad input).
+    #[error("the simulated static log did not read back: {0}")]
+    SimulatedLog(String),
 }
 
 /// The Allan deviation at one τ.

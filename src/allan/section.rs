@@ -319,7 +319,8 @@ pub fn section(
         "static.csv",
         csv_text(&log.samples(samples, seed), log.sample_period_s),
     );
-    let read = read_static_log(&source, "accel_m_s2").map_err(|_| AllanError::Constant)?;
+    let read = read_static_log(&source, "accel_m_s2")
+        .map_err(|e| AllanError::SimulatedLog(e.to_string()))?;
     let a = analyse(&read.values, read.sample_period_s, coverage.confidence)?;
     Ok(AllanSection {
         log_words: format!(
