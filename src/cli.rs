@@ -34,6 +34,9 @@ pub enum Command {
     Sensitivity(SensitivityArgs),
     /// Calibrate the bias from an accelerometer log and a GPS log: filter, smoother, NIS test.
     Calibrate(CalibrateArgs),
+    /// Measure the accelerometer's noise terms from a static log: Allan deviation with
+    /// intervals, N, B and K, and noise.toml for calibrate.
+    Allan(AllanArgs),
     /// Print the default configuration file.
     Config,
 }
@@ -274,6 +277,26 @@ fn output_parser() -> impl TypedValueParser<Value = AccelerometerOutput> {
 
 fn engine_parser() -> impl TypedValueParser<Value = Engine> {
     EnumValueParser::<EngineArg>::new().map(Engine::from)
+}
+
+/// Options of `allan`.
+#[derive(Debug, Args)]
+pub struct AllanArgs {
+    /// The static accelerometer log: CSV with a column t_s and the axis column.
+    #[arg(long, value_name = "FILE")]
+    pub accel: PathBuf,
+    /// The axis column to analyse.
+    #[arg(long, value_name = "NAME", default_value = "accel_m_s2")]
+    pub column: String,
+    /// Directory that receives allan.json, noise.toml, imu.yaml and index.html.
+    #[arg(long, value_name = "DIR", default_value = "allan")]
+    pub out: PathBuf,
+    /// Confidence of the two-sided intervals, in (0, 1).
+    #[arg(long, value_name = "C", default_value_t = accelcal::allan::DEFAULT_CONFIDENCE)]
+    pub confidence: f64,
+    /// Print nothing but the result.
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 #[cfg(test)]

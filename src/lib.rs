@@ -5,11 +5,12 @@
 //! [`config`] → [`model`] → [`state`] → [`filter`] → [`simulation`] → [`realization`], [`ensemble`] →
 //! [`stats`], [`checks`] → [`study`], [`sensitivity`] → [`export`], [`plot`] → [`report`].
 //! Below the study, [`logs`] reads and writes sensor logs and [`calibrate`] runs the filter and a
-//! smoother over them. [`format`](mod@format), [`output`], [`progress`] and [`error`] are leaves
-//! every step may use. The `accelcal` binary (`src/main.rs`) parses the command line and calls
+//! smoother over them; [`allan`] measures the accelerometer's noise terms from a static log.
+//! [`format`](mod@format), [`output`], [`progress`] and [`error`] are leaves every step may use. The `accelcal` binary (`src/main.rs`) parses the command line and calls
 //! [`study`], [`sensitivity`], [`calibrate`], [`export`] and [`report`].
 #![warn(missing_docs)]
 
+pub mod allan;
 pub mod calibrate;
 pub mod checks;
 pub mod config;

@@ -3,6 +3,7 @@
 //! the commands of the Monte Carlo study (report, ensemble and its shards, merge, sensitivity),
 //! `logs` those of sensor logs (simulate, calibrate).
 
+mod allan;
 mod logs;
 mod monte_carlo;
 
@@ -31,6 +32,7 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
             || e.is::<FilterError>()
             || e.is::<LogError>()
             || e.is::<partial::PartialError>()
+            || e.is::<accelcal::allan::AllanError>()
             || e.downcast_ref::<CalibrateError>()
                 .is_some_and(CalibrateError::is_bad_input)
     });
@@ -47,6 +49,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Sensitivity(args)) => monte_carlo::run_sensitivity(&args),
         Some(Command::Merge(args)) => monte_carlo::run_merge(&args),
         Some(Command::Calibrate(args)) => logs::run_calibrate(&args),
+        Some(Command::Allan(args)) => allan::run_allan(&args),
         Some(Command::Config) => {
             print!("{DEFAULT_TOML}");
             Ok(())

@@ -260,8 +260,17 @@ impl<'a> AccelReader<'a> {
     /// # Errors
     /// [`LogError`] when it cannot be read or its header lacks `t_s` or `accel_m_s2`.
     pub fn open(source: &'a dyn LogSource) -> Result<Self, LogError> {
+        Self::with_column(source, ACCEL_COLUMNS[1])
+    }
+
+    /// Opens the accelerometer log `source` reading its samples from `column` instead of
+    /// `accel_m_s2` (a log of several axes).
+    ///
+    /// # Errors
+    /// [`LogError`] when it cannot be read or its header lacks `t_s` or `column`.
+    pub fn with_column(source: &'a dyn LogSource, column: &'static str) -> Result<Self, LogError> {
         Ok(Self {
-            csv: CsvReader::open(source, ACCEL_COLUMNS)?,
+            csv: CsvReader::open(source, [ACCEL_COLUMNS[0], column])?,
             previous_s: None,
         })
     }
@@ -363,6 +372,22 @@ mod tests {
         let s = r.next_sample().unwrap().unwrap();
         assert_eq!((s.line, s.t_s, s.accel_m_s2), (4, 0.005, -2.0));
         assert!(r.next_sample().unwrap().is_none());
+    }
+
+    #[test]
+    fn reads_a_named_axis_column() {
+        let src = LogText::new("a.csv", "t_s,ax_m_s2,ay_m_s2\n0,1,2\n0.01,3,4\n");
+        let mut r = AccelReader::with_column(&src, "ay_m_s2").unwrap();
+        assert_eq!(r.next_sample().unwrap().unwrap().accel_m_s2, 2.0);
+        assert_eq!(r.next_sample().unwrap().unwrap().accel_m_s2, 4.0);
+        let e = AccelReader::with_column(&src, "az_m_s2").err().unwrap();
+        assert!(matches!(
+            e.problem,
+            LogProblem::MissingColumn {
+                column: "az_m_s2",
+                ..
+            }
+        ));
     }
 
     #[test]

@@ -1,0 +1,203 @@
+//! The Allan deviation of a static accelerometer log and the noise terms it measures.
+//!
+//! The pieces, one pure function each, in the order [`analyse`] runs them:
+//! 1. [`deviation`]: the overlapping Allan deviation from cumulative sums, O(n) per τ, at
+//!    octave-spaced τ = m·τ₀ (NIST SP 1065, eq. 11; equal to allantools' `oadev`);
+//! 2. [`noise_id`]: the power-law noise at each τ from the lag-1 autocorrelation (Riley &
+//!    Greenhall 2004);
+//! 3. [`edf`]: the equivalent degrees of freedom of each estimate for that noise (Greenhall &
+//!    Riley 2003) and its χ² interval (SP 1065, eq. 45);
+//! 4. [`fit`](mod@fit): the terms Q, N, B, K by weighted least squares, with intervals from the exact
+//!    covariance of the estimates across τ ([`covariance`]).
+//!
+//! [`simulate`] draws synthetic static logs with known terms (for the tests, the report and the
+//! benchmarks); [`export`] writes `allan.json`, `noise.toml` and `imu.yaml`; [`page`] the page.
+
+pub mod covariance;
+pub mod deviation;
+pub mod edf;
+pub mod export;
+pub mod figure;
+pub mod fit;
+pub mod log;
+pub mod noise_id;
+pub mod page;
+pub mod section;
+pub mod simulate;
+
+use rayon::prelude::*;
+use thiserror::Error;
+
+pub use fit::{Fit, FitPoint, Term, TermEstimate};
+pub use noise_id::NoiseId;
+
+/// The interval confidence when none is given: one standard deviation of a normal.
+pub const DEFAULT_CONFIDENCE: f64 = 0.683;
+
+/// Fewest samples an analysis accepts: the fit needs at least four τ with
+/// [`noise_id::MIN_POINTS`] block means each.
+pub const MIN_SAMPLES: usize = 8 * noise_id::MIN_POINTS;
+
+/// A log the analysis cannot use.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum AllanError {
+    /// Too few samples.
+    #[error("the log has {found} samples; the Allan analysis needs at least {needed}")]
+    TooFewSamples {
+        /// Samples found.
+        found: usize,
+        /// Samples needed.
+        needed: usize,
+    },
+    /// Every sample is the same number.
+    #[error("every sample is the same number: the Allan deviation is zero at every τ")]
+    Constant,
+    /// The confidence is outside (0, 1).
+    #[error("the confidence is {0}; expected a number strictly between 0 and 1")]
+    Confidence(f64),
+    /// A simulated log written as CSV text did not read back (a defect, not bad input).
+    #[error("the simulated static log did not read back: {0}")]
+    SimulatedLog(String),
+}
+
+/// The Allan deviation at one τ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AllanPoint {
+    /// Averaging factor m.
+    pub m: usize,
+    /// τ = m·τ₀, s.
+    pub tau_s: f64,
+    /// σ̂(τ), m/s².
+    pub adev: f64,
+    /// The noise identified at this τ, or (fewer than 30 block means) at the longest τ that
+    /// had them.
+    pub noise: Option<NoiseId>,
+    /// Whether `noise` was identified at this τ itself.
+    pub identified_here: bool,
+    /// Equivalent degrees of freedom for that noise.
+    pub edf: Option<f64>,
+    /// The χ² interval of σ̂(τ), m/s².
+    pub interval: Option<(f64, f64)>,
+}
+
+/// The analysis of one log.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Analysis {
+    /// Samples n.
+    pub samples: usize,
+    /// τ₀, s.
+    pub sample_period_s: f64,
+    /// The confidence of every interval.
+    pub confidence: f64,
+    /// The deviation at every τ of the octave grid.
+    pub points: Vec<AllanPoint>,
+    /// The terms.
+    pub fit: Fit,
+}
+
+impl Analysis {
+    /// The τ of the smallest deviation, s.
+    pub fn tau_at_minimum_s(&self) -> f64 {
+        self.points
+            .iter()
+            .min_by(|a, b| a.adev.total_cmp(&b.adev))
+            .map_or(self.sample_period_s, |p| p.tau_s)
+    }
+}
+
+/// The deviation, noise type, EDF and interval at every τ of the octave grid, from the phase
+/// `x` (in samples) of n rate samples.
+fn points(x: &[f64], tau0_s: f64, confidence: f64) -> Vec<AllanPoint> {
+    let n = x.len() - 1;
+    let factors = deviation::octave_factors(n);
+    let avars = deviation::overlapping_avars(x, &factors);
+    let mut out: Vec<AllanPoint> = factors
+        .par_iter()
+        .zip(avars)
+        .map(|(&m, avar)| {
+            let noise = noise_id::identify(&noise_id::block_means(x, m));
+            AllanPoint {
+                m,
+                tau_s: m as f64 * tau0_s,
+                adev: avar.sqrt(),
+                noise,
+                identified_here: noise.is_some(),
+                edf: None,
+                interval: None,
+            }
+        })
+        .collect();
+    let mut last = None;
+    for p in &mut out {
+        if p.noise.is_none() {
+            p.noise = last;
+        }
+        last = p.noise.or(last);
+        let Some(id) = p.noise else { continue };
+        // Greenhall's EDF covers α from −2 (random walk) to +2 (white phase).
+        let alpha = id.alpha.clamp(-2, 2);
+        p.edf = edf::greenhall_edf(alpha, 2, p.m as f64, (n + 1) as f64, true);
+        p.interval = p
+            .edf
+            .map(|e| edf::chi_squared_interval(p.adev, e, confidence));
+    }
+    out
+}
+
+/// The terms fitted: N, B and K always, Q when the shortest τ shows phase noise (α ≥ 1).
+fn fitted_terms(points: &[AllanPoint]) -> Vec<Term> {
+    let phase_noise = points
+        .first()
+        .and_then(|p| p.noise)
+        .is_some_and(|id| id.alpha >= 1);
+    Term::ALL
+        .into_iter()
+        .filter(|&t| t != Term::Quantization || phase_noise)
+        .collect()
+}
+
+/// Analyses the rate samples `y` (m/s²) taken τ₀ = `tau0_s` apart: the overlapping Allan
+/// deviation at octave τ with χ² intervals at `confidence`, and the fitted noise terms. The fit
+/// uses every τ whose noise was identified there (at least 30 block means).
+///
+/// # Errors
+/// [`AllanError`] for fewer than [`MIN_SAMPLES`] samples, a constant log or a confidence
+/// outside (0, 1).
+pub fn analyse(y: &[f64], tau0_s: f64, confidence: f64) -> Result<Analysis, AllanError> {
+    if !(confidence > 0.0 && confidence < 1.0) {
+        return Err(AllanError::Confidence(confidence));
+    }
+    if y.len() < MIN_SAMPLES {
+        return Err(AllanError::TooFewSamples {
+            found: y.len(),
+            needed: MIN_SAMPLES,
+        });
+    }
+    let x = deviation::phase(y);
+    let points = points(&x, tau0_s, confidence);
+    if points.iter().all(|p| p.adev == 0.0) {
+        return Err(AllanError::Constant);
+    }
+    let fit_points: Vec<FitPoint> = points
+        .iter()
+        .filter(|p| p.identified_here && p.adev > 0.0)
+        .filter_map(|p| {
+            p.edf.map(|edf| FitPoint {
+                m: p.m,
+                tau_s: p.tau_s,
+                avar: p.adev * p.adev,
+                edf,
+            })
+        })
+        .collect();
+    let terms = fitted_terms(&points);
+    let fit =
+        fit::fit(&fit_points, y.len(), tau0_s, &terms, confidence).ok_or(AllanError::Constant)?;
+    Ok(Analysis {
+        samples: y.len(),
+        sample_period_s: tau0_s,
+        confidence,
+        points,
+        fit,
+    })
+}

@@ -1,0 +1,119 @@
+//! Identification of the power-law noise at one averaging time by the lag-1 autocorrelation.
+//!
+//! Riley & Greenhall, "Power law noise identification using the lag 1 autocorrelation",
+//! Proc. 18th EFTF (2004), as implemented by allantools' `autocorr_noise_id` for frequency data:
+//! the rate samples are averaged in non-overlapping blocks of m, a straight line is removed, and
+//! the series is differenced until the lag-1 autocorrelation r₁ gives δ = r₁/(1 + r₁) < 0.25
+//! (at most twice). Then α = −2(δ + d) for S_y(f) ∝ f^α, rounded to the nearest integer:
+//! +2 white phase (quantization), 0 white rate (velocity random walk), −1 flicker (bias
+//! instability), −2 random walk of the rate (acceleration random walk).
+
+/// Fewest block means the identification accepts (Riley & Greenhall's recommended minimum).
+pub const MIN_POINTS: usize = 30;
+/// Most differences taken (2 for the Allan variance).
+pub const MAX_DIFFERENCES: u32 = 2;
+
+/// The noise identified at one τ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoiseId {
+    /// α rounded to an integer (ties to even, as numpy's `round`).
+    pub alpha: i32,
+    /// α before rounding: −2(δ + d).
+    pub alpha_estimate: f64,
+    /// Differences taken, d.
+    pub differences: u32,
+    /// δ = r₁/(1 + r₁) of the last series.
+    pub delta: f64,
+}
+
+/// The lag-1 autocorrelation of `z`.
+///
+/// # Formula
+/// Riley & Greenhall (2004), eq. (2): r₁ = Σ_{n=0}^{L−2} (z_n − z̄)(z_{n+1} − z̄) / Σ (z_n − z̄)².
+pub fn lag1_autocorrelation(z: &[f64]) -> f64 {
+    let mean = z.iter().sum::<f64>() / z.len() as f64;
+    let num: f64 = z.windows(2).map(|w| (w[0] - mean) * (w[1] - mean)).sum();
+    let den: f64 = z.iter().map(|v| (v - mean) * (v - mean)).sum();
+    num / den
+}
+
+/// `z` less its least-squares straight line over the index 0, 1, …, L − 1 (numpy's
+/// `polyfit(t, z, 1)`).
+pub fn remove_line(z: &[f64]) -> Vec<f64> {
+    let l = z.len() as f64;
+    let t_mean = (l - 1.0) / 2.0;
+    let z_mean = z.iter().sum::<f64>() / l;
+    let (mut stz, mut stt) = (0.0, 0.0);
+    for (i, v) in z.iter().enumerate() {
+        let dt = i as f64 - t_mean;
+        stz += dt * (v - z_mean);
+        stt += dt * dt;
+    }
+    let slope = if stt > 0.0 { stz / stt } else { 0.0 };
+    z.iter()
+        .enumerate()
+        .map(|(i, v)| v - z_mean - slope * (i as f64 - t_mean))
+        .collect()
+}
+
+/// Identifies the noise of the block means `means` (rate data averaged over τ); `None` with
+/// fewer than [`MIN_POINTS`] means or a series without variation.
+pub fn identify(means: &[f64]) -> Option<NoiseId> {
+    if means.len() < MIN_POINTS {
+        return None;
+    }
+    let mut z = remove_line(means);
+    let mut d = 0u32;
+    loop {
+        let r1 = lag1_autocorrelation(&z);
+        if !r1.is_finite() {
+            return None;
+        }
+        let delta = r1 / (1.0 + r1);
+        if delta < 0.25 || d >= MAX_DIFFERENCES {
+            return Some(NoiseId {
+                alpha: (-(2.0 * delta).round_ties_even() - 2.0 * d as f64) as i32,
+                alpha_estimate: -2.0 * (delta + d as f64),
+                differences: d,
+                delta,
+            });
+        }
+        z = z.windows(2).map(|w| w[1] - w[0]).collect();
+        d += 1;
+    }
+}
+
+/// The non-overlapping block means of m samples of the rate data whose phase (in samples) is
+/// `x`: (x_{(k+1)m} − x_{km}) / m for k < ⌊n/m⌋. They differ from the raw samples' means by the
+/// subtracted mean only, which the line removal takes out.
+pub fn block_means(x: &[f64], m: usize) -> Vec<f64> {
+    let blocks = (x.len() - 1) / m;
+    (0..blocks)
+        .map(|k| (x[(k + 1) * m] - x[k * m]) / m as f64)
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::Stream;
+
+    #[test]
+    fn tells_white_from_random_walk_and_white_phase() {
+        let mut s = Stream::new(7, 0);
+        let white: Vec<f64> = (0..4000).map(|_| s.normal()).collect();
+        let mut acc = 0.0;
+        let walk: Vec<f64> = white
+            .iter()
+            .map(|w| {
+                acc += w;
+                acc
+            })
+            .collect();
+        let phase: Vec<f64> = white.windows(2).map(|w| w[1] - w[0]).collect();
+        assert_eq!(identify(&white).unwrap().alpha, 0);
+        assert_eq!(identify(&walk).unwrap().alpha, -2);
+        assert_eq!(identify(&phase).unwrap().alpha, 2);
+        assert!(identify(&white[..29]).is_none());
+    }
+}
