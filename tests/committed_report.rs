@@ -43,6 +43,8 @@ fn default_study() -> &'static Study {
             .unwrap()
             .with_sensitivity(&mut Silent)
             .unwrap()
+            .with_static_noise()
+            .unwrap()
     })
 }
 

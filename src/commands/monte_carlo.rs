@@ -19,7 +19,9 @@ use anyhow::Result;
 pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
     let model = load_model(&args.model, &CaseArgs::default(), args.realizations)?;
     let mut bar = Bar::new(args.model.quiet);
-    let study = Study::run(&model, &mut bar)?.with_sensitivity(&mut bar)?;
+    let study = Study::run(&model, &mut bar)?
+        .with_sensitivity(&mut bar)?
+        .with_static_noise()?;
     let command = reproduce_command(args);
     let page = report::render(&report::ReportInput {
         study: &study,

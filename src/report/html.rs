@@ -72,6 +72,12 @@ struct SensitivityHtml<'a> {
 }
 
 #[derive(Template)]
+#[template(path = "sections/allan.html")]
+struct StaticNoiseHtml<'a> {
+    a: &'a crate::allan::section::AllanSection,
+}
+
+#[derive(Template)]
 #[template(path = "sections/conclusions.html")]
 struct ConclusionsHtml<'a> {
     v: &'a ConclusionsView,
@@ -103,6 +109,7 @@ pub fn section(node: &SectionNode, eq: &Equations) -> Result<String, askama::Err
         SectionView::Case(c) => CaseHtml { c }.render(),
         SectionView::Performance(v) => PerformanceHtml { v }.render(),
         SectionView::Sensitivity(s) => SensitivityHtml { s }.render(),
+        SectionView::StaticNoise(a) => StaticNoiseHtml { a }.render(),
         SectionView::Conclusions(v) => ConclusionsHtml { v }.render(),
         SectionView::Appendix(v) => AppendixHtml { v }.render(),
     }?;

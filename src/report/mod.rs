@@ -43,6 +43,9 @@ pub enum RenderError {
         /// What plotters said.
         source: crate::plot::PlotError,
     },
+    /// The static log of the noise-statistics section could not be analysed.
+    #[error("cannot analyse the static log: {0}")]
+    StaticNoise(#[from] crate::allan::AllanError),
     /// The templates could not be filled.
     #[error("cannot fill the report templates: {0}")]
     Template(#[from] askama::Error),
@@ -134,7 +137,11 @@ pub fn build(
 /// The outline of the report of `study`: every case, and the sensitivity section when the
 /// study ran it.
 pub fn outline_of(study: &Study) -> Outline {
-    Outline::standard(study.cases.len(), study.sensitivity.is_some())
+    Outline::standard(
+        study.cases.len(),
+        study.sensitivity.is_some(),
+        study.static_noise.is_some(),
+    )
 }
 
 /// Renders the report of `input` as HTML, with its view as JSON.

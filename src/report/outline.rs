@@ -30,6 +30,8 @@ pub enum Section {
     Performance,
     /// Sensitivity to the assumed statistics.
     Sensitivity,
+    /// Noise statistics from a static log: the Allan deviation and its validation.
+    StaticNoise,
     /// Conclusions.
     Conclusions,
     /// Configuration and reproduction.
@@ -55,6 +57,11 @@ pub enum Table {
     Performance,
     /// The detection of a mistuned filter.
     Detection,
+    /// The noise terms recovered from a static log, then their coverage over many logs (two
+    /// consecutive numbers).
+    StaticNoise,
+    /// The coverage of the noise terms' intervals.
+    StaticNoiseCoverage,
 }
 
 /// A numbered figure.
@@ -72,6 +79,8 @@ pub enum Figure {
     Check(usize, CheckFigure),
     /// Actual against claimed σ of the mistuned filters.
     Sensitivity,
+    /// The Allan deviation of a static log.
+    AllanDeviation,
 }
 
 /// A numbered display equation.
@@ -154,6 +163,11 @@ impl Section {
                 .collect(),
             Section::Performance => vec![T(Table::Performance)],
             Section::Sensitivity => vec![F(Figure::Sensitivity), T(Table::Detection)],
+            Section::StaticNoise => vec![
+                F(Figure::AllanDeviation),
+                T(Table::StaticNoise),
+                T(Table::StaticNoiseCoverage),
+            ],
         }
     }
 }
@@ -186,8 +200,8 @@ pub struct Outline {
 
 impl Outline {
     /// The report's order for a study of `cases` cases, with the sensitivity section when
-    /// `sensitivity` is true.
-    pub fn standard(cases: usize, sensitivity: bool) -> Self {
+    /// `sensitivity` is true and the static-noise section when `static_noise` is.
+    pub fn standard(cases: usize, sensitivity: bool, static_noise: bool) -> Self {
         let results = Node {
             section: Section::Results,
             children: (0..cases)
@@ -204,6 +218,9 @@ impl Outline {
         ];
         if sensitivity {
             nodes.push(Node::leaf(Section::Sensitivity));
+        }
+        if static_noise {
+            nodes.push(Node::leaf(Section::StaticNoise));
         }
         nodes.push(Node::leaf(Section::Conclusions));
         nodes.push(Node::leaf(Section::Appendix));

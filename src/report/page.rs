@@ -184,6 +184,8 @@ pub enum SectionView {
     Performance(PerformanceView),
     /// Sensitivity to the assumed statistics.
     Sensitivity(Box<SensitivityView>),
+    /// Noise statistics from a static log.
+    StaticNoise(Box<crate::allan::section::AllanSection>),
     /// Conclusions.
     Conclusions(ConclusionsView),
     /// Configuration and reproduction.
@@ -202,6 +204,7 @@ impl SectionView {
             SectionView::Case(c) => format!("case-{}", c.id),
             SectionView::Performance(_) => "performance".to_string(),
             SectionView::Sensitivity(_) => "sensitivity".to_string(),
+            SectionView::StaticNoise(_) => "allan".to_string(),
             SectionView::Conclusions(_) => "conclusions".to_string(),
             SectionView::Appendix(_) => "appendix".to_string(),
         }
@@ -218,6 +221,7 @@ impl SectionView {
             SectionView::Case(c) => format!("Case {}: {}", c.letter, c.title),
             SectionView::Performance(_) => "Performance".to_string(),
             SectionView::Sensitivity(_) => "Sensitivity to the assumed statistics".to_string(),
+            SectionView::StaticNoise(_) => "Noise statistics from a static log".to_string(),
             SectionView::Conclusions(_) => "Conclusions".to_string(),
             SectionView::Appendix(_) => "Appendix: configuration and reproduction".to_string(),
         }

@@ -4,13 +4,14 @@
 use super::cases::{self, case_label, states};
 use super::figures;
 use super::math::Math;
-use super::outline::{Equation, Numbers, Section, Table};
+use super::outline::{Equation, Figure, Numbers, Section, Table};
 use super::page::{
     AbstractView, AppendixView, ConclusionsView, IntroductionView, PerformanceView, ProblemView,
     ResultsView, SectionView, TheoryView,
 };
 use super::view::{CatalogueEntry, EquationNumbers};
 use super::{RenderError, ReportInput, params, prose, rich, sensitivity};
+use crate::allan::section::AllanSection;
 use crate::format::{count, fixed, percent, short, sig};
 use crate::state::ErrorState;
 use crate::study::Study;
@@ -30,6 +31,32 @@ pub struct Context<'a> {
 impl Context<'_> {
     fn study(&self) -> &Study {
         self.input.study
+    }
+
+    /// The static-noise section: the report's simulated static log analysed again, with the
+    /// coverage the study measured.
+    ///
+    /// # Panics
+    /// When the study did not run the static-noise study.
+    fn static_noise(&self) -> Result<AllanSection, RenderError> {
+        use crate::allan::section::{REPORT_LOG, REPORT_SAMPLES, section};
+        let coverage = self
+            .study()
+            .static_noise
+            .as_ref()
+            .expect("the outline shows the static noise only when the study ran it");
+        let n = self.numbers;
+        let figure = n.figure(Figure::AllanDeviation);
+        let table = n.table(Table::StaticNoise);
+        debug_assert_eq!(n.table(Table::StaticNoiseCoverage), table + 1);
+        Ok(section(
+            &REPORT_LOG,
+            REPORT_SAMPLES,
+            0,
+            coverage,
+            figure,
+            table,
+        )?)
     }
 
     /// The view of `section`.
@@ -63,6 +90,7 @@ impl Context<'_> {
                     .expect("the outline shows sensitivity only when the study ran it"),
                 self.numbers,
             )?)),
+            Section::StaticNoise => SectionView::StaticNoise(Box::new(self.static_noise()?)),
             Section::Conclusions => SectionView::Conclusions(self.conclusions()),
             Section::Appendix => SectionView::Appendix(AppendixView {
                 command: self.input.command.to_string(),
