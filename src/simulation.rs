@@ -263,7 +263,8 @@ impl<'a> Run<'a> {
         rng: &mut N,
         obs: &mut O,
     ) -> [f64; 4] {
-        let (b, w_sigma, dt, half_dt2) = (self.draws.bias_m_s2, self.w_sigma, self.dt, self.half_dt2);
+        let (b, w_sigma, dt, half_dt2) =
+            (self.draws.bias_m_s2, self.w_sigma, self.dt, self.half_dt2);
         let [mut pc, mut vc, mut pe, mut ve] = state;
         for (k, &a) in self.model.accel_m_s2[j..end].iter().enumerate() {
             // eq. (2): the accelerometer's output.

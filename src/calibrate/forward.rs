@@ -5,7 +5,9 @@ use crate::error::FilterError;
 use crate::filter::{ErrorStateModel, propagate_over};
 use crate::logs::GpsFix;
 use crate::simulation::measurement;
-use crate::state::{ErrorState, MeasMatrix, MeasVector, StateMatrix, StateModel, StateVector, transition};
+use crate::state::{
+    ErrorState, MeasMatrix, MeasVector, StateMatrix, StateModel, StateVector, transition,
+};
 
 use super::StepMode;
 

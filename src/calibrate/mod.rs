@@ -256,9 +256,11 @@ impl Prepared<'_> {
         let f = &s.filter_stats;
         let sc = &self.scan;
         let start_smoothed = match (self.fixes.first(), self.smoothed.first()) {
-            (Some(fix), Some(sm)) => {
-                sm.smooth(&StateVector::zeros(), &self.model.p0, &fix.phi_from_previous)
-            }
+            (Some(fix), Some(sm)) => sm.smooth(
+                &StateVector::zeros(),
+                &self.model.p0,
+                &fix.phi_from_previous,
+            ),
             _ => (StateVector::zeros(), self.model.p0),
         };
         let nis: Vec<f64> = self.fixes.iter().map(|f| f.nis).collect();

@@ -55,7 +55,12 @@ impl SmoothedFix {
 
     /// The smoothed estimate and covariance at a sample whose filtered ones are `x`, `p`, with
     /// this fix the next one after it and `phi` the transition from the sample to this fix.
-    pub fn smooth(&self, x: &StateVector, p: &StateMatrix, phi: &StateMatrix) -> (StateVector, StateMatrix) {
+    pub fn smooth(
+        &self,
+        x: &StateVector,
+        p: &StateMatrix,
+        phi: &StateMatrix,
+    ) -> (StateVector, StateMatrix) {
         let g = p * phi.transpose();
         (
             x + g * self.lambda,

@@ -4,6 +4,7 @@
 mod validate;
 
 use crate::config::{AccelerometerOutput, Case, Config, TruthModel};
+use crate::ensemble::StageSums;
 use crate::error::ConfigError;
 use validate::{validate, whole};
 
@@ -11,10 +12,13 @@ use validate::{validate, whole};
 pub const MAX_STEPS: usize = 10_000_000;
 /// Largest number of GPS fixes in a run.
 pub const MAX_FIXES: usize = 1_000_000;
-/// Largest memory the running sums of one chunk of realizations may take, bytes: 51 floats per
-/// fix and the kept residual products. A run needs a few of them at once (one per thread in
+/// Largest memory the running sums of one chunk of realizations may take, bytes:
+/// [`SUMS_FLOATS_PER_FIX`] floats per fix and the kept residual products. A run needs a few of them at once (one per thread in
 /// flight, one per open block, the total).
 pub const MAX_SUMS_BYTES: usize = 256 << 20;
+/// Floats of the running sums at one fix: both stages' sums and the NIS sum (51 for the error
+/// state).
+pub const SUMS_FLOATS_PER_FIX: usize = 2 * <StageSums>::FLOATS + 1;
 /// Runs with at most this many fixes test the residual whiteness of every pair of fixes by
 /// default; longer runs test lags up to [`DEFAULT_MAX_LAG`] (every pair costs O(fixes²)).
 pub const ALL_PAIRS_MAX_FIXES: usize = 1_000;
