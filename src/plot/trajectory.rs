@@ -7,7 +7,9 @@ use super::axis::{Axis, y_label_area};
 use super::geometry::{before, clipped_until, extent, padded, settled_from, time_span};
 use super::legend::{Entry, Swatch, render_under_legend};
 use super::panel::{Area, Layout, Panel, columns};
-use super::{BLUE, BLUISH_GREEN, PlotError, PlotResult, VERMILLION, WIDTH_PX, state_unit};
+use super::{
+    BLUE, BLUISH_GREEN, PlotError, PlotResult, VERMILLION, WIDTH_PX, state_name, state_unit,
+};
 use crate::realization::{Realization, SampleRecord};
 use crate::state::ErrorState;
 
@@ -103,14 +105,14 @@ fn motion_axes(s: &[SampleRecord]) -> [Axis; ROWS] {
             s.iter().map(|x| x.accel_m_s2).collect(),
         ),
         fitted(
-            "velocity",
+            state_name(ErrorState::VELOCITY),
             state_unit(ErrorState::VELOCITY),
             s.iter()
                 .flat_map(|x| [x.truth_v_m_s, x.computed_v_m_s])
                 .collect(),
         ),
         fitted(
-            "position",
+            state_name(ErrorState::POSITION),
             state_unit(ErrorState::POSITION),
             s.iter()
                 .flat_map(|x| [x.truth_p_m, x.computed_p_m])
@@ -122,19 +124,20 @@ fn motion_axes(s: &[SampleRecord]) -> [Axis; ROWS] {
 /// The right-hand axes: bias, velocity drift and position drift, fitted to the truth over the
 /// run and to the estimate from `settle` on.
 fn drift_axes(s: &[SampleRecord], settle: f64) -> [Axis; ROWS] {
-    let drift_axis = |k: usize, name: &str| {
+    let drift = |k: usize| format!("{} drift", state_name(k));
+    let drift_axis = |k: usize, name: String| {
         let values = s
             .iter()
             .map(|x| x.delta_x[k])
             .chain(s.iter().filter(|x| x.t_s >= settle).map(|x| x.estimate[k]))
             .collect::<Vec<_>>();
         let range = extent(values).map_or((-1.0, 1.0), |e| padded(e, 0.12));
-        Axis::linear(name, state_unit(k), range, 6)
+        Axis::linear(&name, state_unit(k), range, 6)
     };
     [
-        drift_axis(ErrorState::BIAS, "bias"),
-        drift_axis(ErrorState::VELOCITY, "velocity drift"),
-        drift_axis(ErrorState::POSITION, "position drift"),
+        drift_axis(ErrorState::BIAS, state_name(ErrorState::BIAS).to_string()),
+        drift_axis(ErrorState::VELOCITY, drift(ErrorState::VELOCITY)),
+        drift_axis(ErrorState::POSITION, drift(ErrorState::POSITION)),
     ]
 }
 

@@ -271,7 +271,9 @@ fn consistency_far_from_its_band_gets_a_log_axis_and_the_band_enlarged() {
     let (nees, nis) = (check(study, CheckId::NEES), check(study, CheckId::NIS));
     let mut near = study.case(CASE).run.stats.clone();
     for f in &mut near.fixes {
-        (f.prior.nees_avg, f.post.nees_avg, f.nis_avg) = (3.0, 3.0, 2.0);
+        // Each at its expected value: the number of states, of measured components.
+        let (states, measured) = (ErrorState::DIM as f64, ErrorState::MEAS as f64);
+        (f.prior.nees_avg, f.post.nees_avg, f.nis_avg) = (states, states, measured);
     }
     let titles = |stats| {
         texts(&consistency(stats, nees, nis).unwrap())
