@@ -4,7 +4,6 @@
 mod validate;
 
 use crate::config::{AccelerometerOutput, Case, Config, TruthModel};
-use crate::ensemble::StageSums;
 use crate::error::ConfigError;
 use validate::{validate, whole};
 
@@ -16,9 +15,16 @@ pub const MAX_FIXES: usize = 1_000_000;
 /// [`SUMS_FLOATS_PER_FIX`] floats per fix and the kept residual products. A run needs a few of them at once (one per thread in
 /// flight, one per open block, the total).
 pub const MAX_SUMS_BYTES: usize = 256 << 20;
-/// Floats of the running sums at one fix: both stages' sums and the NIS sum (51 for the error
-/// state).
-pub const SUMS_FLOATS_PER_FIX: usize = 2 * <StageSums>::FLOATS + 1;
+/// Floats of the running sums at one fix: both stages' sums (Σ e, the upper triangle of Σ e·eᵀ,
+/// Σ e·δx̂ᵀ, Σ δx̂, Σ δx̂², NEES: 25 for the three states of the error state) and the NIS sum.
+///
+/// The model sits below the state model, which takes its noise statistics, so it cannot ask the
+/// state model its sizes: the number is written here and checked at compile time against the
+/// ensemble's sums of the error state (in `study`), so that a change of state fails to compile.
+pub const SUMS_FLOATS_PER_FIX: usize = 51;
+/// Components of one GPS residual (position, velocity): the residual products per pair of fixes
+/// are its square. Checked at compile time against the error state's measurement (in `study`).
+pub const RESIDUAL_WIDTH: usize = 2;
 /// Runs with at most this many fixes test the residual whiteness of every pair of fixes by
 /// default; longer runs test lags up to [`DEFAULT_MAX_LAG`] (every pair costs O(fixes²)).
 pub const ALL_PAIRS_MAX_FIXES: usize = 1_000;

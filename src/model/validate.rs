@@ -3,11 +3,10 @@
 
 use super::{
     ALL_PAIRS_MAX_FIXES, DEFAULT_MAX_LAG, FILTER_FLOOR, MAX_FIXES, MAX_REALIZATIONS, MAX_STEPS,
-    MAX_SUMS_BYTES, SUMS_FLOATS_PER_FIX, WHOLE_TOL,
+    MAX_SUMS_BYTES, RESIDUAL_WIDTH, SUMS_FLOATS_PER_FIX, WHOLE_TOL,
 };
 use crate::config::Config;
 use crate::error::ConfigError;
-use crate::state::ErrorState;
 
 /// `x` rounded to the nearest whole number when it is one within [`WHOLE_TOL`].
 pub(super) fn whole(x: f64) -> Option<u64> {
@@ -249,7 +248,7 @@ fn validate_sums_memory(c: &Config, fixes: u64) -> Result<(), ConfigError> {
     };
     // The residual stacks M components per fix: M·f rows, of which a band of lags up to l keeps
     // M·(l + 1) columns each, every pair the M·f·(M·f + 1)/2 of the lower triangle.
-    let m = ErrorState::MEAS as f64;
+    let m = RESIDUAL_WIDTH as f64;
     let per_fix = SUMS_FLOATS_PER_FIX as f64;
     let products = match lag {
         Some(l) if l + 1.0 < f => m * f * (m * l + m),

@@ -17,6 +17,13 @@ pub use crate::progress::{Progress, Silent};
 use crate::realization::{self, Realization};
 use crate::sensitivity::{self, Plan, Sensitivity, SensitivityError};
 use crate::state::ErrorState;
+
+// The model's memory bound counts the running sums of the error state and the width of its
+// residual; it cannot ask the state model (which sits above it), so the two agree here.
+const _: () = assert!(
+    crate::model::SUMS_FLOATS_PER_FIX == 2 * <ensemble::StageSums>::FLOATS + 1
+        && crate::model::RESIDUAL_WIDTH == ErrorState::MEAS
+);
 pub use analysis::{MeanErrorPrediction, StagedState, max_mean_over_sigma};
 
 /// The samples of the recorded realization that the report keeps, at most about: a run with
