@@ -79,7 +79,7 @@ impl std::ops::AddAssign for Lanes {
 
 impl Lanes {
     /// The lanes' sum, in a fixed order: lane k + 4 added to lane k, then lane k + 2, then lane
-    /// 1 (three vector additions rather than seven dependent ones).
+    /// 1 (a tree three additions deep rather than a chain of dependent ones).
     #[inline(always)]
     pub fn sum(self) -> f64 {
         let v = self.0;

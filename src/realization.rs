@@ -2,9 +2,10 @@
 
 use serde::Serialize;
 
-use crate::filter::{FilterSchedule, Matrix3, Vector3, rows};
+use crate::filter::{FilterSchedule, rows};
 use crate::model::Model;
 use crate::simulation::{Draws, FixState, Observer, SampleState, run_realization};
+use crate::state::{ErrorState, StateMatrix, StateVector};
 
 /// The state at one accelerometer sample t_j.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -24,13 +25,13 @@ pub struct SampleRecord {
     /// Integrated accelerometer velocity v_c(t_j), m/s.
     pub computed_v_m_s: f64,
     /// True error state δx(t_j) = (p − p_c, v − v_c, b).
-    pub delta_x: [f64; 3],
+    pub delta_x: [f64; ErrorState::DIM],
     /// The filter's estimate δx̂(t_j), propagated from the last fix.
-    pub estimate: [f64; 3],
+    pub estimate: [f64; ErrorState::DIM],
     /// The filter's σ = √diag P(t_j).
-    pub sigma: [f64; 3],
+    pub sigma: [f64; ErrorState::DIM],
     /// The filter's covariance P(t_j), row-major.
-    pub cov: [[f64; 3]; 3],
+    pub cov: [[f64; ErrorState::DIM]; ErrorState::DIM],
 }
 
 /// A realization at one GPS fix.
@@ -39,23 +40,23 @@ pub struct FixRecord {
     /// Time of the fix t_i, s.
     pub t_s: f64,
     /// True error state δx(t_i) = (p − p_c, v − v_c, b).
-    pub delta_x: [f64; 3],
+    pub delta_x: [f64; ErrorState::DIM],
     /// A priori estimate δx̂(t_i⁻).
-    pub prior: [f64; 3],
+    pub prior: [f64; ErrorState::DIM],
     /// A posteriori estimate δx̂(t_i⁺).
-    pub post: [f64; 3],
+    pub post: [f64; ErrorState::DIM],
     /// A priori σ = √diag P(t_i⁻).
-    pub sigma_prior: [f64; 3],
+    pub sigma_prior: [f64; ErrorState::DIM],
     /// A posteriori σ = √diag P(t_i⁺).
-    pub sigma_post: [f64; 3],
+    pub sigma_post: [f64; ErrorState::DIM],
     /// A priori covariance P(t_i⁻), row-major.
-    pub cov_prior: [[f64; 3]; 3],
+    pub cov_prior: [[f64; ErrorState::DIM]; ErrorState::DIM],
     /// A posteriori covariance P(t_i⁺), row-major.
-    pub cov_post: [[f64; 3]; 3],
+    pub cov_post: [[f64; ErrorState::DIM]; ErrorState::DIM],
     /// Residual r = δz − H·δx̂⁻, (m, m/s).
-    pub residual: [f64; 2],
+    pub residual: [f64; ErrorState::MEAS],
     /// Measurement δz = z − (p_c, v_c), (m, m/s).
-    pub dz: [f64; 2],
+    pub dz: [f64; ErrorState::MEAS],
 }
 
 /// One realization, recorded at every sample and every fix.
@@ -79,7 +80,7 @@ pub struct Realization {
     pub fixes: Vec<FixRecord>,
 }
 
-fn sigma(p: &Matrix3) -> [f64; 3] {
+fn sigma(p: &StateMatrix) -> [f64; ErrorState::DIM] {
     std::array::from_fn(|k| p[(k, k)].sqrt())
 }
 
@@ -98,6 +99,9 @@ pub fn detail_window(t0_s: f64, t1_s: f64) -> (f64, f64) {
     (start, start + DETAIL_S)
 }
 
+/// Samples a bucket keeps at most: its first, and the smallest and largest error of each state.
+const KEPT_PER_BUCKET: usize = 1 + 2 * ErrorState::DIM;
+
 /// Keeps a long run's samples to what a figure can show: every sample in the detail window, and
 /// elsewhere, per bucket of consecutive samples, the first one and those where an error
 /// component δx − δx̂ is smallest or largest, so that spikes survive.
@@ -114,7 +118,7 @@ impl Thinning {
         }
         let error = |s: &SampleRecord, k: usize| s.delta_x[k] - s.estimate[k];
         let mut keep = vec![0];
-        for k in 0..3 {
+        for k in 0..ErrorState::DIM {
             let by = |a: &&SampleRecord, b: &&SampleRecord| error(a, k).total_cmp(&error(b, k));
             let indexed = || self.pending.iter().enumerate();
             keep.extend(indexed().min_by(|a, b| by(&a.1, &b.1)).map(|(i, _)| i));
@@ -130,8 +134,8 @@ impl Thinning {
 struct Recorder<'a> {
     model: &'a Model,
     schedule: &'a FilterSchedule,
-    estimate: Vector3,
-    cov: Matrix3,
+    estimate: StateVector,
+    cov: StateMatrix,
     samples: Vec<SampleRecord>,
     fixes: Vec<FixRecord>,
     thinning: Option<Thinning>,
@@ -151,11 +155,7 @@ impl Observer for Recorder<'_> {
             truth_v_m_s: s.truth_v_m_s,
             computed_p_m: s.computed_p_m,
             computed_v_m_s: s.computed_v_m_s,
-            delta_x: [
-                s.truth_p_m - s.computed_p_m,
-                s.truth_v_m_s - s.computed_v_m_s,
-                s.bias_m_s2,
-            ],
+            delta_x: s.delta_x().into(),
             estimate: self.estimate.into(),
             sigma: sigma(&self.cov),
             cov: rows(&self.cov),
@@ -218,8 +218,7 @@ pub fn record_for_figures(
 ) -> Realization {
     let steps = model.timeline.steps + 1;
     let thinning = (steps > max_samples).then(|| Thinning {
-        // Up to seven samples kept per bucket.
-        bucket: (7 * steps).div_ceil(max_samples.max(7)),
+        bucket: (KEPT_PER_BUCKET * steps).div_ceil(max_samples.max(KEPT_PER_BUCKET)),
         window: detail_window(0.0, model.timeline.time_s(model.timeline.steps)),
         pending: Vec::new(),
     });
@@ -241,7 +240,7 @@ fn record_with(
     let mut rec = Recorder {
         model,
         schedule,
-        estimate: Vector3::zeros(),
+        estimate: StateVector::zeros(),
         cov: schedule.model.p0,
         samples: Vec::with_capacity(capacity),
         fixes: Vec::with_capacity(model.timeline.fixes()),

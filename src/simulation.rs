@@ -6,10 +6,11 @@
 //! eq. (6). What a caller keeps of a realization is decided by its [`Observer`].
 
 use crate::config::{Case, TruthModel};
-use crate::filter::{FilterSchedule, Vector2, Vector3};
+use crate::filter::FilterSchedule;
 use crate::model::Model;
 pub use crate::random::Stream;
 use crate::random::splitmix64;
+use crate::state::{ErrorState, MeasVector, StateVector};
 
 /// The key of the random streams of `case` under `seed`: realization l draws from
 /// `Stream::new(key, l)`.
@@ -70,23 +71,34 @@ pub struct SampleState {
     pub accel_output_m_s2: f64,
 }
 
+impl SampleState {
+    /// The true error state δx(t_j) = (p − p_c, v − v_c, b).
+    pub fn delta_x(&self) -> StateVector {
+        error_state(
+            self.truth_p_m - self.computed_p_m,
+            self.truth_v_m_s - self.computed_v_m_s,
+            self.bias_m_s2,
+        )
+    }
+}
+
 /// What a realization produced at one GPS fix.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FixState {
     /// Fix index i.
     pub index: usize,
     /// True error state δx(t_i) = (p − p_c, v − v_c, b).
-    pub delta_x: Vector3,
+    pub delta_x: StateVector,
     /// A priori estimate δx̂(t_i⁻).
-    pub prior: Vector3,
+    pub prior: StateVector,
     /// A posteriori estimate δx̂(t_i⁺).
-    pub post: Vector3,
+    pub post: StateVector,
     /// Residual r(t_i) = δz − H·δx̂⁻.
-    pub residual: Vector2,
+    pub residual: MeasVector,
     /// The measurement δz(t_i) = z − (p_c, v_c).
-    pub dz: Vector2,
+    pub dz: MeasVector,
     /// The GPS fix z(t_i) = (p + η_p, v + η_v): what a log of the receiver holds, (m, m/s).
-    pub z: Vector2,
+    pub z: MeasVector,
 }
 
 /// Receives what a realization produces. Both hooks default to doing nothing.
@@ -154,14 +166,8 @@ fn run_with<N: Noise, O: Observer>(
         v0_m_s: cfg.initial.velocity_mean_m_s + ts.initial_velocity_sigma_m_s * rng.normal(),
         bias_m_s2: ts.bias_var_m2_s4.sqrt() * rng.normal(),
     };
-    let b = draws.bias_m_s2;
-    let w_sigma = ts.accel_noise_var_m2_s4.sqrt();
-    let (eta_p_sigma, eta_v_sigma) = (ts.gps_position_sigma_m, ts.gps_velocity_sigma_m_s);
+    let run = Run::new(model, draws);
     let tl = &model.timeline;
-    let dt = tl.dt_s;
-    let half_dt2 = 0.5 * dt * dt;
-    let accel = &model.accel_m_s2;
-
     // eq. (3) starts from the prior means; eq. (4) from the true initial values.
     let mut s = [
         cfg.initial.position_mean_m,
@@ -169,63 +175,14 @@ fn run_with<N: Noise, O: Observer>(
         draws.p0_m,
         draws.v0_m_s,
     ];
-    let truth_at = |j: usize, pe: f64, ve: f64| match model.truth() {
-        TruthModel::Analytic => model.analytic_truth(tl.time_s(j), draws.p0_m, draws.v0_m_s),
-        TruthModel::Euler => (pe, ve),
-    };
-    let sample = |j: usize, [pc, vc, pe, ve]: [f64; 4], ac: f64| {
-        let (tp, tv) = truth_at(j, pe, ve);
-        SampleState {
-            step: j,
-            truth_p_m: tp,
-            truth_v_m_s: tv,
-            computed_p_m: pc,
-            computed_v_m_s: vc,
-            bias_m_s2: b,
-            accel_output_m_s2: ac,
-        }
-    };
-
-    let mut estimate = Vector3::zeros();
+    let mut estimate = StateVector::zeros();
     let mut j = 0;
-    // The integration state (p_c, v_c, p_E, v_E), advanced sample by sample from `j` to `end`.
-    // It is passed by value so that it lives in registers through the hot loop.
-    let integrate_to = |j: usize, end: usize, state: [f64; 4], rng: &mut N, obs: &mut O| {
-        let [mut pc, mut vc, mut pe, mut ve] = state;
-        for (k, &a) in accel[j..end].iter().enumerate() {
-            // eq. (2): the accelerometer's output.
-            let ac = a + b + w_sigma * rng.normal();
-            if O::SAMPLES {
-                obs.sample(&sample(j + k, [pc, vc, pe, ve], ac));
-            }
-            // eq. (3): position uses the velocity before the step.
-            pc += vc * dt + ac * half_dt2;
-            vc += ac * dt;
-            // eq. (4): the true acceleration through the same formula.
-            pe += ve * dt + a * half_dt2;
-            ve += a * dt;
-        }
-        [pc, vc, pe, ve]
-    };
     for (i, (&jf, fix)) in tl.fix_steps.iter().zip(&schedule.fixes).enumerate() {
-        s = integrate_to(j, jf, s, rng, observer);
+        s = run.integrate(j, jf, s, rng, observer);
         j = jf;
-        let [pc, vc, pe, ve] = s;
-        let (tp, tv) = match model.truth() {
-            TruthModel::Analytic => {
-                model.analytic_truth_at_fix(i, tl.time_s(jf), draws.p0_m, draws.v0_m_s)
-            }
-            TruthModel::Euler => (pe, ve),
-        };
-        let delta_x = Vector3::new(tp - pc, tv - vc, b);
-        // eq. (6): δz = z − (p_c, v_c), with z the receiver's fix.
-        let z = Vector2::new(
-            tp + eta_p_sigma * rng.normal(),
-            tv + eta_v_sigma * rng.normal(),
-        );
-        let dz = Vector2::new(z[0] - pc, z[1] - vc);
+        let (delta_x, z, dz) = run.measure(i, jf, s, rng);
         let (prior, post, residual) = fix.step(&estimate.into(), &dz.into());
-        let (prior, post, residual) = (prior.into(), post.into(), Vector2::from(residual));
+        let (prior, post, residual) = (prior.into(), post.into(), MeasVector::from(residual));
         estimate = post;
         observer.fix(&FixState {
             index: i,
@@ -238,11 +195,135 @@ fn run_with<N: Noise, O: Observer>(
         });
     }
     if O::SAMPLES {
-        let end = integrate_to(j, tl.steps, s, rng, observer);
-        let ac = accel[tl.steps] + b + w_sigma * rng.normal();
-        observer.sample(&sample(tl.steps, end, ac));
+        let end = run.integrate(j, tl.steps, s, rng, observer);
+        let ac = model.accel_m_s2[tl.steps] + draws.bias_m_s2 + run.w_sigma * rng.normal();
+        observer.sample(&run.sample(tl.steps, end, ac));
     }
     draws
+}
+
+/// What stays fixed through one realization: the model, the initial draws and the step constants.
+struct Run<'a> {
+    model: &'a Model,
+    draws: Draws,
+    /// σ of the accelerometer's white noise w, m/s².
+    w_sigma: f64,
+    /// Sample interval Δt, s.
+    dt: f64,
+    /// Δt²/2, s².
+    half_dt2: f64,
+}
+
+impl<'a> Run<'a> {
+    fn new(model: &'a Model, draws: Draws) -> Self {
+        let dt = model.timeline.dt_s;
+        Run {
+            model,
+            draws,
+            w_sigma: model.truth_stats.accel_noise_var_m2_s4.sqrt(),
+            dt,
+            half_dt2: 0.5 * dt * dt,
+        }
+    }
+
+    /// The true position and velocity at sample `j`, given the Euler-integrated truth (p_E, v_E).
+    fn truth_at(&self, j: usize, pe: f64, ve: f64) -> (f64, f64) {
+        let d = &self.draws;
+        match self.model.truth() {
+            TruthModel::Analytic => {
+                let t_s = self.model.timeline.time_s(j);
+                self.model.analytic_truth(t_s, d.p0_m, d.v0_m_s)
+            }
+            TruthModel::Euler => (pe, ve),
+        }
+    }
+
+    /// The state at sample `j` from the integration state (p_c, v_c, p_E, v_E) and the output a_c.
+    fn sample(&self, j: usize, [pc, vc, pe, ve]: [f64; 4], ac: f64) -> SampleState {
+        let (tp, tv) = self.truth_at(j, pe, ve);
+        SampleState {
+            step: j,
+            truth_p_m: tp,
+            truth_v_m_s: tv,
+            computed_p_m: pc,
+            computed_v_m_s: vc,
+            bias_m_s2: self.draws.bias_m_s2,
+            accel_output_m_s2: ac,
+        }
+    }
+
+    /// The integration state (p_c, v_c, p_E, v_E) advanced sample by sample from `j` to `end`.
+    /// It is passed by value so that it lives in registers through the hot loop.
+    #[inline(always)]
+    fn integrate<N: Noise, O: Observer>(
+        &self,
+        j: usize,
+        end: usize,
+        state: [f64; 4],
+        rng: &mut N,
+        obs: &mut O,
+    ) -> [f64; 4] {
+        let (b, w_sigma, dt, half_dt2) =
+            (self.draws.bias_m_s2, self.w_sigma, self.dt, self.half_dt2);
+        let [mut pc, mut vc, mut pe, mut ve] = state;
+        for (k, &a) in self.model.accel_m_s2[j..end].iter().enumerate() {
+            // eq. (2): the accelerometer's output.
+            let ac = a + b + w_sigma * rng.normal();
+            if O::SAMPLES {
+                obs.sample(&self.sample(j + k, [pc, vc, pe, ve], ac));
+            }
+            // eq. (3): position uses the velocity before the step.
+            pc += vc * dt + ac * half_dt2;
+            vc += ac * dt;
+            // eq. (4): the true acceleration through the same formula.
+            pe += ve * dt + a * half_dt2;
+            ve += a * dt;
+        }
+        [pc, vc, pe, ve]
+    }
+
+    /// The true error state δx, the GPS fix z and the filter's measurement δz at fix `i` (sample
+    /// `jf`), from the integration state (p_c, v_c, p_E, v_E).
+    fn measure<N: Noise>(
+        &self,
+        i: usize,
+        jf: usize,
+        [pc, vc, pe, ve]: [f64; 4],
+        rng: &mut N,
+    ) -> (StateVector, MeasVector, MeasVector) {
+        let d = &self.draws;
+        let (tp, tv) = match self.model.truth() {
+            TruthModel::Analytic => {
+                let t_s = self.model.timeline.time_s(jf);
+                self.model.analytic_truth_at_fix(i, t_s, d.p0_m, d.v0_m_s)
+            }
+            TruthModel::Euler => (pe, ve),
+        };
+        let delta_x = error_state(tp - pc, tv - vc, d.bias_m_s2);
+        // eq. (6): δz = z − (p_c, v_c), with z the receiver's fix.
+        let ts = &self.model.truth_stats;
+        // Drawn in this order: η_p, then η_v.
+        let zp = tp + ts.gps_position_sigma_m * rng.normal();
+        let zv = tv + ts.gps_velocity_sigma_m_s * rng.normal();
+        (delta_x, measurement(zp, zv), measurement(zp - pc, zv - vc))
+    }
+}
+
+/// A GPS measurement (or its difference to the integration) from its position and velocity.
+pub fn measurement(position_m: f64, velocity_m_s: f64) -> MeasVector {
+    let mut z = MeasVector::zeros();
+    z[ErrorState::GPS_POSITION] = position_m;
+    z[ErrorState::GPS_VELOCITY] = velocity_m_s;
+    z
+}
+
+/// The error state δx = (δp, δv, b) from its components.
+pub fn error_state(dp_m: f64, dv_m_s: f64, bias_m_s2: f64) -> StateVector {
+    let mut x = StateVector::zeros();
+    x[ErrorState::POSITION] = dp_m;
+    x[ErrorState::VELOCITY] = dv_m_s;
+    x[ErrorState::BIAS] = bias_m_s2;
+    x
 }
 
 #[cfg(test)]

@@ -2,9 +2,12 @@
 //! filter, one sample at a time, with the step of each pair of time stamps.
 
 use crate::error::FilterError;
-use crate::filter::{ErrorStateModel, Matrix2, Matrix3, Vector2, Vector3, propagate_over};
+use crate::filter::{ErrorStateModel, propagate_over};
 use crate::logs::GpsFix;
-use crate::state::{ErrorState, StateModel, transition};
+use crate::simulation::measurement;
+use crate::state::{
+    ErrorState, MeasMatrix, MeasVector, StateMatrix, StateModel, StateVector, transition,
+};
 
 use super::StepMode;
 
@@ -18,27 +21,27 @@ pub struct FilteredFix {
     /// Time stamp of that sample, s.
     pub t_s: f64,
     /// The fix z = (z_p, z_v), (m, m/s).
-    pub z: Vector2,
+    pub z: MeasVector,
     /// Integrated accelerometer (p_c, v_c) at the fix, (m, m/s).
-    pub integrated: Vector2,
+    pub integrated: MeasVector,
     /// A priori estimate δx̂⁻.
-    pub prior: Vector3,
+    pub prior: StateVector,
     /// A posteriori estimate δx̂⁺.
-    pub post: Vector3,
+    pub post: StateVector,
     /// Residual r = δz − H·δx̂⁻, (m, m/s).
-    pub residual: Vector2,
+    pub residual: MeasVector,
     /// Innovation covariance S = H·P⁻·Hᵀ + R.
-    pub s: Matrix2,
+    pub s: MeasMatrix,
     /// Normalized innovation squared rᵀ·S⁻¹·r.
     pub nis: f64,
     /// A priori covariance P⁻.
-    pub p_prior: Matrix3,
+    pub p_prior: StateMatrix,
     /// (P⁻)⁻¹.
-    pub p_prior_inv: Matrix3,
+    pub p_prior_inv: StateMatrix,
     /// A posteriori covariance P⁺.
-    pub p_post: Matrix3,
+    pub p_post: StateMatrix,
     /// Transition of the estimate from the previous fix (or the log's first sample).
-    pub phi_from_previous: Matrix3,
+    pub phi_from_previous: StateMatrix,
 }
 
 /// The integration and the filter at the current sample.
@@ -58,11 +61,11 @@ pub(super) struct Forward<'m> {
     /// Integrated velocity v_c, m/s.
     pub vc_m_s: f64,
     /// Estimate δx̂ (a posteriori at a fix).
-    pub x: Vector3,
+    pub x: StateVector,
     /// Its covariance P.
-    pub p: Matrix3,
+    pub p: StateMatrix,
     /// Sample, time and a posteriori estimate of the last fix (the start before any).
-    last_fix: (u64, f64, Vector3),
+    last_fix: (u64, f64, StateVector),
 }
 
 impl<'m> Forward<'m> {
@@ -85,9 +88,9 @@ impl<'m> Forward<'m> {
             t_s: t0_s,
             pc_m: position_mean_m,
             vc_m_s: velocity_mean_m_s,
-            x: Vector3::zeros(),
+            x: StateVector::zeros(),
             p: model.p0,
-            last_fix: (0, t0_s, Vector3::zeros()),
+            last_fix: (0, t0_s, StateVector::zeros()),
         }
     }
 
@@ -119,7 +122,7 @@ impl<'m> Forward<'m> {
     }
 
     /// Transition Φ from the current sample to sample `k_to` at `t_to_s`.
-    pub fn transition_to(&self, k_to: u64, t_to_s: f64) -> Matrix3 {
+    pub fn transition_to(&self, k_to: u64, t_to_s: f64) -> StateMatrix {
         match self.mode {
             StepMode::Nominal => transition((k_to - self.k) as f64 * self.model.dt_s),
             StepMode::PerStep => transition(t_to_s - self.t_s),
@@ -141,9 +144,9 @@ impl<'m> Forward<'m> {
             StepMode::PerStep => (transition(self.t_s - t0), self.x),
         };
         let cov = self.model.update_covariance(&self.p, self.t_s, phi)?;
-        let z = Vector2::new(fix.position_m, fix.velocity_m_s);
+        let z = measurement(fix.position_m, fix.velocity_m_s);
         // eq. (6): δz = z − (p_c, v_c).
-        let dz = Vector2::new(
+        let dz = measurement(
             z[ErrorState::GPS_POSITION] - self.pc_m,
             z[ErrorState::GPS_VELOCITY] - self.vc_m_s,
         );
@@ -156,7 +159,7 @@ impl<'m> Forward<'m> {
             sample: self.k,
             t_s: self.t_s,
             z,
-            integrated: Vector2::new(self.pc_m, self.vc_m_s),
+            integrated: measurement(self.pc_m, self.vc_m_s),
             prior,
             post,
             residual,

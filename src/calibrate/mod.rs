@@ -27,11 +27,11 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::error::FilterError;
-use crate::filter::{ErrorStateModel, Matrix3, Vector3};
+use crate::filter::ErrorStateModel;
 use crate::logs::read::{AccelReader, LogSource};
 use crate::logs::{LogError, LogProblem};
 use crate::model::{Model, NoiseStats};
-use crate::state::ErrorState;
+use crate::state::{ErrorState, StateMatrix, StateVector};
 use forward::FilteredFix;
 pub use nis::{NisTest, nis_test};
 pub use scan::NOMINAL_TOLERANCE;
@@ -120,7 +120,7 @@ pub struct Prepared<'a> {
     fixes: Vec<FilteredFix>,
     smoothed: Vec<SmoothedFix>,
     /// Filtered estimate and covariance at the last sample.
-    end: (Vector3, Matrix3),
+    end: (StateVector, StateMatrix),
 }
 
 /// One sample of the forward pass as a visitor sees it.
@@ -145,7 +145,7 @@ pub fn prepare<'a>(
         fixes: Vec::new(),
         scan,
         smoothed: Vec::new(),
-        end: (Vector3::zeros(), Matrix3::zeros()),
+        end: (StateVector::zeros(), StateMatrix::zeros()),
     };
     let mut fixes = Vec::with_capacity(prepared.scan.gps.len());
     let mut end = prepared.end;
@@ -256,10 +256,12 @@ impl Prepared<'_> {
         let f = &s.filter_stats;
         let sc = &self.scan;
         let start_smoothed = match (self.fixes.first(), self.smoothed.first()) {
-            (Some(fix), Some(sm)) => {
-                sm.smooth(&Vector3::zeros(), &self.model.p0, &fix.phi_from_previous)
-            }
-            _ => (Vector3::zeros(), self.model.p0),
+            (Some(fix), Some(sm)) => sm.smooth(
+                &StateVector::zeros(),
+                &self.model.p0,
+                &fix.phi_from_previous,
+            ),
+            _ => (StateVector::zeros(), self.model.p0),
         };
         let nis: Vec<f64> = self.fixes.iter().map(|f| f.nis).collect();
         let (lo, hi) = sc.accepted_step_s();
@@ -267,8 +269,8 @@ impl Prepared<'_> {
             accelcal_version: env!("CARGO_PKG_VERSION"),
             accelerometer_log: self.accel.name().to_string(),
             gps_log: sc.gps_name.clone(),
-            bias_m_s2: x_end[2],
-            bias_sigma_m_s2: p_end[(2, 2)].sqrt(),
+            bias_m_s2: x_end[ErrorState::BIAS],
+            bias_sigma_m_s2: p_end[(ErrorState::BIAS, ErrorState::BIAS)].sqrt(),
             samples: sc.samples,
             fixes: self.fixes.len(),
             start_s: sc.span_s.0,
@@ -308,7 +310,7 @@ impl Prepared<'_> {
                 smoothed: sm.x.into(),
                 smoothed_sigma: sigma(&sm.p),
                 residual: f.residual.into(),
-                residual_sigma: [f.s[(0, 0)].sqrt(), f.s[(1, 1)].sqrt()],
+                residual_sigma: std::array::from_fn(|k| f.s[(k, k)].sqrt()),
                 nis: f.nis,
             })
             .collect();

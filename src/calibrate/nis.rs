@@ -2,10 +2,11 @@
 
 use serde::Serialize;
 
+use crate::state::ErrorState;
 use crate::stats::chi_squared_band;
 
-/// Measurement dimension: each fix measures position and velocity.
-const MEASUREMENT_DIM: u64 = 2;
+/// Measurement dimension M: each fix measures position and velocity.
+const MEASUREMENT_DIM: u64 = ErrorState::MEAS as u64;
 
 /// The NIS test of a whole log.
 ///

@@ -21,7 +21,7 @@
 //! last fix no measurement follows and the smoothed estimate is the filtered one. So the backward
 //! pass keeps O(fixes) and every sample's smoothed value costs a few 3×3 products.
 
-use crate::filter::{Matrix3, Vector3};
+use crate::state::{StateMatrix, StateVector};
 
 use super::forward::FilteredFix;
 
@@ -29,21 +29,21 @@ use super::forward::FilteredFix;
 #[derive(Clone, Debug, PartialEq)]
 pub struct SmoothedFix {
     /// Smoothed estimate x̂^s at the fix.
-    pub x: Vector3,
+    pub x: StateVector,
     /// Its covariance P^s.
-    pub p: Matrix3,
+    pub p: StateMatrix,
     /// λ = (P⁻)⁻¹ (x̂^s − x̂⁻).
-    lambda: Vector3,
+    lambda: StateVector,
     /// Λ = (P⁻)⁻¹ (P^s − P⁻) (P⁻)⁻¹.
-    big_lambda: Matrix3,
+    big_lambda: StateMatrix,
 }
 
-fn symmetric(m: Matrix3) -> Matrix3 {
+fn symmetric(m: StateMatrix) -> StateMatrix {
     (m + m.transpose()) * 0.5
 }
 
 impl SmoothedFix {
-    fn new(f: &FilteredFix, x: Vector3, p: Matrix3) -> Self {
+    fn new(f: &FilteredFix, x: StateVector, p: StateMatrix) -> Self {
         let inv = &f.p_prior_inv;
         Self {
             lambda: inv * (x - f.prior),
@@ -55,7 +55,12 @@ impl SmoothedFix {
 
     /// The smoothed estimate and covariance at a sample whose filtered ones are `x`, `p`, with
     /// this fix the next one after it and `phi` the transition from the sample to this fix.
-    pub fn smooth(&self, x: &Vector3, p: &Matrix3, phi: &Matrix3) -> (Vector3, Matrix3) {
+    pub fn smooth(
+        &self,
+        x: &StateVector,
+        p: &StateMatrix,
+        phi: &StateMatrix,
+    ) -> (StateVector, StateMatrix) {
         let g = p * phi.transpose();
         (
             x + g * self.lambda,

@@ -3,11 +3,14 @@
 
 use serde::Serialize;
 
-use crate::filter::{Matrix3, Vector3};
 use crate::logs::write::push_row;
+use crate::state::{ErrorState, StateMatrix, StateVector};
 
 use super::StepMode;
 use super::nis::NisTest;
+
+// The columns and records below name the three states of the error state one by one.
+const _: () = assert!(ErrorState::DIM == 3);
 
 /// Columns of `estimates.csv`: one row per accelerometer sample. Filtered values are a
 /// posteriori at a fix; corrected position and velocity are the integration plus the estimated
@@ -36,7 +39,7 @@ pub const ESTIMATES_COLUMNS: [&str; 20] = [
 ];
 
 /// σ = √diag P.
-pub fn sigma(p: &Matrix3) -> [f64; 3] {
+pub fn sigma(p: &StateMatrix) -> [f64; ErrorState::DIM] {
     std::array::from_fn(|k| p[(k, k)].sqrt())
 }
 
@@ -45,18 +48,22 @@ pub fn sigma(p: &Matrix3) -> [f64; 3] {
 pub(super) struct EstimateRow<'a> {
     pub t_s: f64,
     pub fix: bool,
-    pub integrated: [f64; 2],
-    pub filtered: (&'a Vector3, &'a Matrix3),
-    pub smoothed: (&'a Vector3, &'a Matrix3),
+    pub integrated: [f64; ErrorState::MEAS],
+    pub filtered: (&'a StateVector, &'a StateMatrix),
+    pub smoothed: (&'a StateVector, &'a StateMatrix),
 }
 
 impl EstimateRow<'_> {
     /// Appends the row in the order of [`ESTIMATES_COLUMNS`].
     pub fn push(&self, out: &mut String) {
-        let [pc, vc] = self.integrated;
+        let (pc, vc) = (
+            self.integrated[ErrorState::GPS_POSITION],
+            self.integrated[ErrorState::GPS_VELOCITY],
+        );
         let (x, p) = self.filtered;
         let (xs, ps) = self.smoothed;
         let (sf, ss) = (sigma(p), sigma(ps));
+        let (dp, dv, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
         push_row(
             out,
             &[
@@ -64,22 +71,22 @@ impl EstimateRow<'_> {
                 if self.fix { 1.0 } else { 0.0 },
                 pc,
                 vc,
-                x[0],
-                x[1],
-                x[2],
-                sf[0],
-                sf[1],
-                sf[2],
-                xs[0],
-                xs[1],
-                xs[2],
-                ss[0],
-                ss[1],
-                ss[2],
-                pc + x[0],
-                vc + x[1],
-                pc + xs[0],
-                vc + xs[1],
+                x[dp],
+                x[dv],
+                x[b],
+                sf[dp],
+                sf[dv],
+                sf[b],
+                xs[dp],
+                xs[dv],
+                xs[b],
+                ss[dp],
+                ss[dv],
+                ss[b],
+                pc + x[dp],
+                vc + x[dv],
+                pc + xs[dp],
+                vc + xs[dv],
             ],
         );
     }
@@ -104,15 +111,16 @@ pub struct StateRecord {
 
 impl StateRecord {
     /// The record of estimate `x` with covariance `p`.
-    pub fn new(x: &Vector3, p: &Matrix3) -> Self {
+    pub fn new(x: &StateVector, p: &StateMatrix) -> Self {
         let s = sigma(p);
+        let (dp, dv, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
         Self {
-            dp_m: x[0],
-            dv_m_s: x[1],
-            bias_m_s2: x[2],
-            sigma_dp_m: s[0],
-            sigma_dv_m_s: s[1],
-            sigma_bias_m_s2: s[2],
+            dp_m: x[dp],
+            dv_m_s: x[dv],
+            bias_m_s2: x[b],
+            sigma_dp_m: s[dp],
+            sigma_dv_m_s: s[dv],
+            sigma_bias_m_s2: s[b],
         }
     }
 }
@@ -192,21 +200,21 @@ pub struct FixReport {
     /// Time of the fix's sample, s.
     pub t_s: f64,
     /// The fix (z_p, z_v), (m, m/s).
-    pub z: [f64; 2],
+    pub z: [f64; ErrorState::MEAS],
     /// Integrated accelerometer (p_c, v_c), (m, m/s).
-    pub integrated: [f64; 2],
+    pub integrated: [f64; ErrorState::MEAS],
     /// A posteriori estimate.
-    pub filtered: [f64; 3],
+    pub filtered: [f64; ErrorState::DIM],
     /// Its σ.
-    pub filtered_sigma: [f64; 3],
+    pub filtered_sigma: [f64; ErrorState::DIM],
     /// Smoothed estimate.
-    pub smoothed: [f64; 3],
+    pub smoothed: [f64; ErrorState::DIM],
     /// Its σ.
-    pub smoothed_sigma: [f64; 3],
+    pub smoothed_sigma: [f64; ErrorState::DIM],
     /// Residual r = δz − H·δx̂⁻, (m, m/s).
-    pub residual: [f64; 2],
+    pub residual: [f64; ErrorState::MEAS],
     /// √diag S: the residual's predicted σ, (m, m/s).
-    pub residual_sigma: [f64; 2],
+    pub residual_sigma: [f64; ErrorState::MEAS],
     /// rᵀ S⁻¹ r.
     pub nis: f64,
 }

@@ -10,7 +10,11 @@ use crate::config::{AccelerometerOutput, Config, TruthModel};
 use crate::ensemble::FixStats;
 use crate::filter::FilterSchedule;
 use crate::realization::Realization;
-use crate::study::{CaseOutcome, Study};
+use crate::state::ErrorState;
+use crate::study::{CaseOutcome, StagedState, Study};
+
+// `FinalSigma` and the columns of `realization_csv` name the three states one by one.
+const _: () = assert!(ErrorState::DIM == 3);
 
 /// A value per state at the last fix: the filter's a posteriori σ, or the achieved RMS error.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -23,12 +27,12 @@ pub struct FinalSigma {
     pub bias_m_s2: f64,
 }
 
-impl From<[f64; 3]> for FinalSigma {
-    fn from(x: [f64; 3]) -> Self {
+impl From<[f64; ErrorState::DIM]> for FinalSigma {
+    fn from(x: [f64; ErrorState::DIM]) -> Self {
         Self {
-            position_m: x[0],
-            velocity_m_s: x[1],
-            bias_m_s2: x[2],
+            position_m: x[ErrorState::POSITION],
+            velocity_m_s: x[ErrorState::VELOCITY],
+            bias_m_s2: x[ErrorState::BIAS],
         }
     }
 }
@@ -172,9 +176,9 @@ pub struct EnsembleDoc<'a> {
     /// The ensemble statistics at every fix.
     pub fixes: &'a [FixStats],
     /// The predicted mean error at every fix, [a priori, a posteriori].
-    pub predicted_mean_error: &'a [[[f64; 3]; 2]],
+    pub predicted_mean_error: &'a [StagedState],
     /// The achieved RMS a posteriori error at every fix.
-    pub achieved_rms: &'a [[f64; 3]],
+    pub achieved_rms: &'a [[f64; ErrorState::DIM]],
 }
 
 /// Worst normalized residual correlation at one lag.
@@ -203,8 +207,10 @@ pub fn ensemble_doc<'a>(
             let max_abs_z = (lag..n)
                 .flat_map(|i| {
                     let m = i - lag;
-                    (0..4).map(move |c| {
-                        crate::checks::residual_z(stats, 2 * i + c / 2, 2 * m + c % 2).abs()
+                    // Residual component c of fix i is row M·i + c of the residual layout.
+                    const M: usize = ErrorState::MEAS;
+                    (0..M * M).map(move |c| {
+                        crate::checks::residual_z(stats, M * i + c / M, M * m + c % M).abs()
                     })
                 })
                 .fold(0.0, f64::max);
@@ -276,6 +282,7 @@ pub fn realization_csv(r: &Realization, fix_times_s: &[f64]) -> String {
          dp_true_m,dv_true_m_s,bias_true_m_s2,dp_est_m,dv_est_m_s,bias_est_m_s2,\
          sigma_p_m,sigma_v_m_s,sigma_b_m_s2,cov_pv_m2_s,cov_pb_m2_s2,cov_vb_m2_s3,gps_fix\n",
     );
+    let (dp, dv, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
     let mut next_fix = fix_times_s.iter().peekable();
     for s in &r.samples {
         let fix = match next_fix.peek() {
@@ -292,18 +299,18 @@ pub fn realization_csv(r: &Realization, fix_times_s: &[f64]) -> String {
             s.truth_v_m_s,
             s.computed_p_m,
             s.computed_v_m_s,
-            s.delta_x[0],
-            s.delta_x[1],
-            s.delta_x[2],
-            s.estimate[0],
-            s.estimate[1],
-            s.estimate[2],
-            s.sigma[0],
-            s.sigma[1],
-            s.sigma[2],
-            s.cov[0][1],
-            s.cov[0][2],
-            s.cov[1][2],
+            s.delta_x[dp],
+            s.delta_x[dv],
+            s.delta_x[b],
+            s.estimate[dp],
+            s.estimate[dv],
+            s.estimate[b],
+            s.sigma[dp],
+            s.sigma[dv],
+            s.sigma[b],
+            s.cov[dp][dv],
+            s.cov[dp][b],
+            s.cov[dv][b],
         ];
         for x in v {
             out.push_str(&format!("{x:.12e},"));

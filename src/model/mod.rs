@@ -29,6 +29,9 @@ pub const SUM_FLOATS_PER_STAGE: usize = {
     let n = ErrorState::DIM;
     n + n * n + n * n + n + n + 1
 };
+/// Components of one GPS residual (position, velocity): the residual products per pair of fixes
+/// are its square.
+pub const RESIDUAL_WIDTH: usize = ErrorState::MEAS;
 /// Runs with at most this many fixes test the residual whiteness of every pair of fixes by
 /// default; longer runs test lags up to [`DEFAULT_MAX_LAG`] (every pair costs O(fixes²)).
 pub const ALL_PAIRS_MAX_FIXES: usize = 1_000;

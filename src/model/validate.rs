@@ -3,7 +3,7 @@
 
 use super::{
     ALL_PAIRS_MAX_FIXES, DEFAULT_MAX_LAG, FILTER_FLOOR, MAX_FIXES, MAX_REALIZATIONS, MAX_STEPS,
-    MAX_SUMS_BYTES, SUM_FLOATS_PER_FIX, WHOLE_TOL,
+    MAX_SUMS_BYTES, RESIDUAL_WIDTH, SUM_FLOATS_PER_FIX, WHOLE_TOL,
 };
 use crate::config::Config;
 use crate::error::ConfigError;
@@ -57,6 +57,50 @@ fn non_negative(field: &'static str, x: f64, hi: f64) -> Result<(), ConfigError>
 
 /// Checks every field against its accepted range, in file order.
 pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
+    let grid = validate_grid(c)?;
+    validate_initial(c)?;
+    validate_filter(c)?;
+    let e = &c.ensemble;
+    if !(2..=MAX_REALIZATIONS).contains(&e.realizations) {
+        return Err(ConfigError::invalid(
+            "ensemble.realizations",
+            e.realizations,
+            format!("must be a whole number in [2, {MAX_REALIZATIONS}]"),
+        ));
+    }
+    c.sensitivity.check([
+        "sensitivity.factors",
+        "sensitivity.ensembles",
+        "sensitivity.draws",
+    ])?;
+    let k = &c.checks;
+    finite_in(
+        "checks.false_alarm_rate",
+        k.false_alarm_rate,
+        0.0,
+        0.5,
+        true,
+    )?;
+    if k.residual_max_lag == Some(0) {
+        return Err(ConfigError::invalid(
+            "checks.residual_max_lag",
+            0,
+            "must be a whole number of fixes ≥ 1 (or left out)",
+        ));
+    }
+    validate_sums_memory(c, grid.fixes)?;
+    validate_residual_pair(c, &grid)
+}
+
+/// The time grid a valid configuration has: accelerometer samples, samples per fix, fixes.
+struct Grid {
+    steps: u64,
+    per_fix: u64,
+    fixes: u64,
+}
+
+/// The profile, the accelerometer and the GPS, and the time grid they make.
+fn validate_grid(c: &Config) -> Result<Grid, ConfigError> {
     let p = &c.profile;
     non_negative("profile.accel_amplitude_m_s2", p.accel_amplitude_m_s2, 1e4)?;
     finite_in(
@@ -72,24 +116,23 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
     positive("accelerometer.sample_rate_hz", a.sample_rate_hz, 1e6)?;
     non_negative("accelerometer.noise_var_m2_s4", a.noise_var_m2_s4, 1e6)?;
     non_negative("accelerometer.bias_var_m2_s4", a.bias_var_m2_s4, 1e6)?;
-    match whole(p.duration_s * a.sample_rate_hz) {
-        Some(n) if n >= 1 && n as usize <= MAX_STEPS => {}
-        _ => {
-            return Err(ConfigError::invalid(
-                "profile.duration_s",
-                p.duration_s,
-                format!(
-                    "duration_s × accelerometer.sample_rate_hz ({} Hz) must be a whole number of \
-                     samples in [1, {MAX_STEPS}]",
-                    a.sample_rate_hz
-                ),
-            ));
-        }
-    }
+    let Some(steps) =
+        whole(p.duration_s * a.sample_rate_hz).filter(|&n| n >= 1 && n as usize <= MAX_STEPS)
+    else {
+        return Err(ConfigError::invalid(
+            "profile.duration_s",
+            p.duration_s,
+            format!(
+                "duration_s × accelerometer.sample_rate_hz ({} Hz) must be a whole number of \
+                 samples in [1, {MAX_STEPS}]",
+                a.sample_rate_hz
+            ),
+        ));
+    };
 
     let g = &c.gps;
     positive("gps.sample_rate_hz", g.sample_rate_hz, a.sample_rate_hz)?;
-    if whole(a.sample_rate_hz / g.sample_rate_hz).is_none() {
+    let Some(per_fix) = whole(a.sample_rate_hz / g.sample_rate_hz) else {
         return Err(ConfigError::invalid(
             "gps.sample_rate_hz",
             g.sample_rate_hz,
@@ -99,11 +142,9 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
                 a.sample_rate_hz
             ),
         ));
-    }
+    };
     positive("gps.position_sigma_m", g.position_sigma_m, 1e6)?;
     positive("gps.velocity_sigma_m_s", g.velocity_sigma_m_s, 1e6)?;
-    let steps = whole(p.duration_s * a.sample_rate_hz).expect("checked above");
-    let per_fix = whole(a.sample_rate_hz / g.sample_rate_hz).expect("checked above");
     let fixes = steps / per_fix + u64::from(g.fix_at_start);
     if !(2..=MAX_FIXES as u64).contains(&fixes) {
         return Err(ConfigError::invalid(
@@ -116,7 +157,15 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
             ),
         ));
     }
+    Ok(Grid {
+        steps,
+        per_fix,
+        fixes,
+    })
+}
 
+/// The prior of the initial position and velocity.
+fn validate_initial(c: &Config) -> Result<(), ConfigError> {
     let i = &c.initial;
     finite_in(
         "initial.position_mean_m",
@@ -133,9 +182,11 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
         1e6,
         false,
     )?;
-    non_negative("initial.velocity_sigma_m_s", i.velocity_sigma_m_s, 1e6)?;
+    non_negative("initial.velocity_sigma_m_s", i.velocity_sigma_m_s, 1e6)
+}
 
-    // The filter's statistics must keep its covariance positive definite: all strictly positive.
+/// The filter's statistics must keep its covariance positive definite: all strictly positive.
+fn validate_filter(c: &Config) -> Result<(), ConfigError> {
     let f = &c.filter;
     let filter_fields: [(&'static str, Option<f64>); 6] = [
         ("filter.accel_noise_var_m2_s4", f.accel_noise_var_m2_s4),
@@ -181,58 +232,33 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
             ));
         }
     }
+    Ok(())
+}
 
-    let e = &c.ensemble;
-    if !(2..=MAX_REALIZATIONS).contains(&e.realizations) {
-        return Err(ConfigError::invalid(
-            "ensemble.realizations",
-            e.realizations,
-            format!("must be a whole number in [2, {MAX_REALIZATIONS}]"),
-        ));
-    }
-
-    c.sensitivity.check([
-        "sensitivity.factors",
-        "sensitivity.ensembles",
-        "sensitivity.draws",
-    ])?;
-
-    let k = &c.checks;
-    finite_in(
-        "checks.false_alarm_rate",
-        k.false_alarm_rate,
-        0.0,
-        0.5,
-        true,
-    )?;
-    if k.residual_max_lag == Some(0) {
-        return Err(ConfigError::invalid(
-            "checks.residual_max_lag",
-            0,
-            "must be a whole number of fixes ≥ 1 (or left out)",
-        ));
-    }
-    // The running sums of one block of realizations must fit the memory budget: the per-fix sums
-    // and the kept residual products (every pair, or a band of lags).
+/// The running sums of one block of realizations must fit the memory budget: the fix-level sums
+/// ([`SUM_FLOATS_PER_FIX`] per fix) and the kept residual products (every pair, or a band of
+/// lags).
+fn validate_sums_memory(c: &Config, fixes: u64) -> Result<(), ConfigError> {
+    let (k, g) = (&c.checks, &c.gps);
     let f = fixes as f64;
-    let sum_floats = SUM_FLOATS_PER_FIX as f64;
     let lag = match k.residual_max_lag {
         Some(l) => Some(f64::from(l)),
         None if fixes as usize <= ALL_PAIRS_MAX_FIXES => None,
         None => Some(DEFAULT_MAX_LAG as f64),
     };
-    // The stacked residuals have 2·fixes components: a band keeps at most 2·(lag + 1) of each
-    // row, every pair keeps the whole lower triangle (see `ensemble::ResidualLayout`).
+    // The residual stacks M components per fix: M·f rows, of which a band of lags up to l keeps
+    // M·(l + 1) columns each, every pair the M·f·(M·f + 1)/2 of the lower triangle.
+    let m = RESIDUAL_WIDTH as f64;
+    let per_fix = SUM_FLOATS_PER_FIX as f64;
     let products = match lag {
-        Some(l) if l + 1.0 < f => 2.0 * f * (2.0 * l + 2.0),
-        _ => f * (2.0 * f + 1.0),
+        Some(l) if l + 1.0 < f => m * f * (m * l + m),
+        _ => m * f * (m * f + 1.0) / 2.0,
     };
     let float_bytes = std::mem::size_of::<f64>() as f64;
-    let bytes = float_bytes * (sum_floats * f + products);
+    let bytes = float_bytes * (per_fix * f + products);
     if bytes > MAX_SUMS_BYTES as f64 {
-        let budget = MAX_SUMS_BYTES as f64 / float_bytes - sum_floats * f;
-        // The largest lag whose band fits: 2·f·(2·lag + 2) ≤ budget.
-        let most = ((budget / (2.0 * f) - 2.0) / 2.0).floor();
+        let budget = MAX_SUMS_BYTES as f64 / float_bytes - per_fix * f;
+        let most = ((budget / (m * f) - m) / m).floor();
         let mib = |b: f64| format!("{:.0} MiB", b / 1048576.0);
         return Err(match k.residual_max_lag {
             Some(l) if most >= 1.0 => ConfigError::invalid(
@@ -258,7 +284,14 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
             ),
         });
     }
-    let Some([tm, ti]) = k.residual_pair_s else {
+    Ok(())
+}
+
+/// The single residual pair, when configured: two fix times of the run, in order.
+fn validate_residual_pair(c: &Config, grid: &Grid) -> Result<(), ConfigError> {
+    let (a, g) = (&c.accelerometer, &c.gps);
+    let (steps, per_fix) = (grid.steps, grid.per_fix);
+    let Some([tm, ti]) = c.checks.residual_pair_s else {
         return Ok(());
     };
     let period = per_fix as f64 / a.sample_rate_hz;

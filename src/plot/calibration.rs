@@ -9,12 +9,22 @@ use super::axis::{Axis, y_label_area};
 use super::geometry::{Point, extent, padded, settled_from, time_span};
 use super::legend::{Entry, Swatch, render_under_legend};
 use super::panel::{Area, Layout, Panel, columns};
-use super::{BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotError, PlotResult, VERMILLION, WIDTH_PX};
+use super::{
+    BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotError, PlotResult, VERMILLION, WIDTH_PX, state_name,
+    state_unit,
+};
 use crate::calibrate::NisTest;
 use crate::calibrate::summary::FixReport;
+use crate::state::{ErrorState, Variable};
 
 /// Height of one row, px.
 const ROW_PX: u32 = 260;
+/// The bias's index in the state.
+const B: usize = ErrorState::BIAS;
+/// Measured components M.
+const M: usize = ErrorState::MEAS;
+/// The measurement's components.
+const MEASURED: [Variable; M] = ErrorState::MEASURED;
 /// Up to this many fixes are drawn as markers; more as a line through them.
 const MAX_MARKERS: usize = 600;
 
@@ -25,6 +35,13 @@ fn markers(panel: &Panel<'_>, points: Vec<Point>, style: ShapeStyle) -> Result<(
     } else {
         panel.line(points, style.stroke_width(1))
     }
+}
+
+/// Heights of `n` stacked rows: the last also holds the time axis.
+fn rows_px(n: usize) -> Vec<u32> {
+    (0..n)
+        .map(|row| ROW_PX + if row + 1 == n { 30 } else { 0 })
+        .collect()
 }
 
 /// A linear axis fitted to `values`, padded.
@@ -42,21 +59,21 @@ pub fn calibration_bias(fixes: &[FixReport]) -> PlotResult {
     let time = Axis::linear("time", "s", (t0, t1), 8);
     let late = || fixes.iter().filter(|f| f.t_s >= settle);
     let bias_axis = fitted(
-        "bias",
-        "m/s²",
+        state_name(B),
+        state_unit(B),
         late().flat_map(|f| {
-            let (b, s) = (f.filtered[2], f.filtered_sigma[2]);
-            let (bs, ss) = (f.smoothed[2], f.smoothed_sigma[2]);
+            let (b, s) = (f.filtered[B], f.filtered_sigma[B]);
+            let (bs, ss) = (f.smoothed[B], f.smoothed_sigma[B]);
             [b - s, b + s, bs - ss, bs + ss]
         }),
         6,
     );
     let sigmas = fixes
         .iter()
-        .flat_map(|f| [f.filtered_sigma[2], f.smoothed_sigma[2]]);
+        .flat_map(|f| [f.filtered_sigma[B], f.smoothed_sigma[B]]);
     let sigma_axis = Axis::log10(
         "σ of the bias",
-        "m/s²",
+        state_unit(B),
         extent(sigmas.filter(|s| *s > 0.0)).unwrap_or((1e-4, 1e-1)),
     );
     let y_area_px = y_label_area(&[&bias_axis, &sigma_axis]);
@@ -100,8 +117,8 @@ fn draw_bias(
             })
             .collect()
     };
-    let filtered = |f: &FixReport| (f.filtered[2], f.filtered_sigma[2]);
-    let smoothed = |f: &FixReport| (f.smoothed[2], f.smoothed_sigma[2]);
+    let filtered = |f: &FixReport| (f.filtered[B], f.filtered_sigma[B]);
+    let smoothed = |f: &FixReport| (f.smoothed[B], f.smoothed_sigma[B]);
     p.band(
         &t,
         &band(&filtered, -1.0),
@@ -115,11 +132,11 @@ fn draw_bias(
         BLUE.mix(0.2),
     )?;
     p.line(
-        fixes.iter().map(|f| (f.t_s, f.filtered[2])),
+        fixes.iter().map(|f| (f.t_s, f.filtered[B])),
         VERMILLION.stroke_width(2),
     )?;
     p.line(
-        fixes.iter().map(|f| (f.t_s, f.smoothed[2])),
+        fixes.iter().map(|f| (f.t_s, f.smoothed[B])),
         BLUE.stroke_width(2),
     )?;
     let q = Panel::new(
@@ -130,11 +147,11 @@ fn draw_bias(
         Layout::titled(y_area_px, true),
     )?;
     q.line(
-        fixes.iter().map(|f| (f.t_s, f.filtered_sigma[2])),
+        fixes.iter().map(|f| (f.t_s, f.filtered_sigma[B])),
         VERMILLION.stroke_width(2),
     )?;
     q.line(
-        fixes.iter().map(|f| (f.t_s, f.smoothed_sigma[2])),
+        fixes.iter().map(|f| (f.t_s, f.smoothed_sigma[B])),
         BLUE.stroke_width(2),
     )?;
     Ok(())
@@ -148,26 +165,28 @@ pub fn calibration_trajectory(fixes: &[FixReport]) -> PlotResult {
     let time = Axis::linear("time", "s", (t0, t1), 6);
     let left: Vec<Axis> = TRAJECTORY_ROWS
         .iter()
-        .map(|&(k, name, unit)| {
+        .map(|&r| {
+            let m = r.gps;
             fitted(
-                name,
-                unit,
+                r.name(),
+                r.unit(),
                 fixes
                     .iter()
-                    .flat_map(|f| [f.z[k], f.integrated[k], corrected(f, k)]),
+                    .flat_map(|f| [f.z[m], f.integrated[m], corrected(f, r)]),
                 6,
             )
         })
         .collect();
     let right: Vec<Axis> = TRAJECTORY_ROWS
         .iter()
-        .map(|&(k, name, unit)| {
+        .map(|&r| {
+            let (m, k) = (r.gps, r.state);
             fitted(
-                &format!("{name} drift"),
-                unit,
+                &format!("{} drift", r.name()),
+                r.unit(),
                 fixes.iter().flat_map(|f| {
                     let (x, s) = (f.smoothed[k], f.smoothed_sigma[k]);
-                    [f.z[k] - f.integrated[k], x - s, x + s]
+                    [f.z[m] - f.integrated[m], x - s, x + s]
                 }),
                 6,
             )
@@ -186,7 +205,7 @@ pub fn calibration_trajectory(fixes: &[FixReport]) -> PlotResult {
         Entry::new(Swatch::Line(BLUE.stroke_width(2)), "corrected (smoothed)"),
         Entry::new(Swatch::Block(BLUE.mix(0.2).filled()), "smoothed ±1σ"),
     ];
-    render_under_legend(&legend, &[ROW_PX, ROW_PX + 30], 0, |parts| {
+    render_under_legend(&legend, &rows_px(TRAJECTORY_ROWS.len()), 0, |parts| {
         for (row, area) in parts.iter().enumerate() {
             let axes = [left[row].clone(), right[row].clone()];
             draw_trajectory_row(area, fixes, row, (&time, axes), y_areas_px)?;
@@ -195,12 +214,42 @@ pub fn calibration_trajectory(fixes: &[FixReport]) -> PlotResult {
     })
 }
 
-/// The rows of [`calibration_trajectory`]: the state component, its name and unit.
-const TRAJECTORY_ROWS: [(usize, &str, &str); 2] = [(1, "velocity", "m/s"), (0, "position", "m")];
+/// The rows of [`calibration_trajectory`]: the GPS component (of z and of the integration) and
+/// the error-state component that corrects it.
+const TRAJECTORY_ROWS: [Row; 2] = [
+    Row {
+        gps: ErrorState::GPS_VELOCITY,
+        state: ErrorState::VELOCITY,
+    },
+    Row {
+        gps: ErrorState::GPS_POSITION,
+        state: ErrorState::POSITION,
+    },
+];
 
-/// Component `k` of the corrected (smoothed) trajectory at a fix.
-fn corrected(f: &FixReport, k: usize) -> f64 {
-    f.integrated[k] + f.smoothed[k]
+/// A measured component and the state that corrects it.
+#[derive(Clone, Copy)]
+struct Row {
+    gps: usize,
+    state: usize,
+}
+
+impl Row {
+    /// The quantity's name (`velocity`), from the state's variable.
+    fn name(self) -> &'static str {
+        state_name(self.state)
+    }
+
+    /// Its unit.
+    fn unit(self) -> &'static str {
+        state_unit(self.state)
+    }
+}
+
+/// The corrected (smoothed) trajectory of row `r` at a fix: the integration plus the smoothed
+/// error.
+fn corrected(f: &FixReport, r: Row) -> f64 {
+    f.integrated[r.gps] + f.smoothed[r.state]
 }
 
 /// Row `row` of [`calibration_trajectory`] on `area`: left, the GPS fix, the integration and the
@@ -212,7 +261,8 @@ fn draw_trajectory_row(
     (time, [left, right]): (&Axis, [Axis; 2]),
     [left_px, right_px]: [u32; 2],
 ) -> Result<(), PlotError> {
-    let (k, name, _) = TRAJECTORY_ROWS[row];
+    let r = TRAJECTORY_ROWS[row];
+    let (m, k, name) = (r.gps, r.state, r.name());
     let last = row == TRAJECTORY_ROWS.len() - 1;
     let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
     let cols = columns(area, &[WIDTH_PX / 2]);
@@ -224,16 +274,16 @@ fn draw_trajectory_row(
         Layout::titled(left_px, last),
     )?;
     p.line(
-        fixes.iter().map(|f| (f.t_s, f.integrated[k])),
+        fixes.iter().map(|f| (f.t_s, f.integrated[m])),
         ORANGE.stroke_width(2),
     )?;
     p.line(
-        fixes.iter().map(|f| (f.t_s, corrected(f, k))),
+        fixes.iter().map(|f| (f.t_s, corrected(f, r))),
         BLUE.stroke_width(2),
     )?;
     markers(
         &p,
-        fixes.iter().map(|f| (f.t_s, f.z[k])).collect(),
+        fixes.iter().map(|f| (f.t_s, f.z[m])).collect(),
         BLACK.filled(),
     )?;
     let q = Panel::new(
@@ -256,7 +306,7 @@ fn draw_trajectory_row(
         &q,
         fixes
             .iter()
-            .map(|f| (f.t_s, f.z[k] - f.integrated[k]))
+            .map(|f| (f.t_s, f.z[m] - f.integrated[m]))
             .collect(),
         BLACK.filled(),
     )?;
@@ -274,13 +324,12 @@ pub fn calibration_residuals(fixes: &[FixReport]) -> PlotResult {
     let (t0, t1) = time_span(fixes.iter().map(|f| f.t_s));
     let settle = settled_from(t0, t1);
     let time = Axis::linear("time", "s", (t0, t1), 8);
-    let names = [("position residual", "m"), ("velocity residual", "m/s")];
-    let axes: Vec<Axis> = (0..2)
+    let names: [String; M] = std::array::from_fn(|k| format!("{} residual", MEASURED[k].key));
+    let axes: Vec<Axis> = (0..M)
         .map(|k| {
-            let (name, unit) = names[k];
             fitted(
-                name,
-                unit,
+                &names[k],
+                MEASURED[k].unit,
                 fixes.iter().filter(|f| f.t_s >= settle).flat_map(|f| {
                     let s = f.residual_sigma[k];
                     [f.residual[k], -2.0 * s, 2.0 * s]
@@ -295,15 +344,15 @@ pub fn calibration_residuals(fixes: &[FixReport]) -> PlotResult {
         Entry::new(Swatch::Block(ORANGE.mix(0.35).filled()), "±√S (1σ)"),
         Entry::new(Swatch::Block(ORANGE.mix(0.15).filled()), "±2√S"),
     ];
-    render_under_legend(&legend, &[ROW_PX, ROW_PX + 30], 0, |parts| {
+    render_under_legend(&legend, &rows_px(M), 0, |parts| {
         let t: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
-        for k in 0..2 {
+        for k in 0..M {
             let p = Panel::new(
                 &parts[k],
-                &format!("{} at each fix", super::capitalized(names[k].0)),
+                &format!("{} at each fix", super::capitalized(&names[k])),
                 time.clone(),
                 axes[k].clone(),
-                Layout::titled(y_area_px, k == 1),
+                Layout::titled(y_area_px, k + 1 == M),
             )?;
             let s: Vec<f64> = fixes.iter().map(|f| f.residual_sigma[k]).collect();
             let scaled = |c: f64| s.iter().map(|v| c * v).collect::<Vec<_>>();
@@ -320,7 +369,7 @@ pub fn calibration_residuals(fixes: &[FixReport]) -> PlotResult {
     })
 }
 
-/// The NIS rᵀS⁻¹r of every fix on a log axis, against its expected value 2 and the per-fix χ²(2)
+/// The NIS rᵀS⁻¹r of every fix on a log axis, against its expected value M and the per-fix χ²(M)
 /// band of `test`; the title gives the test of the whole sequence.
 pub fn calibration_nis(fixes: &[FixReport], test: &NisTest) -> PlotResult {
     let (t0, t1) = time_span(fixes.iter().map(|f| f.t_s));
@@ -336,9 +385,12 @@ pub fn calibration_nis(fixes: &[FixReport], test: &NisTest) -> PlotResult {
         Entry::new(Swatch::Marker(BLUISH_GREEN.filled()), "NIS of a fix"),
         Entry::new(
             Swatch::Line(BLACK.mix(0.4).stroke_width(1)),
-            "expected value 2",
+            format!("expected value {M}"),
         ),
-        Entry::new(Swatch::Line(BLACK.stroke_width(1)), "per-fix χ²(2) band"),
+        Entry::new(
+            Swatch::Line(BLACK.stroke_width(1)),
+            format!("per-fix χ²({M}) band"),
+        ),
     ];
     render_under_legend(&legend, &[ROW_PX + 30], 0, |parts| {
         let p = Panel::new(
@@ -351,7 +403,7 @@ pub fn calibration_nis(fixes: &[FixReport], test: &NisTest) -> PlotResult {
             axis,
             Layout::titled(y_area_px, true),
         )?;
-        p.hline(2.0, BLACK.mix(0.4).stroke_width(1))?;
+        p.hline(M as f64, BLACK.mix(0.4).stroke_width(1))?;
         p.hline(test.per_fix_lower, BLACK.stroke_width(1))?;
         p.hline(test.per_fix_upper, BLACK.stroke_width(1))?;
         markers(

@@ -8,9 +8,11 @@ use super::geometry::{extent, time_span};
 use super::legend::{Entry, Swatch, render_state_rows};
 use super::panel::{Layout, Panel, columns};
 use super::{
-    BLACK, BLUE, PlotResult, REDDISH_PURPLE, REFERENCE, VERMILLION, capitalized, state_name,
+    BLACK, BLUE, PlotResult, REDDISH_PURPLE, REFERENCE, VERMILLION, capitalized, last_state,
+    state_name, states,
 };
 use crate::ensemble::EnsembleStats;
+use crate::state::ErrorState;
 
 /// Height of one state's panel, px.
 const ROW_PX: u32 = 230;
@@ -26,7 +28,7 @@ pub struct CaseSeries<'a> {
     /// The ensemble statistics.
     pub stats: &'a EnsembleStats,
     /// Achieved RMS error at every fix, per state.
-    pub achieved_rms: &'a [[f64; 3]],
+    pub achieved_rms: &'a [[f64; ErrorState::DIM]],
 }
 
 fn color(i: usize) -> RGBColor {
@@ -41,7 +43,7 @@ fn legend(cases: &[CaseSeries<'_>]) -> Vec<Entry> {
         .collect()
 }
 
-/// Three stacked panels, one per state, sharing a time axis; `draw(panel, k)` fills each.
+/// Stacked panels, one per state, sharing a time axis; `draw(panel, k)` fills each.
 fn per_state(
     cases: &[CaseSeries<'_>],
     extra_legend: Vec<Entry>,
@@ -64,7 +66,7 @@ fn per_state(
             &title(k),
             time.clone(),
             axes[k].clone(),
-            Layout::titled(y_area_px, k == 2),
+            Layout::titled(y_area_px, last_state(k)),
         )?;
         draw(&p, k)?;
         Ok(())
@@ -81,7 +83,7 @@ pub fn accuracy_ratio(cases: &[CaseSeries<'_>]) -> PlotResult {
     let ratio = |c: &CaseSeries<'_>, i: usize, k: usize| {
         c.achieved_rms[i][k] / c.stats.fixes[i].post.filter_cov[k][k].sqrt()
     };
-    let full_axes: Vec<Axis> = (0..3)
+    let full_axes: Vec<Axis> = states()
         .map(|k| {
             let (lo, hi) = extent(
                 cases
@@ -94,7 +96,7 @@ pub fn accuracy_ratio(cases: &[CaseSeries<'_>]) -> PlotResult {
             Axis::linear("RMS error / σ", "", (lo - pad, hi + pad), 6)
         })
         .collect();
-    let near_axes: Vec<Axis> = (0..3)
+    let near_axes: Vec<Axis> = states()
         .map(|_| Axis::linear("RMS error / σ", "", (0.9, 1.1), 5))
         .collect();
     let (t0, t1) = time_span(
@@ -133,7 +135,7 @@ pub fn accuracy_ratio(cases: &[CaseSeries<'_>]) -> PlotResult {
                 &title,
                 time.clone(),
                 axis.clone(),
-                Layout::titled(area, k == 2),
+                Layout::titled(area, last_state(k)),
             )?;
             p.hline(1.0, BLACK.stroke_width(1))?;
             p.hline(1.05, REFERENCE.stroke_width(1))?;
@@ -158,7 +160,7 @@ pub fn mean_error_in_sigma(cases: &[CaseSeries<'_>], bound: f64) -> PlotResult {
         (f.mean_error[k] / f.filter_cov[k][k].sqrt()).abs()
     };
     let limit = |c: &CaseSeries<'_>| bound / (c.stats.realizations as f64).sqrt();
-    let axes: Vec<Axis> = (0..3)
+    let axes: Vec<Axis> = states()
         .map(|k| {
             let values = cases.iter().flat_map(|c| {
                 (0..c.stats.fixes.len())

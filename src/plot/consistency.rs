@@ -9,15 +9,16 @@ use super::panel::{Area, Layout, Panel, columns};
 use super::{BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotError, PlotResult, REFERENCE};
 use crate::checks::Check;
 use crate::ensemble::EnsembleStats;
+use crate::state::ErrorState;
 
 /// Height of one panel, px.
 const ROW_PX: u32 = 300;
 /// Width of the full-run column of a split row, px; the enlarged band takes the rest.
 const FULL_COLUMN_PX: u32 = 590;
 /// Dimension of the error state: the expected NEES.
-const STATE_DIM: f64 = 3.0;
+const STATE_DIM: f64 = ErrorState::DIM as f64;
 /// Dimension of the measurement: the expected NIS.
-const MEASUREMENT_DIM: f64 = 2.0;
+const MEASUREMENT_DIM: f64 = ErrorState::MEAS as f64;
 /// A statistic reaching this multiple of its band's upper end (or this fraction of its lower
 /// end) would flatten the band to a line on a linear axis: its row is split.
 const FAR_RATIO: f64 = 3.0;

@@ -8,7 +8,7 @@ use super::legend::{Entry, Swatch, render_state_rows};
 use super::panel::{Layout, Panel, columns};
 use super::{
     BLACK, BLUE, ORANGE, PlotError, PlotResult, REFERENCE, SKY_BLUE, VERMILLION, WIDTH_PX,
-    capitalized, state_name, state_unit,
+    capitalized, last_state, state_name, state_unit, states,
 };
 use crate::checks::Check;
 use crate::ensemble::{EnsembleStats, FixStats, StageStats};
@@ -22,7 +22,7 @@ pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
     let fixes = &stats.fixes;
     let (t0, t1) = time_span(fixes.iter().map(|f| f.time_s));
     let time = Axis::linear("time", "s", (t0.min(0.0), t1), 7);
-    let var_axes: Vec<Axis> = (0..3)
+    let var_axes: Vec<Axis> = states()
         .map(|k| {
             let values = fixes.iter().flat_map(|f| {
                 let (a, b) = var(&f.prior, k);
@@ -30,15 +30,15 @@ pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
                 [a, b, c, d]
             });
             let (lo, hi) = extent(values.filter(|v| *v > 0.0)).unwrap_or((0.1, 10.0));
-            let unit = if k == 0 {
-                "m²".to_string()
-            } else {
-                format!("({})²", state_unit(k))
+            // A compound unit is squared in parentheses: m², (m/s)².
+            let unit = match state_unit(k) {
+                u if u.contains('/') => format!("({u})²"),
+                u => format!("{u}²"),
             };
             Axis::log10("variance", &unit, (lo, hi))
         })
         .collect();
-    let ratio_axes: Vec<Axis> = (0..3)
+    let ratio_axes: Vec<Axis> = states()
         .map(|k| {
             let values = fixes
                 .iter()
@@ -52,7 +52,7 @@ pub fn covariance(stats: &EnsembleStats, check: &Check) -> PlotResult {
     let ratio_area = y_label_area(&ratio_axes.iter().collect::<Vec<_>>());
     render_state_rows(ROW_PX, &legend(check), |area, k| {
         let cols = columns(area, &[WIDTH_PX / 2]);
-        let layout = |y_area_px| Layout::titled(y_area_px, k == 2);
+        let layout = |y_area_px| Layout::titled(y_area_px, last_state(k));
         let name = state_name(k);
         let p = Panel::new(
             &cols[0],

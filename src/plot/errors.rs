@@ -6,7 +6,10 @@ use super::axis::{Axis, y_label_area};
 use super::geometry::{before, clipped_until, extent, max_abs, padded, settled_from, time_span};
 use super::legend::{Entry, Swatch, render_state_rows};
 use super::panel::{Layout, Panel, columns};
-use super::{BLACK, BLUE, ORANGE, PlotResult, REFERENCE, capitalized, state_name, state_unit};
+use super::{
+    BLACK, BLUE, ORANGE, PlotResult, REFERENCE, capitalized, last_state, state_name, state_unit,
+    states,
+};
 use crate::realization::Realization;
 
 /// Height of one state's row, px.
@@ -35,8 +38,8 @@ pub fn realization_errors(r: &Realization) -> PlotResult {
 
     let time = Axis::linear("time", "s", (t0, t1), 8);
     let zoom_time = Axis::linear("time", "s", zoom, 5);
-    let error_axes: Vec<Axis> = (0..3).map(|k| error_axis(r, k, settle)).collect();
-    let sigma_axes: Vec<Axis> = (0..3).map(|k| sigma_axis(r, k, zoom)).collect();
+    let error_axes: Vec<Axis> = states().map(|k| error_axis(r, k, settle)).collect();
+    let sigma_axes: Vec<Axis> = states().map(|k| sigma_axis(r, k, zoom)).collect();
     let (full_area, zoom_area) = (
         y_label_area(&error_axes.iter().collect::<Vec<_>>()),
         y_label_area(&sigma_axes.iter().collect::<Vec<_>>()),
@@ -52,7 +55,7 @@ pub fn realization_errors(r: &Realization) -> PlotResult {
         Entry::new(Swatch::Marker(BLACK.filled()), "σ after update"),
     ];
     render_state_rows(ROW_PX, &legend, |area, k| {
-        let last = k == 2;
+        let last = last_state(k);
         let cols = columns(area, &[FULL_COLUMN_PX]);
         let name = state_name(k);
 

@@ -135,7 +135,11 @@ pub(crate) fn render_state_rows(
     legend: &[Entry],
     mut draw: impl FnMut(&Area<'_>, usize) -> Result<(), PlotError>,
 ) -> PlotResult {
-    render_under_legend(legend, &[row_px, row_px, row_px + 24], 6, |parts| {
+    // The last row also holds the time axis's tick labels.
+    let heights: Vec<u32> = super::states()
+        .map(|k| row_px + if super::last_state(k) { 24 } else { 0 })
+        .collect();
+    render_under_legend(legend, &heights, 6, |parts| {
         for (k, area) in parts.iter().enumerate() {
             draw(area, k)?;
         }

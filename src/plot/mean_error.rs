@@ -7,10 +7,12 @@ use super::geometry::{max_abs, settled_from, time_span};
 use super::legend::{Entry, Swatch, render_state_rows};
 use super::panel::{Layout, Panel, columns};
 use super::{
-    BLACK, BLUE, ORANGE, PlotError, PlotResult, REFERENCE, capitalized, state_name, state_unit,
+    BLACK, BLUE, ORANGE, PlotError, PlotResult, REFERENCE, capitalized, last_state, state_name,
+    state_unit, states,
 };
 use crate::checks::Check;
 use crate::ensemble::{EnsembleStats, FixStats, StageStats};
+use crate::study::StagedState;
 
 /// Height of one state's row, px.
 const ROW_PX: u32 = 240;
@@ -28,7 +30,7 @@ const FULL_COLUMN_PX: u32 = 590;
 /// run is shorter), where the prior's large σ would otherwise set the scale. The band narrows as
 /// σ does (a hundredfold for the bias over the default run), so the enlarged half keeps the
 /// late mean error from looking like zero.
-pub fn mean_error(stats: &EnsembleStats, check: &Check, predicted: &[[[f64; 3]; 2]]) -> PlotResult {
+pub fn mean_error(stats: &EnsembleStats, check: &Check, predicted: &[StagedState]) -> PlotResult {
     let fixes = &stats.fixes;
     let n = stats.realizations as f64;
     let (t0, t1) = time_span(fixes.iter().map(|f| f.time_s));
@@ -56,8 +58,8 @@ pub fn mean_error(stats: &EnsembleStats, check: &Check, predicted: &[[[f64; 3]; 
         let m = if m > 0.0 { 1.15 * m } else { 1.0 };
         Axis::linear("e^{ave}", state_unit(k), (-m, m), 7)
     };
-    let full_axes: Vec<Axis> = (0..3).map(|k| axis(k, settle)).collect();
-    let half_axes: Vec<Axis> = (0..3).map(|k| axis(k, half)).collect();
+    let full_axes: Vec<Axis> = states().map(|k| axis(k, settle)).collect();
+    let half_axes: Vec<Axis> = states().map(|k| axis(k, half)).collect();
     let full_area = y_label_area(&full_axes.iter().collect::<Vec<_>>());
     let half_area = y_label_area(&half_axes.iter().collect::<Vec<_>>());
     let full_time = Axis::linear("time", "s", (t0.min(0.0), t1), 8);
@@ -83,7 +85,7 @@ pub fn mean_error(stats: &EnsembleStats, check: &Check, predicted: &[[[f64; 3]; 
     render_state_rows(ROW_PX, &legend, |area, k| {
         let cols = columns(area, &[FULL_COLUMN_PX]);
         let name = capitalized(state_name(k));
-        let layout = |y_area_px| Layout::titled(y_area_px, k == 2);
+        let layout = |y_area_px| Layout::titled(y_area_px, last_state(k));
         let full = Panel::new(
             &cols[0],
             &format!(
@@ -111,7 +113,7 @@ pub fn mean_error(stats: &EnsembleStats, check: &Check, predicted: &[[[f64; 3]; 
 fn draw(
     p: &Panel<'_>,
     fixes: &[FixStats],
-    predicted: &[[[f64; 3]; 2]],
+    predicted: &[StagedState],
     k: usize,
     band: &dyn Fn(&StageStats, usize) -> f64,
 ) -> Result<(), PlotError> {

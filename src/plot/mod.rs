@@ -120,6 +120,16 @@ impl<E: std::error::Error + Send + Sync> From<DrawingAreaErrorKind<E>> for PlotE
     }
 }
 
+/// The indices of the error state's components, in state order: one panel row each.
+pub(crate) fn states() -> std::ops::Range<usize> {
+    0..ErrorState::DIM
+}
+
+/// Whether state `k` is the last, whose panel carries the time axis.
+pub(crate) fn last_state(k: usize) -> bool {
+    k + 1 == ErrorState::DIM
+}
+
 /// Unit of state component `k` of the error state.
 pub(crate) fn state_unit(k: usize) -> &'static str {
     ErrorState::VARIABLES[k].unit

@@ -7,15 +7,24 @@ use super::geometry::{max_abs, time_span};
 use super::legend::{Entry, Swatch, render_state_rows};
 use super::panel::{Layout, Panel, columns};
 use super::{
-    BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotResult, REFERENCE, WIDTH_PX, capitalized, state_name,
+    BLACK, BLUE, BLUISH_GREEN, ORANGE, PlotResult, REFERENCE, WIDTH_PX, capitalized, last_state,
+    state_name, states,
 };
 use crate::checks::Check;
 use crate::ensemble::{EnsembleStats, StageStats};
+use crate::state::ErrorState;
 
 /// Height of one error component's row, px.
 const ROW_PX: u32 = 230;
-/// Colour of each estimate component k.
+/// Colours of the estimate components, in state order (repeated beyond the last).
 const COLORS: [plotters::style::RGBColor; 3] = [BLUE, ORANGE, BLUISH_GREEN];
+/// Number of states.
+const N: usize = ErrorState::DIM;
+
+/// Colour of estimate component `k`.
+fn color(k: usize) -> plotters::style::RGBColor {
+    COLORS[k % COLORS.len()]
+}
 
 /// The normalized correlations √N·corr(e_j − e_ave,j, δx̂_k) of every component pair at every fix
 /// against ±bound: one row per error component j, a priori on the left and a posteriori on the
@@ -31,16 +40,16 @@ pub fn orthogonality(stats: &EnsembleStats, check: &Check) -> PlotResult {
         fixes
             .iter()
             .flat_map(|f| [&f.prior, &f.post])
-            .flat_map(|s| (0..9).map(move |i| z(s, i / 3, i % 3)))
+            .flat_map(|s| (0..N * N).map(move |i| z(s, i / N, i % N)))
             .chain([check.upper]),
     );
     let y = Axis::linear("√N · correlation", "", (-1.15 * m, 1.15 * m), 7);
     let y_area_px = y_label_area(&[&y]);
 
-    let mut legend: Vec<Entry> = (0..3)
+    let mut legend: Vec<Entry> = states()
         .map(|k| {
             Entry::new(
-                Swatch::Line(COLORS[k].stroke_width(2)),
+                Swatch::Line(color(k).stroke_width(2)),
                 format!("{} estimate", state_name(k)),
             )
         })
@@ -61,18 +70,18 @@ pub fn orthogonality(stats: &EnsembleStats, check: &Check) -> PlotResult {
                 ),
                 time.clone(),
                 y.clone(),
-                Layout::titled(y_area_px, j == 2),
+                Layout::titled(y_area_px, last_state(j)),
             )?;
             p.hline(0.0, REFERENCE.stroke_width(1))?;
             p.hline(check.upper, BLACK.stroke_width(1))?;
             p.hline(-check.upper, BLACK.stroke_width(1))?;
-            for (k, color) in COLORS.iter().enumerate() {
+            for k in states() {
                 p.line(
                     fixes.iter().map(|f| {
                         let s = if prior { &f.prior } else { &f.post };
                         (f.time_s, z(s, j, k))
                     }),
-                    color.stroke_width(1),
+                    color(k).stroke_width(1),
                 )?;
             }
         }

@@ -10,6 +10,10 @@ use super::{font, text_width};
 use crate::checks::{Check, ResidualPair, residual_z};
 use crate::ensemble::EnsembleStats;
 use crate::format::fixed;
+use crate::state::ErrorState;
+
+/// Components M of a residual: residual component c of fix i is stacked at M·i + c.
+const M: usize = ErrorState::MEAS;
 
 /// Cells per side of the map at most: fixes are grouped so the map holds ≤ 50 × 50 cells.
 const MAX_CELLS: usize = 50;
@@ -25,9 +29,9 @@ const SCALE_PX: u32 = 96;
 const LOW: RGBColor = RGBColor(0xF1, 0xF6, 0xFB);
 const HIGH: RGBColor = RGBColor(0x00, 0x45, 0x7A);
 
-/// Left: every pair of fixes t_m < t_i, coloured by the largest |z| of its four component pairs,
+/// Left: every pair of fixes t_m < t_i, coloured by the largest |z| of its M² component pairs,
 /// z = √N·corr(r_a(t_i), r_b(t_m)); the fixes are grouped into at most 50 × 50 cells, each showing
-/// its largest |z|, with |z| beyond `check.upper` in vermillion. Right: the four z of the
+/// its largest |z|, with |z| beyond `check.upper` in vermillion. Right: the M² z of the
 /// statement's pair against `pair.bound`.
 pub fn residual_whiteness(stats: &EnsembleStats, check: &Check, pair: &ResidualPair) -> PlotResult {
     let cells = Cells::new(stats);
@@ -124,9 +128,9 @@ impl<'a> Cells<'a> {
         let mut worst = f64::NAN;
         for i in ci * per_cell..((ci + 1) * per_cell).min(n) {
             for m in cm * per_cell..((cm + 1) * per_cell).min(i) {
-                for a in 0..2 {
-                    for b in 0..2 {
-                        let z = residual_z(self.stats, 2 * i + a, 2 * m + b).abs();
+                for a in 0..M {
+                    for b in 0..M {
+                        let z = residual_z(self.stats, M * i + a, M * m + b).abs();
                         if z.is_finite() {
                             worst = z.max(worst);
                         }
@@ -222,12 +226,12 @@ fn draw_scale(area: &Area<'_>, upper: f64, y_area_px: u32) -> Result<(), PlotErr
     Ok(())
 }
 
-/// The four z of the statement's pair on `area`, one row per component pair, against ±bound.
+/// The M² z of the statement's pair on `area`, one row per component pair, against ±bound.
 fn draw_pair(area: &Area<'_>, pair: &ResidualPair) -> Result<(), PlotError> {
-    let names = ["r_{p}", "r_{v}"];
+    let names: [&str; M] = ["r_{p}", "r_{v}"];
     // In pair.z's order: (position, position), (position, velocity), (velocity, position), ….
-    let categories: Vec<String> = (0..4)
-        .map(|c| format!("{}(t_{{i}})·{}(t_{{m}})", names[c / 2], names[c % 2]))
+    let categories: Vec<String> = (0..M * M)
+        .map(|c| format!("{}(t_{{i}})·{}(t_{{m}})", names[c / M], names[c % M]))
         .collect();
     let zs = pair.z.iter().flatten().copied().collect::<Vec<_>>();
     let reach = zs

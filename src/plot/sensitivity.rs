@@ -9,8 +9,9 @@ use super::legend::{Entry, Swatch, render_state_rows};
 use super::panel::{Layout, Panel};
 use super::{
     BLACK, BLUE, BLUISH_GREEN, GREY, ORANGE, PlotResult, REDDISH_PURPLE, VERMILLION, capitalized,
-    state_name,
+    last_state, state_name, states,
 };
+use crate::state::ErrorState;
 
 /// Height of one state's panel, px.
 const ROW_PX: u32 = 230;
@@ -30,7 +31,7 @@ pub struct SensitivitySeries {
     /// Legend label: the `[filter]` key.
     pub label: String,
     /// (factor, actual σ / claimed σ per state) at each factor.
-    pub points: Vec<(f64, [f64; 3])>,
+    pub points: Vec<(f64, [f64; ErrorState::DIM])>,
 }
 
 /// Per state, actual σ / claimed σ at the last fix against the factor on the assumed standard
@@ -40,7 +41,7 @@ pub fn sigma_ratio(series: &[SensitivitySeries]) -> PlotResult {
     let factors =
         extent(series.iter().flat_map(|s| s.points.iter().map(|p| p.0))).unwrap_or((0.5, 2.0));
     let x = Axis::factor("factor on the assumed σ", factors);
-    let axes: Vec<Axis> = (0..3)
+    let axes: Vec<Axis> = states()
         .map(|k| {
             let (lo, hi) = extent(
                 series
@@ -76,7 +77,7 @@ pub fn sigma_ratio(series: &[SensitivitySeries]) -> PlotResult {
             ),
             x.clone(),
             axes[k].clone(),
-            Layout::titled(y_area_px, k == 2),
+            Layout::titled(y_area_px, last_state(k)),
         )?;
         p.hline(1.0, GREY.stroke_width(1))?;
         for (i, s) in series.iter().enumerate() {

@@ -8,6 +8,7 @@ use crate::checks::{Check, CheckId};
 use crate::config::{Case, Config};
 use crate::ensemble::EnsembleStats;
 use crate::model::Model;
+use crate::state::ErrorState;
 use crate::study::Study;
 
 mod presentation;
@@ -157,13 +158,13 @@ fn figures_are_deterministic() {
 fn non_finite_statistics_are_skipped() {
     let study = small_study();
     let mut stats = study.case(CASE).run.stats.clone();
-    stats.fixes[1].post.mean_error[0] = f64::NAN;
-    stats.fixes[2].post.ensemble_cov[1][1] = f64::INFINITY;
-    stats.fixes[3].prior.orthogonality_corr[2][0] = f64::NAN;
+    stats.fixes[1].post.mean_error[ErrorState::POSITION] = f64::NAN;
+    stats.fixes[2].post.ensemble_cov[ErrorState::VELOCITY][ErrorState::VELOCITY] = f64::INFINITY;
+    stats.fixes[3].prior.orthogonality_corr[ErrorState::BIAS][ErrorState::POSITION] = f64::NAN;
     stats.fixes[4].nis_avg = f64::NAN;
     let c = check(study, CheckId::MEAN_ERROR);
-    let prediction = vec![[[f64::NAN; 3]; 2]; stats.fixes.len()];
-    let rms = vec![[f64::NAN; 3]; stats.fixes.len()];
+    let prediction = vec![[[f64::NAN; ErrorState::DIM]; 2]; stats.fixes.len()];
+    let rms = vec![[f64::NAN; ErrorState::DIM]; stats.fixes.len()];
     for svg in [
         mean_error(&stats, c, &prediction).unwrap(),
         covariance(&stats, c).unwrap(),
@@ -183,10 +184,10 @@ fn figures_survive_statistics_that_are_all_undefined() {
     let mut stats = study.case(CASE).run.stats.clone();
     for f in &mut stats.fixes {
         for s in [&mut f.prior, &mut f.post] {
-            s.mean_error = [f64::NAN; 3];
-            s.ensemble_cov = [[f64::NAN; 3]; 3];
-            s.filter_cov = [[f64::INFINITY; 3]; 3];
-            s.orthogonality_corr = [[f64::NAN; 3]; 3];
+            s.mean_error = [f64::NAN; ErrorState::DIM];
+            s.ensemble_cov = [[f64::NAN; ErrorState::DIM]; ErrorState::DIM];
+            s.filter_cov = [[f64::INFINITY; ErrorState::DIM]; ErrorState::DIM];
+            s.orthogonality_corr = [[f64::NAN; ErrorState::DIM]; ErrorState::DIM];
             s.nees_avg = f64::NAN;
         }
         f.nis_avg = f64::NAN;
@@ -197,14 +198,14 @@ fn figures_survive_statistics_that_are_all_undefined() {
         .for_each(|x| *x = f64::NAN);
     let mut r = study.realization.clone();
     for s in &mut r.samples {
-        s.sigma = [f64::NAN; 3];
-        s.estimate = [f64::INFINITY; 3];
+        s.sigma = [f64::NAN; ErrorState::DIM];
+        s.estimate = [f64::INFINITY; ErrorState::DIM];
     }
     let c = check(study, CheckId::MEAN_ERROR);
     let mut pair = study.case(CASE).verdicts.residual_pair.clone();
-    pair.z = vec![vec![f64::NAN; 2]; 2];
-    let prediction = vec![[[f64::INFINITY; 3]; 2]; stats.fixes.len()];
-    let rms = vec![[f64::NAN; 3]; stats.fixes.len()];
+    pair.z = vec![vec![f64::NAN; ErrorState::MEAS]; ErrorState::MEAS];
+    let prediction = vec![[[f64::INFINITY; ErrorState::DIM]; 2]; stats.fixes.len()];
+    let rms = vec![[f64::NAN; ErrorState::DIM]; stats.fixes.len()];
     for svg in [
         realization_errors(&r).unwrap(),
         trajectory(&r).unwrap(),
@@ -222,7 +223,10 @@ fn figures_survive_statistics_that_are_all_undefined() {
 }
 
 /// One case series of `stats` with achieved RMS errors `rms`.
-fn undefined<'a>(stats: &'a EnsembleStats, rms: &'a [[f64; 3]]) -> Vec<CaseSeries<'a>> {
+fn undefined<'a>(
+    stats: &'a EnsembleStats,
+    rms: &'a [[f64; ErrorState::DIM]],
+) -> Vec<CaseSeries<'a>> {
     vec![CaseSeries {
         label: "undefined".to_string(),
         stats,

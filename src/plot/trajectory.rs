@@ -7,8 +7,11 @@ use super::axis::{Axis, y_label_area};
 use super::geometry::{before, clipped_until, extent, padded, settled_from, time_span};
 use super::legend::{Entry, Swatch, render_under_legend};
 use super::panel::{Area, Layout, Panel, columns};
-use super::{BLUE, BLUISH_GREEN, PlotError, PlotResult, VERMILLION, WIDTH_PX};
+use super::{
+    BLUE, BLUISH_GREEN, PlotError, PlotResult, VERMILLION, WIDTH_PX, state_name, state_unit,
+};
 use crate::realization::{Realization, SampleRecord};
+use crate::state::ErrorState;
 
 /// Height of one row, px.
 const ROW_PX: u32 = 250;
@@ -51,9 +54,10 @@ pub fn trajectory(r: &Realization) -> PlotResult {
         ),
         Entry::new(Swatch::Line(VERMILLION.stroke_width(2)), "filter estimate"),
     ];
-    let last_row_px = ROW_PX + 24;
-
-    render_under_legend(&legend, &[ROW_PX, ROW_PX, last_row_px], 6, |parts| {
+    // The last row also holds the time axis's tick labels.
+    let heights: [u32; ROWS] =
+        std::array::from_fn(|row| ROW_PX + if row + 1 == ROWS { 24 } else { 0 });
+    render_under_legend(&legend, &heights, 6, |parts| {
         for (row, area) in parts.iter().enumerate() {
             let axes = [left[row].clone(), right[row].clone()];
             let title = titles_right[row].as_str();
@@ -64,10 +68,12 @@ pub fn trajectory(r: &Realization) -> PlotResult {
 }
 
 /// The state component of each right-hand row: bias, velocity, position.
-const DRIFT_INDEX: [usize; 3] = [2, 1, 0];
+const DRIFT_INDEX: [usize; ROWS] = [ErrorState::BIAS, ErrorState::VELOCITY, ErrorState::POSITION];
+/// Rows of the figure: acceleration, velocity, position.
+const ROWS: usize = 3;
 
 /// The right-hand titles: in full, and shortened for a note on what the axis clips.
-const DRIFT_TITLES: [(&str, &str); 3] = [
+const DRIFT_TITLES: [(&str, &str); ROWS] = [
     (
         "Accelerometer bias b and its estimate",
         "Bias b and its estimate",
@@ -90,23 +96,24 @@ fn fitted(name: &str, unit: &str, values: Vec<f64>) -> Axis {
 
 /// The left-hand axes: acceleration, velocity and position, fitted to the truth and the
 /// integration.
-fn motion_axes(s: &[SampleRecord]) -> [Axis; 3] {
+fn motion_axes(s: &[SampleRecord]) -> [Axis; ROWS] {
     [
+        // The bias is an acceleration, and δv, δp have the units of v, p.
         fitted(
             "acceleration",
-            "m/s²",
+            state_unit(ErrorState::BIAS),
             s.iter().map(|x| x.accel_m_s2).collect(),
         ),
         fitted(
-            "velocity",
-            "m/s",
+            state_name(ErrorState::VELOCITY),
+            state_unit(ErrorState::VELOCITY),
             s.iter()
                 .flat_map(|x| [x.truth_v_m_s, x.computed_v_m_s])
                 .collect(),
         ),
         fitted(
-            "position",
-            "m",
+            state_name(ErrorState::POSITION),
+            state_unit(ErrorState::POSITION),
             s.iter()
                 .flat_map(|x| [x.truth_p_m, x.computed_p_m])
                 .collect(),
@@ -116,20 +123,21 @@ fn motion_axes(s: &[SampleRecord]) -> [Axis; 3] {
 
 /// The right-hand axes: bias, velocity drift and position drift, fitted to the truth over the
 /// run and to the estimate from `settle` on.
-fn drift_axes(s: &[SampleRecord], settle: f64) -> [Axis; 3] {
-    let drift_axis = |k: usize, name: &str, unit: &str| {
+fn drift_axes(s: &[SampleRecord], settle: f64) -> [Axis; ROWS] {
+    let drift = |k: usize| format!("{} drift", state_name(k));
+    let drift_axis = |k: usize, name: String| {
         let values = s
             .iter()
             .map(|x| x.delta_x[k])
             .chain(s.iter().filter(|x| x.t_s >= settle).map(|x| x.estimate[k]))
             .collect::<Vec<_>>();
         let range = extent(values).map_or((-1.0, 1.0), |e| padded(e, 0.12));
-        Axis::linear(name, unit, range, 6)
+        Axis::linear(&name, state_unit(k), range, 6)
     };
     [
-        drift_axis(2, "bias", "m/s²"),
-        drift_axis(1, "velocity drift", "m/s"),
-        drift_axis(0, "position drift", "m"),
+        drift_axis(ErrorState::BIAS, state_name(ErrorState::BIAS).to_string()),
+        drift_axis(ErrorState::VELOCITY, drift(ErrorState::VELOCITY)),
+        drift_axis(ErrorState::POSITION, drift(ErrorState::POSITION)),
     ]
 }
 
@@ -148,11 +156,11 @@ fn draw_row(
         "Position: truth p and integrated p_{c}",
     ];
     type Series = fn(&SampleRecord) -> f64;
-    let truth: [Series; 3] = [|x| x.accel_m_s2, |x| x.truth_v_m_s, |x| x.truth_p_m];
-    let computed: [Option<Series>; 3] =
+    let truth: [Series; ROWS] = [|x| x.accel_m_s2, |x| x.truth_v_m_s, |x| x.truth_p_m];
+    let computed: [Option<Series>; ROWS] =
         [None, Some(|x| x.computed_v_m_s), Some(|x| x.computed_p_m)];
     let cols = columns(area, &[WIDTH_PX / 2]);
-    let layout = |y_area_px| Layout::titled(y_area_px, row == 2);
+    let layout = |y_area_px| Layout::titled(y_area_px, row + 1 == ROWS);
     let p = Panel::new(
         &cols[0],
         titles_left[row],

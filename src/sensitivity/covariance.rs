@@ -6,8 +6,9 @@
 //! recursion as the filter's own, with the filter's K and the truth's W, R and P(0); the Joseph
 //! form holds for any gain. No random numbers are involved.
 
-use crate::filter::{ErrorStateModel, FilterSchedule, Matrix2, Matrix3};
+use crate::filter::{ErrorStateModel, FilterSchedule};
 use crate::model::{NoiseStats, Timeline};
+use crate::state::{MeasMatrix, StateMatrix};
 
 /// The actual error covariance at one fix, beside the filter's.
 #[derive(Clone, Debug, PartialEq)]
@@ -15,11 +16,11 @@ pub struct ActualFix {
     /// Time of the fix, s.
     pub time_s: f64,
     /// Actual a priori covariance, (m, m/s, m/s²)².
-    pub prior: Matrix3,
+    pub prior: StateMatrix,
     /// Actual a posteriori covariance.
-    pub post: Matrix3,
+    pub post: StateMatrix,
     /// Actual innovation covariance H·P_actual⁻·Hᵀ + R_truth, (m, m/s)².
-    pub innovation: Matrix2,
+    pub innovation: MeasMatrix,
 }
 
 /// The actual error covariance of the filter `schedule` when the truth has the statistics
@@ -44,7 +45,7 @@ pub fn actual_covariance(
             j += 1;
         }
         let prior = p;
-        let i_kh = Matrix3::identity() - fix.gain * h;
+        let i_kh = StateMatrix::identity() - fix.gain * h;
         let post = i_kh * prior * i_kh.transpose() + fix.gain * world.r * fix.gain.transpose();
         let post = (post + post.transpose()) * 0.5;
         out.push(ActualFix {
@@ -66,9 +67,9 @@ pub struct SampleCovariance {
     /// Time of the sample, s.
     pub time_s: f64,
     /// The filter's own covariance P, (m, m/s, m/s²)²: a posteriori at a fix.
-    pub claimed: Matrix3,
+    pub claimed: StateMatrix,
     /// The actual error covariance, likewise.
-    pub actual: Matrix3,
+    pub actual: StateMatrix,
 }
 
 /// Visits the claimed and the actual covariance of the filter `schedule` at every accelerometer
@@ -95,7 +96,7 @@ pub fn covariance_at_samples(
             actual = world.propagate(&actual);
         }
         if let Some((_, fix)) = fixes.next_if(|(jf, _)| **jf == j) {
-            let i_kh = Matrix3::identity() - fix.gain * h;
+            let i_kh = StateMatrix::identity() - fix.gain * h;
             let post = i_kh * actual * i_kh.transpose() + fix.gain * world.r * fix.gain.transpose();
             actual = (post + post.transpose()) * 0.5;
             claimed = fix.p_post;

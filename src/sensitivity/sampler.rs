@@ -24,28 +24,41 @@ use rayon::prelude::*;
 
 use crate::checks::{self, Budget, CheckId};
 use crate::ensemble::{Accumulator, EnsembleStats, ResidualLayout, StageSums};
-use crate::filter::{ErrorStateModel, FilterSchedule, Matrix2, Matrix3};
+use crate::filter::{ErrorStateModel, FilterSchedule};
 use crate::model::{NoiseStats, Timeline};
 use crate::random::Stream;
+use crate::state::{ErrorState, MeasMatrix, StateMatrix};
 
-type M6 = SMatrix<f64, 6, 6>;
-type M8 = SMatrix<f64, 8, 8>;
-type V6 = SVector<f64, 6>;
+/// States N of the error state e (and of the estimate δx̂).
+const N: usize = ErrorState::DIM;
+/// Measured components M.
+const M: usize = ErrorState::MEAS;
+/// Dimension of the joint state z = (e, δx̂).
+const JOINT: usize = 2 * N;
+/// Dimension of the joint state with the measurement noise at a fix, (z, η).
+const WITH_NOISE: usize = JOINT + M;
+
+/// A matrix of the joint state z: F, a scatter.
+type JointMatrix = SMatrix<f64, JOINT, JOINT>;
+/// A matrix of (z, η).
+type WithNoiseMatrix = SMatrix<f64, WITH_NOISE, WITH_NOISE>;
+/// A vector of the joint state z.
+type JointVector = SVector<f64, JOINT>;
 
 /// The transitions of one fix: the propagation from the previous fix and the update.
 #[derive(Clone, Debug)]
 struct FixStep {
     /// z ← F·z over the interval.
-    f: M6,
+    f: JointMatrix,
     /// Noise loading over the interval: G·Gᵀ is the truth's accumulated process noise.
-    g: SMatrix<f64, 6, 3>,
+    g: SMatrix<f64, JOINT, N>,
     /// (z, η) ↦ z⁺ at the fix.
-    update: SMatrix<f64, 6, 8>,
+    update: SMatrix<f64, JOINT, WITH_NOISE>,
     /// (z, η) ↦ r at the fix.
-    residual: SMatrix<f64, 2, 8>,
-    p_prior_inv: Matrix3,
-    p_post_inv: Matrix3,
-    s_inv: Matrix2,
+    residual: SMatrix<f64, M, WITH_NOISE>,
+    p_prior_inv: StateMatrix,
+    p_post_inv: StateMatrix,
+    s_inv: MeasMatrix,
 }
 
 /// Draws the sums of ensembles of the filter `schedule` in the world of `truth`.
@@ -53,16 +66,16 @@ struct FixStep {
 pub struct Sampler {
     realizations: u64,
     /// A square root of the truth's P(0).
-    p0_root: Matrix3,
+    p0_root: StateMatrix,
     /// A square root of the truth's R.
-    r_root: Matrix2,
+    r_root: MeasMatrix,
     steps: Vec<FixStep>,
     layout: ResidualLayout,
     pair: [usize; 2],
 }
 
 impl Sampler {
-    /// The sampler of ensembles of `realizations` (at least 7, the joint dimension plus one) of
+    /// The sampler of ensembles of `realizations` (more than the joint dimension 2N) of
     /// the filter `schedule` over `timeline`, in the model-exact world with the statistics
     /// `truth`. The residual products are kept at lag 0 only and the single pair `pair` is not
     /// drawn (its products are NaN).
@@ -73,7 +86,10 @@ impl Sampler {
         realizations: u64,
         pair: [usize; 2],
     ) -> Self {
-        assert!(realizations > 6, "the joint state has 6 dimensions");
+        assert!(
+            realizations > JOINT as u64,
+            "the joint state has {JOINT} dimensions"
+        );
         let world = ErrorStateModel::new(timeline.dt_s, truth);
         let h = schedule.model.h;
         let mut j = 0;
@@ -82,35 +98,36 @@ impl Sampler {
             .iter()
             .zip(&schedule.fixes)
             .map(|(&jf, fix)| {
-                let mut q = Matrix3::zeros();
-                let mut phi = Matrix3::identity();
+                let mut q = StateMatrix::zeros();
+                let mut phi = StateMatrix::identity();
                 while j < jf {
                     q = world.propagate(&q);
                     phi = world.phi * phi;
                     j += 1;
                 }
-                let mut f = M6::zeros();
-                f.fixed_view_mut::<3, 3>(0, 0).copy_from(&phi);
-                f.fixed_view_mut::<3, 3>(3, 3).copy_from(&phi);
-                let mut g = SMatrix::<f64, 6, 3>::zeros();
-                g.fixed_view_mut::<3, 3>(0, 0).copy_from(&psd_cholesky(&q));
+                // Rows and columns: e in 0..N, δx̂ in N..2N, η in 2N..2N + M.
+                let mut f = JointMatrix::zeros();
+                f.fixed_view_mut::<N, N>(0, 0).copy_from(&phi);
+                f.fixed_view_mut::<N, N>(N, N).copy_from(&phi);
+                let mut g = SMatrix::<f64, JOINT, N>::zeros();
+                g.fixed_view_mut::<N, N>(0, 0).copy_from(&psd_cholesky(&q));
                 let k = fix.gain;
                 let kh = k * h;
-                let mut update = SMatrix::<f64, 6, 8>::zeros();
+                let mut update = SMatrix::<f64, JOINT, WITH_NOISE>::zeros();
                 update
-                    .fixed_view_mut::<3, 3>(0, 0)
-                    .copy_from(&(Matrix3::identity() - kh));
-                update.fixed_view_mut::<3, 2>(0, 6).copy_from(&(-k));
-                update.fixed_view_mut::<3, 3>(3, 0).copy_from(&kh);
+                    .fixed_view_mut::<N, N>(0, 0)
+                    .copy_from(&(StateMatrix::identity() - kh));
+                update.fixed_view_mut::<N, M>(0, JOINT).copy_from(&(-k));
+                update.fixed_view_mut::<N, N>(N, 0).copy_from(&kh);
                 update
-                    .fixed_view_mut::<3, 3>(3, 3)
-                    .copy_from(&Matrix3::identity());
-                update.fixed_view_mut::<3, 2>(3, 6).copy_from(&k);
-                let mut residual = SMatrix::<f64, 2, 8>::zeros();
-                residual.fixed_view_mut::<2, 3>(0, 0).copy_from(&h);
+                    .fixed_view_mut::<N, N>(N, N)
+                    .copy_from(&StateMatrix::identity());
+                update.fixed_view_mut::<N, M>(N, JOINT).copy_from(&k);
+                let mut residual = SMatrix::<f64, M, WITH_NOISE>::zeros();
+                residual.fixed_view_mut::<M, N>(0, 0).copy_from(&h);
                 residual
-                    .fixed_view_mut::<2, 2>(0, 6)
-                    .copy_from(&Matrix2::identity());
+                    .fixed_view_mut::<M, M>(0, JOINT)
+                    .copy_from(&MeasMatrix::identity());
                 FixStep {
                     f,
                     g,
@@ -144,45 +161,48 @@ impl Sampler {
         acc.pair_products.fill(f64::NAN);
 
         // Start: e ~ N(0, P(0)), δx̂ = 0.
-        let mut scatter = M6::zeros();
-        let w0 = wishart::<3>(n, rng);
+        let mut scatter = JointMatrix::zeros();
+        let w0 = wishart::<N>(n, rng);
         scatter
-            .fixed_view_mut::<3, 3>(0, 0)
+            .fixed_view_mut::<N, N>(0, 0)
             .copy_from(&(self.p0_root * w0 * self.p0_root.transpose()));
-        let mut mean = V6::zeros();
-        let e0: SVector<f64, 3> = normals(rng);
-        mean.fixed_rows_mut::<3>(0)
+        let mut mean = JointVector::zeros();
+        let e0: SVector<f64, N> = normals(rng);
+        mean.fixed_rows_mut::<N>(0)
             .copy_from(&(self.p0_root * e0 / sqrt_n));
 
         for (i, step) in self.steps.iter().enumerate() {
             // Propagation to the fix.
             let l = psd_cholesky(&scatter);
-            let b: SMatrix<f64, 3, 6> = normals(rng);
+            let b: SMatrix<f64, N, JOINT> = normals(rng);
             let a = step.f * l + step.g * b;
-            let w = wishart::<3>(n - 6, rng);
+            let w = wishart::<N>(n - JOINT as u64, rng);
             scatter = symmetric(a * a.transpose() + step.g * w * step.g.transpose());
-            let noise: SVector<f64, 3> = normals(rng);
+            let noise: SVector<f64, N> = normals(rng);
             mean = step.f * mean + step.g * noise / sqrt_n;
             let prior = stage_sums(&scatter, &mean, n_real, &step.p_prior_inv);
 
             // The joint (z, η) at the fix.
             let l = psd_cholesky(&scatter);
-            let b: SMatrix<f64, 2, 6> = normals(rng);
-            let mut a = SMatrix::<f64, 8, 6>::zeros();
-            a.fixed_view_mut::<6, 6>(0, 0).copy_from(&l);
-            a.fixed_view_mut::<2, 6>(6, 0).copy_from(&(self.r_root * b));
-            let w = wishart::<2>(n - 6, rng);
-            let mut joint: M8 = a * a.transpose();
+            let b: SMatrix<f64, M, JOINT> = normals(rng);
+            let mut a = SMatrix::<f64, WITH_NOISE, JOINT>::zeros();
+            a.fixed_view_mut::<JOINT, JOINT>(0, 0).copy_from(&l);
+            a.fixed_view_mut::<M, JOINT>(JOINT, 0)
+                .copy_from(&(self.r_root * b));
+            let w = wishart::<M>(n - JOINT as u64, rng);
+            let mut joint: WithNoiseMatrix = a * a.transpose();
             let wr = self.r_root * w * self.r_root.transpose();
-            for (x, y) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
-                joint[(6 + x, 6 + y)] += wr[(x, y)];
+            for x in 0..M {
+                for y in 0..M {
+                    joint[(JOINT + x, JOINT + y)] += wr[(x, y)];
+                }
             }
             let joint = symmetric(joint);
-            let eta: SVector<f64, 2> = normals(rng);
-            let mut joint_mean = SVector::<f64, 8>::zeros();
-            joint_mean.fixed_rows_mut::<6>(0).copy_from(&mean);
+            let eta: SVector<f64, M> = normals(rng);
+            let mut joint_mean = SVector::<f64, WITH_NOISE>::zeros();
+            joint_mean.fixed_rows_mut::<JOINT>(0).copy_from(&mean);
             joint_mean
-                .fixed_rows_mut::<2>(6)
+                .fixed_rows_mut::<M>(JOINT)
                 .copy_from(&(self.r_root * eta / sqrt_n));
 
             let r_scatter = step.residual * joint * step.residual.transpose();
@@ -196,12 +216,15 @@ impl Sampler {
             sums.prior = prior;
             sums.post = post;
             sums.nis = (step.s_inv * rr).trace();
-            for (x, y) in [(0, 0), (1, 0), (1, 1)] {
-                let k = self
-                    .layout
-                    .index(2 * i + x, 2 * i + y)
-                    .expect("lag 0 is kept");
-                acc.residual_products[k] = rr[(x, y)];
+            // The lower triangle of r·rᵀ at lag 0: components M·i + x and M·i + y, y ≤ x.
+            for x in 0..M {
+                for y in 0..=x {
+                    let k = self
+                        .layout
+                        .index(M * i + x, M * i + y)
+                        .expect("lag 0 is kept");
+                    acc.residual_products[k] = rr[(x, y)];
+                }
             }
         }
         acc
@@ -251,16 +274,16 @@ impl Sampler {
 }
 
 /// The raw sums Σ e, Σ e·eᵀ, … of one stage from the scatter and the mean of z = (e, δx̂).
-fn stage_sums(scatter: &M6, mean: &V6, n: f64, p_inv: &Matrix3) -> StageSums {
+fn stage_sums(scatter: &JointMatrix, mean: &JointVector, n: f64, p_inv: &StateMatrix) -> StageSums {
     let raw = scatter + mean * mean.transpose() * n;
     // Σ e·eᵀ from its upper triangle, exactly symmetric.
-    let ee = Matrix3::from_fn(|r, c| raw[(r.min(c), r.max(c))]);
+    let ee = StateMatrix::from_fn(|r, c| raw[(r.min(c), r.max(c))]);
     StageSums {
-        e: mean.fixed_rows::<3>(0) * n,
+        e: mean.fixed_rows::<N>(0) * n,
         ee,
-        ex: raw.fixed_view::<3, 3>(0, 3).into_owned(),
-        x: mean.fixed_rows::<3>(3) * n,
-        xx: raw.fixed_view::<3, 3>(3, 3).diagonal(),
+        ex: raw.fixed_view::<N, N>(0, N).into_owned(),
+        x: mean.fixed_rows::<N>(N) * n,
+        xx: raw.fixed_view::<N, N>(N, N).diagonal(),
         nees: (p_inv * ee).trace(),
     }
 }

@@ -4,26 +4,30 @@
 use serde::Serialize;
 
 use crate::ensemble::EnsembleStats;
-use crate::filter::{FilterSchedule, FixCovariance, Stage, Vector3};
+use crate::filter::{FilterSchedule, FixCovariance, Stage};
 use crate::model::Model;
 use crate::simulation::{FixState, Observer, run_noise_free};
+use crate::state::{ErrorState, StateVector};
+
+/// A value of every state at one fix, [a priori, a posteriori] (m, m/s, m/s²).
+pub type StagedState = [[f64; ErrorState::DIM]; Stage::ALL.len()];
 
 /// The expected error of every realization, from one noise-free pass, and how well it explains
 /// the ensemble's mean error.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct MeanErrorPrediction {
     /// Predicted mean error m at every fix, [a priori, a posteriori], (m, m/s, m/s²).
-    pub fixes: Vec<[[f64; 3]; 2]>,
+    pub fixes: Vec<StagedState>,
     /// The worst |e_ave − m| / (σ/√N) over fixes, stages and states.
     pub worst_se: f64,
-    /// Predicted average a posteriori NEES at the last fix, 3 + mᵀP⁻¹m.
+    /// Predicted average a posteriori NEES at the last fix, N + mᵀP⁻¹m (N the number of states).
     pub predicted_nees_final: f64,
     /// Measured average a posteriori NEES at the last fix.
     pub measured_nees_final: f64,
 }
 
 /// Collects the error e = δx − δx̂ at every fix.
-struct Errors(Vec<[[f64; 3]; 2]>);
+struct Errors(Vec<StagedState>);
 
 impl Observer for Errors {
     fn fix(&mut self, f: &FixState) {
@@ -35,7 +39,7 @@ impl Observer for Errors {
 /// The mean error every realization of `model` shares: the filter's response to the truth's
 /// deterministic discrepancy from eq. (5), computed by one noise-free pass (the system is
 /// linear, so the expected error is the error of the expected inputs).
-pub fn predicted_mean_error(model: &Model, schedule: &FilterSchedule) -> Vec<[[f64; 3]; 2]> {
+pub fn predicted_mean_error(model: &Model, schedule: &FilterSchedule) -> Vec<StagedState> {
     let mut errors = Errors(Vec::with_capacity(model.timeline.fixes()));
     run_noise_free(model, schedule, &mut errors);
     errors.0
@@ -50,7 +54,7 @@ fn stage_index(stage: Stage) -> usize {
 
 /// Compares the predicted mean error with the measured one.
 pub fn explain_mean_error(
-    predicted: Vec<[[f64; 3]; 2]>,
+    predicted: Vec<StagedState>,
     stats: &EnsembleStats,
     schedule: &FilterSchedule,
 ) -> MeanErrorPrediction {
@@ -72,9 +76,11 @@ pub fn explain_mean_error(
         }
     }
     let last: &FixCovariance = schedule.fixes.last().expect("at least two fixes");
-    let m = Vector3::from(predicted.last().expect("at least two fixes")[1]);
+    let m = StateVector::from(
+        predicted.last().expect("at least two fixes")[stage_index(Stage::Posterior)],
+    );
     MeanErrorPrediction {
-        predicted_nees_final: 3.0 + m.dot(&(last.p_post_inv * m)),
+        predicted_nees_final: ErrorState::DIM as f64 + m.dot(&(last.p_post_inv * m)),
         measured_nees_final: stats
             .fixes
             .last()
@@ -91,7 +97,7 @@ pub fn explain_mean_error(
 ///
 /// # Formula
 /// RMS_k = √((1/N) Σ e_k²) = √(e_ave,k² + (N − 1)/N · P_ave,kk).
-pub fn achieved_rms(stats: &EnsembleStats) -> Vec<[f64; 3]> {
+pub fn achieved_rms(stats: &EnsembleStats) -> Vec<[f64; ErrorState::DIM]> {
     let n = stats.realizations as f64;
     stats
         .fixes
@@ -106,7 +112,7 @@ pub fn achieved_rms(stats: &EnsembleStats) -> Vec<[f64; 3]> {
 }
 
 /// Largest |a posteriori mean error| / σ per state over all fixes.
-pub fn max_mean_over_sigma(stats: &EnsembleStats) -> [f64; 3] {
+pub fn max_mean_over_sigma(stats: &EnsembleStats) -> [f64; ErrorState::DIM] {
     std::array::from_fn(|k| {
         stats
             .fixes

@@ -16,7 +16,9 @@ use crate::model::Model;
 pub use crate::progress::{Progress, Silent};
 use crate::realization::{self, Realization};
 use crate::sensitivity::{self, Plan, Sensitivity, SensitivityError};
-pub use analysis::{MeanErrorPrediction, max_mean_over_sigma};
+use crate::state::ErrorState;
+
+pub use analysis::{MeanErrorPrediction, StagedState, max_mean_over_sigma};
 
 /// The samples of the recorded realization that the report keeps, at most about: a run with
 /// more is thinned to what its figures can show.
@@ -32,16 +34,16 @@ pub struct CaseOutcome {
     /// The checks' verdicts.
     pub verdicts: Verdicts,
     /// Largest |a posteriori mean error| / σ per state over all fixes (σ the filter's).
-    pub max_mean_over_sigma: [f64; 3],
+    pub max_mean_over_sigma: [f64; ErrorState::DIM],
     /// The predicted mean error and how well it explains the measured one.
     pub prediction: MeanErrorPrediction,
     /// Achieved RMS a posteriori error of each state at every fix, (m, m/s, m/s²).
-    pub achieved_rms: Vec<[f64; 3]>,
+    pub achieved_rms: Vec<[f64; ErrorState::DIM]>,
 }
 
 impl CaseOutcome {
     /// The achieved RMS error at the last fix.
-    pub fn achieved_rms_final(&self) -> [f64; 3] {
+    pub fn achieved_rms_final(&self) -> [f64; ErrorState::DIM] {
         *self.achieved_rms.last().expect("at least two fixes")
     }
 }

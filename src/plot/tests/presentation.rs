@@ -4,6 +4,7 @@
 use plotters::style::RGBColor;
 
 use super::*;
+use crate::state::ErrorState;
 
 /// No figure shows ASCII sub- or superscript notation ("e_ave", "t^2") or markup left
 /// unconverted ("p_{c}"): scripts are `<tspan>`s, shifted and smaller.
@@ -229,7 +230,7 @@ fn titles_say_what_the_axes_clip() {
     let mut calm = study.realization.clone();
     for s in &mut calm.samples {
         s.estimate = s.delta_x;
-        s.sigma = [1.0; 3];
+        s.sigma = [1.0; ErrorState::DIM];
     }
     let svg = trajectory(&calm).unwrap();
     assert_eq!(
@@ -242,7 +243,7 @@ fn titles_say_what_the_axes_clip() {
     );
     // The bias estimate far off at the second sample: clipped until the third, at 0.01 s.
     let mut wild = calm.clone();
-    wild.samples[1].estimate[2] = 1e3;
+    wild.samples[1].estimate[ErrorState::BIAS] = 1e3;
     assert!(wild.samples[2].t_s <= 0.1);
     assert_eq!(
         title_with(&trajectory(&wild).unwrap(), "Bias b"),
@@ -253,7 +254,7 @@ fn titles_say_what_the_axes_clip() {
         "Bias: error and ±1σ (error off the axis before 0.1 s)"
     );
     // A σ too large early on, as the prior's is.
-    wild.samples[3].sigma[2] = 1e3;
+    wild.samples[3].sigma[ErrorState::BIAS] = 1e3;
     assert!(wild.samples[4].t_s <= 0.1);
     assert_eq!(
         title_with(&realization_errors(&wild).unwrap(), "Bias:"),
@@ -270,7 +271,9 @@ fn consistency_far_from_its_band_gets_a_log_axis_and_the_band_enlarged() {
     let (nees, nis) = (check(study, CheckId::NEES), check(study, CheckId::NIS));
     let mut near = study.case(CASE).run.stats.clone();
     for f in &mut near.fixes {
-        (f.prior.nees_avg, f.post.nees_avg, f.nis_avg) = (3.0, 3.0, 2.0);
+        // Each at its expected value: the number of states, of measured components.
+        let (states, measured) = (ErrorState::DIM as f64, ErrorState::MEAS as f64);
+        (f.prior.nees_avg, f.post.nees_avg, f.nis_avg) = (states, states, measured);
     }
     let titles = |stats| {
         texts(&consistency(stats, nees, nis).unwrap())
