@@ -25,13 +25,17 @@ fn study() -> &'static Study {
     })
 }
 
-fn render(study: &Study, outline: &Outline) -> Page {
-    let input = ReportInput {
+fn input(study: &Study) -> ReportInput<'_> {
+    ReportInput {
         study,
         command: "accelcal report",
         threads: 1,
-    };
-    report::render_outline(&input, outline).unwrap()
+        static_noise: None,
+    }
+}
+
+fn render(study: &Study, outline: &Outline) -> Page {
+    report::render_outline(&input(study), outline).unwrap()
 }
 
 /// The numbers following `marker` in `html`, in the order the page shows them.
@@ -105,7 +109,7 @@ fn case_tables(view: &ReportView) -> Vec<(String, usize)> {
 #[test]
 fn moving_a_section_renumbers_the_page_and_the_contents_follow() {
     let study = study();
-    let standard = report::outline_of(study);
+    let standard = report::outline_of(&input(study));
     let page = render(study, &standard);
     assert_numbered_in_reading_order(&page.html);
     assert_contents_follow(&page);
@@ -203,7 +207,7 @@ fn a_check_added_to_the_catalogue_shows_up_in_every_table_and_count() {
         assert!((o.verdicts.false_alarm_rate - alpha).abs() < 1e-15);
         assert_eq!(o.verdicts.checks.len(), CATALOGUE.len() + 1);
     }
-    let page = render(&study, &report::outline_of(&study));
+    let page = render(&study, &report::outline_of(&input(&study)));
     let n = catalogue.len().to_string();
     let id = POSTERIOR_NEES.id;
     let mut seen = 0;

@@ -206,7 +206,7 @@ fn data(svg: &mut String, f: &Frame, a: &Analysis) {
 pub fn allan_plot(a: &Analysis) -> String {
     let f = frame(a);
     let mut svg = format!(
-        r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {WIDTH_PX} {HEIGHT_PX}" width="{WIDTH_PX}" height="{HEIGHT_PX}" font-family="{FONT_FAMILY}" role="img" aria-label="Allan deviation against averaging time, log–log">"#
+        r#"<svg viewBox="0 0 {WIDTH_PX} {HEIGHT_PX}" width="{WIDTH_PX}" height="{HEIGHT_PX}" font-family="{FONT_FAMILY}" role="img" aria-label="Allan deviation against averaging time, log–log">"#
     );
     axes(&mut svg, &f);
     term_lines(&mut svg, &f, a);

@@ -19,14 +19,14 @@ use anyhow::Result;
 pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
     let model = load_model(&args.model, &CaseArgs::default(), args.realizations)?;
     let mut bar = Bar::new(args.model.quiet);
-    let study = Study::run(&model, &mut bar)?
-        .with_sensitivity(&mut bar)?
-        .with_static_noise()?;
+    let study = Study::run(&model, &mut bar)?.with_sensitivity(&mut bar)?;
+    let static_noise = accelcal::allan::section::report_coverage()?;
     let command = reproduce_command(args);
     let page = report::render(&report::ReportInput {
         study: &study,
         command: &command,
         threads: rayon::current_num_threads(),
+        static_noise: Some(&static_noise),
     })?;
     let data = export::report_data_json(&study);
     write_all_atomic(

@@ -81,6 +81,9 @@ pub struct ReportInput<'a> {
     pub command: &'a str,
     /// Threads the ensembles ran on (the run times depend on it, the numbers do not).
     pub threads: usize,
+    /// The coverage of `accelcal allan`'s intervals over simulated static logs
+    /// ([`crate::allan::section::report_coverage`]); the page has its section when given.
+    pub static_noise: Option<&'a crate::allan::section::Coverage>,
 }
 
 /// Builds the view of `input`, its sections in the order of `outline`.
@@ -134,13 +137,13 @@ pub fn build(
     })
 }
 
-/// The outline of the report of `study`: every case, and the sensitivity section when the
-/// study ran it.
-pub fn outline_of(study: &Study) -> Outline {
+/// The outline of the report of `input`: every case, the sensitivity section when the study ran
+/// it, the static-noise section when its coverage is given.
+pub fn outline_of(input: &ReportInput) -> Outline {
     Outline::standard(
-        study.cases.len(),
-        study.sensitivity.is_some(),
-        study.static_noise.is_some(),
+        input.study.cases.len(),
+        input.study.sensitivity.is_some(),
+        input.static_noise.is_some(),
     )
 }
 
@@ -149,7 +152,7 @@ pub fn outline_of(study: &Study) -> Outline {
 /// # Errors
 /// [`RenderError`] when a figure cannot be drawn or the templates cannot be filled.
 pub fn render(input: &ReportInput) -> Result<Page, RenderError> {
-    render_outline(input, &outline_of(input.study))
+    render_outline(input, &outline_of(input))
 }
 
 /// Renders the report of `input` with its sections in the order of `outline`.

@@ -37,14 +37,13 @@ impl Context<'_> {
     /// coverage the study measured.
     ///
     /// # Panics
-    /// When the study did not run the static-noise study.
+    /// When the input holds no static-noise coverage.
     fn static_noise(&self) -> Result<AllanSection, RenderError> {
         use crate::allan::section::{REPORT_LOG, REPORT_SAMPLES, section};
         let coverage = self
-            .study()
+            .input
             .static_noise
-            .as_ref()
-            .expect("the outline shows the static noise only when the study ran it");
+            .expect("the outline shows the static noise only when its coverage is given");
         let n = self.numbers;
         let figure = n.figure(Figure::AllanDeviation);
         let table = n.table(Table::StaticNoise);

@@ -74,10 +74,6 @@ pub fn judge_case(model: &Model, schedule: &FilterSchedule, run: EnsembleRun) ->
     }
 }
 
-/// Simulated static logs of the report's validation of `accelcal allan`: enough for a coverage
-/// of 95 % intervals to be judged inside a binomial band at 1 % (about 4 s on 2 cores).
-pub const STATIC_NOISE_SEEDS: u64 = 100;
-
 /// Everything the report shows.
 #[derive(Clone, Debug)]
 pub struct Study {
@@ -95,9 +91,6 @@ pub struct Study {
     pub realization_case: Case,
     /// The sensitivity to the assumed statistics, when it was run ([`Study::with_sensitivity`]).
     pub sensitivity: Option<Sensitivity>,
-    /// The coverage of the noise terms fitted to simulated static logs
-    /// ([`Study::with_static_noise`]).
-    pub static_noise: Option<crate::allan::section::Coverage>,
 }
 
 impl Study {
@@ -141,7 +134,6 @@ impl Study {
             realization,
             realization_case,
             sensitivity: None,
-            static_noise: None,
         })
     }
 
@@ -155,19 +147,6 @@ impl Study {
     ) -> Result<Self, SensitivityError> {
         let config = &self.model.config;
         self.sensitivity = Some(sensitivity::run(config, &Plan::of(config), progress)?);
-        Ok(self)
-    }
-
-    /// The study with the validation of `accelcal allan`: the intervals of the noise terms fitted
-    /// to [`STATIC_NOISE_SEEDS`] simulated static logs (white noise and a random walk of known
-    /// levels), how often they contain the truth.
-    ///
-    /// # Errors
-    /// [`AllanError`](crate::allan::AllanError) when a simulated log cannot be analysed.
-    pub fn with_static_noise(mut self) -> Result<Self, crate::allan::AllanError> {
-        use crate::allan::section::{REPORT_LOG, REPORT_SAMPLES, coverage};
-        let c = coverage(&REPORT_LOG, STATIC_NOISE_SEEDS, REPORT_SAMPLES, 0.95, 0.01)?;
-        self.static_noise = Some(c);
         Ok(self)
     }
 
