@@ -91,6 +91,16 @@ struct Pair {
 }
 
 impl Pair {
+    /// The pair of averaging factors `m_a`, `m_b` over `samples` rate samples with `levels`.
+    fn new(samples: usize, m_a: usize, m_b: usize, levels: &NoiseLevels) -> Self {
+        Pair {
+            a: filters(m_a as f64, levels),
+            b: filters(m_b as f64, levels),
+            terms_a: (samples + 1 - 2 * m_a) as f64,
+            terms_b: (samples + 1 - 2 * m_b) as f64,
+        }
+    }
+
     /// c_ab(h): the covariance of d^a_0 and d^b_h.
     fn c(&self, h: f64) -> f64 {
         let mut total = 0.0;
@@ -176,12 +186,7 @@ fn stretch_sum(pair: &Pair, lo: f64, hi: f64) -> f64 {
 /// the noise `levels`, (unit of y)⁴.
 pub fn avar_covariance(samples: usize, m_a: usize, m_b: usize, levels: &NoiseLevels) -> f64 {
     let (ma, mb) = (m_a as f64, m_b as f64);
-    let pair = Pair {
-        a: filters(ma, levels),
-        b: filters(mb, levels),
-        terms_a: (samples + 1 - 2 * m_a) as f64,
-        terms_b: (samples + 1 - 2 * m_b) as f64,
-    };
+    let pair = Pair::new(samples, m_a, m_b, levels);
     let (first, last) = (-2.0 * mb - 1.0, 2.0 * ma + 2.0);
     let mut cuts: Vec<f64> = pair
         .breaks()
@@ -222,12 +227,7 @@ mod tests {
     /// The same sum over every lag, term by term.
     fn brute(samples: usize, m_a: usize, m_b: usize, levels: &NoiseLevels) -> f64 {
         let (ma, mb) = (m_a as f64, m_b as f64);
-        let pair = Pair {
-            a: filters(ma, levels),
-            b: filters(mb, levels),
-            terms_a: (samples + 1 - 2 * m_a) as f64,
-            terms_b: (samples + 1 - 2 * m_b) as f64,
-        };
+        let pair = Pair::new(samples, m_a, m_b, levels);
         let mut s = 0.0;
         let mut h = -2.0 * mb - 2.0;
         while h < 2.0 * ma + 3.0 {
