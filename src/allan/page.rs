@@ -70,12 +70,18 @@ pub struct AllanPage<'a> {
 
 fn range(t: &TermEstimate, scale: f64, digits: usize) -> String {
     match (t.value, t.lower) {
-        (Some(v), Some(lo)) => format!(
-            "{} [{}, {}]",
-            sig(v * scale, digits),
-            sig(lo * scale, digits),
-            sig(t.upper * scale, digits)
-        ),
+        (Some(v), Some(lo)) => {
+            let [v, lo, hi] = [v, lo, t.upper].map(|x| x * scale);
+            // Enough digits that an interval narrower than the last digit still shows its ends
+            // apart from the estimate (at most three more).
+            let apart = |d: usize| {
+                (lo == v || sig(lo, d) != sig(v, d)) && (hi == v || sig(hi, d) != sig(v, d))
+            };
+            let d = (digits..digits + 4)
+                .find(|&d| apart(d))
+                .unwrap_or(digits + 3);
+            format!("{} [{}, {}]", sig(v, d), sig(lo, d), sig(hi, d))
+        }
         _ => format!("unresolved, ≤ {}", sig(t.upper * scale, digits)),
     }
 }
