@@ -75,7 +75,7 @@ pub struct LaneFix {
 struct LaneStage {
     e: [Lanes; DIM],
     ee: [Lanes; UPPER_LEN],
-    /// Σ e·δx̂ᵀ, column-major like [`Matrix3`].
+    /// Σ e·δx̂ᵀ, column-major like nalgebra's matrices.
     ex: [Lanes; DIM * DIM],
     x: [Lanes; DIM],
     xx: [Lanes; DIM],

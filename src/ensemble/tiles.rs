@@ -119,7 +119,7 @@ pub(super) fn add_products(
     );
 }
 
-/// A tile kernel: adds Σ_q rows_q[OFF + r]·cols_q[c] for r < ROWS, c < PANEL to the tile, summed
+/// A tile kernel: adds Σ_q rows_q\[OFF + r\]·cols_q\[c\] for r < ROWS, c < PANEL to the tile, summed
 /// over q in order in single precision, each product added with one rounding (a fused
 /// multiply-add), then added to the tile's double-precision sums.
 type Kernel = fn(&mut [f64; TILE], &[f32], &[f32]);

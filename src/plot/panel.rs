@@ -109,7 +109,7 @@ pub(crate) fn columns<'b>(area: &Area<'b>, widths: &[u32]) -> Vec<Area<'b>> {
 /// How a panel is laid out.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Layout {
-    /// Width of the left label area, px (see [`y_label_area`]).
+    /// Width of the left label area, px (see [`super::axis::y_label_area`]).
     pub y_area_px: u32,
     /// Whether the x axis shows its title under the tick labels.
     pub x_title: bool,

@@ -149,7 +149,7 @@ impl Sampler {
         }
     }
 
-    /// One draw of the sums of an ensemble, as [`crate::ensemble::run`] would add them up, from
+    /// One draw of the sums of an ensemble, as [`crate::ensemble::Ensemble::sums`] would add them up, from
     /// the engines' generator `rng`: its ziggurat for the normal numbers, and `rand_distr`'s χ²
     /// on its bits for the Bartlett factors.
     pub fn draw(&self, rng: &mut Stream) -> Accumulator {

@@ -4,7 +4,7 @@
 //! `accelcal-partial 1`, a JSON header line describing the ensemble and the shard, then for every
 //! block its index and its sums as little-endian 64-bit floats, in a fixed order. Floats are
 //! stored bit for bit, so merging the shards in block order gives the sums of one run, number for
-//! number ([`merge`]).
+//! number ([`merge()`]).
 
 use std::io::{Read, Write};
 
