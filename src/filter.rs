@@ -13,14 +13,7 @@ use crate::lanes::Real;
 use crate::model::{NoiseStats, Timeline};
 use crate::state::{ErrorState, StateModel};
 
-pub use crate::state::{
-    MeasMatrix as Matrix2, MeasVector as Vector2, StateMatrix as Matrix3, StateVector as Vector3,
-    process_noise, transition,
-};
-/// Measurement matrix H of the error state.
-pub type Matrix2x3 = SMatrix<f64, { ErrorState::MEAS }, { ErrorState::DIM }>;
-/// Kalman gain K of the error state.
-pub type Matrix3x2 = SMatrix<f64, { ErrorState::DIM }, { ErrorState::MEAS }>;
+pub use crate::state::{process_noise, transition};
 
 /// Before or after the measurement update at a fix.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -159,6 +152,8 @@ impl FixCovariance {
         [T; ErrorState::DIM],
         [T; ErrorState::MEAS],
     ) {
+        // Written out for the error state's three states and two measured components.
+        const _: () = assert!(ErrorState::DIM == 3 && ErrorState::MEAS == 2);
         let phi = &self.phi_from_previous;
         // Written out row by row (no `std::array::from_fn`), so that every operation is inlined
         // into the vectorized callers.
@@ -330,11 +325,12 @@ mod tests {
     use super::*;
     use crate::config::Config;
     use crate::model::Model;
+    use crate::state::StateMatrix;
 
     #[test]
     fn composed_transition_is_exact() {
         let phi = transition(0.005);
-        let mut acc = Matrix3::identity();
+        let mut acc = StateMatrix::identity();
         for _ in 0..40 {
             acc = phi * acc;
         }
@@ -354,7 +350,7 @@ mod tests {
                 .try_inverse()
                 .unwrap();
         assert!((k - f.gain).norm() < 1e-12 * k.norm());
-        let short = (Matrix3::identity() - k * h) * f.p_prior;
+        let short = (StateMatrix::identity() - k * h) * f.p_prior;
         assert!((short - f.p_post).norm() < 1e-9 * f.p_post.norm());
     }
 }

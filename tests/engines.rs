@@ -16,9 +16,10 @@ use accelcal::checks::{Budget, evaluate};
 use accelcal::config::{AccelerometerOutput, Case, Config, TruthModel};
 use accelcal::ensemble::epoch::{EpochPlan, interval_noise, interval_noise_by_steps};
 use accelcal::ensemble::{Engine, Ensemble, EnsembleStats, StageStats, kernel};
-use accelcal::filter::{FilterSchedule, Matrix3, Stage};
+use accelcal::filter::{FilterSchedule, Stage};
 use accelcal::model::Model;
 use accelcal::simulation::{FixState, Observer, run_realization, stream_key};
+use accelcal::state::{StateMatrix, StateVector};
 
 const ALL_CASES: [Case; 4] = [
     Case {
@@ -208,8 +209,8 @@ fn two_sample_scores(
                     / (1.0 / (na - 3.0) + 1.0 / (nb - 3.0)).sqrt();
                 out.push((format!("fix {i} {stage:?} correlation {r}{c}"), z));
             }
-            let cov = Matrix3::from_fn(|r, c| x.ensemble_cov[r][c]);
-            let mu = accelcal::filter::Vector3::from(x.mean_error);
+            let cov = StateMatrix::from_fn(|r, c| x.ensemble_cov[r][c]);
+            let mu = StateVector::from(x.mean_error);
             let p_inv = p.try_inverse().expect("P is positive definite");
             let pc = p_inv * cov;
             let var = 2.0 * (pc * pc).trace() + 4.0 * (mu.transpose() * pc * p_inv * mu)[0];

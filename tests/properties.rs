@@ -48,7 +48,7 @@ fn config_strategy() -> impl Strategy<Value = Config> {
         })
 }
 
-fn assert_spd(p: &accelcal::filter::Matrix3, what: &str) {
+fn assert_spd(p: &accelcal::state::StateMatrix, what: &str) {
     let asym = (p - p.transpose()).abs().max();
     assert!(asym <= 1e-12 * p.abs().max(), "{what}: asymmetry {asym}");
     assert!(p.cholesky().is_some(), "{what}: not positive definite: {p}");

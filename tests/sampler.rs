@@ -45,7 +45,7 @@ fn draws() -> (Vec<EnsembleStats>, Vec<Stages>, Vec<Stages>, Vec<f64>) {
         .map(|_| EnsembleStats::from_sums(&sampler.draw(&mut rng), &schedule))
         .collect();
     let actual = actual_covariance(&model.timeline, &schedule, &model.truth_stats);
-    let diag = |p: &accelcal::filter::Matrix3| std::array::from_fn(|k| p[(k, k)]);
+    let diag = |p: &accelcal::state::StateMatrix| std::array::from_fn(|k| p[(k, k)]);
     let actual_var = actual
         .iter()
         .map(|a| [diag(&a.prior), diag(&a.post)])

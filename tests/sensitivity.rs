@@ -13,7 +13,7 @@ use accelcal::study::Silent;
 use common::plain::{M3, mul, transpose};
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
-type M3x = accelcal::filter::Matrix3;
+type M3x = accelcal::state::StateMatrix;
 
 fn add(a: &M3, b: &M3) -> M3 {
     std::array::from_fn(|i| std::array::from_fn(|j| a[i][j] + b[i][j]))

@@ -3,6 +3,7 @@ use crate::config::Config;
 use crate::ensemble::{Ensemble, EnsembleStats};
 use crate::filter::{FilterSchedule, Stage};
 use crate::model::Model;
+use crate::state::ErrorState;
 
 /// The statistics of a seeded ensemble of `n` realizations of a `duration_s` run (euler truth).
 fn stats_of(duration_s: f64, n: u64) -> EnsembleStats {
@@ -40,11 +41,12 @@ fn copies_of_the_bias_are_counted_once() {
     // The copies really are copies: same statistics.
     for i in 1..stats.fixes.len() {
         let (prior, post) = (&stats.fixes[i].prior, &stats.fixes[i - 1].post);
-        assert_eq!(prior.mean_error[2], post.mean_error[2]);
-        assert_eq!(prior.ensemble_cov[2][2], post.ensemble_cov[2][2]);
+        let b = ErrorState::BIAS;
+        assert_eq!(prior.mean_error[b], post.mean_error[b]);
+        assert_eq!(prior.ensemble_cov[b][b], post.ensemble_cov[b][b]);
         assert_eq!(
-            prior.orthogonality_corr[2][2],
-            post.orthogonality_corr[2][2]
+            prior.orthogonality_corr[b][b],
+            post.orthogonality_corr[b][b]
         );
     }
 }

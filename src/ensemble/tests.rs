@@ -1,8 +1,8 @@
 use super::*;
 
 use crate::config::Config;
-use crate::filter::Vector3;
 use crate::simulation::{FixState, Observer, run_realization};
+use crate::state::{ErrorState, StateVector};
 
 fn small() -> (Model, FilterSchedule) {
     let mut c = Config::default();
@@ -84,21 +84,22 @@ fn streaming_moments_match_a_two_pass_computation() {
         })
         .collect();
     let i = 4;
-    let errs: Vec<Vector3> = runs.iter().map(|r| r[i].delta_x - r[i].post).collect();
-    let mean = errs.iter().sum::<Vector3>() / n as f64;
+    let errs: Vec<StateVector> = runs.iter().map(|r| r[i].delta_x - r[i].post).collect();
+    let mean = errs.iter().sum::<StateVector>() / n as f64;
     let var_v = errs.iter().map(|e| (e[1] - mean[1]).powi(2)).sum::<f64>() / (n as f64 - 1.0);
     let got = &stats.fixes[i].post;
     approx::assert_relative_eq!(got.mean_error[1], mean[1], max_relative = 1e-9);
     approx::assert_relative_eq!(got.ensemble_cov[1][1], var_v, max_relative = 1e-9);
     // Orthogonality (1/N) Σ (e − ē) x̂ᵀ, entry (velocity error, bias estimate).
-    let xs: Vec<Vector3> = runs.iter().map(|r| r[i].post).collect();
+    let xs: Vec<StateVector> = runs.iter().map(|r| r[i].post).collect();
+    let (vel, bias) = (ErrorState::VELOCITY, ErrorState::BIAS);
     let ortho = errs
         .iter()
         .zip(&xs)
-        .map(|(e, x)| (e[1] - mean[1]) * x[2])
+        .map(|(e, x)| (e[vel] - mean[vel]) * x[bias])
         .sum::<f64>()
         / n as f64;
-    approx::assert_relative_eq!(got.orthogonality[1][2], ortho, max_relative = 1e-8);
+    approx::assert_relative_eq!(got.orthogonality[vel][bias], ortho, max_relative = 1e-8);
     // NEES (1/N) Σ eᵀ P⁻¹ e with the filter's a posteriori P.
     let p_inv = s.fixes[i].p_post.try_inverse().unwrap();
     let nees = errs.iter().map(|e| e.dot(&(p_inv * e))).sum::<f64>() / n as f64;

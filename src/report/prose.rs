@@ -83,19 +83,18 @@ pub fn and_list(items: &[String]) -> String {
 }
 
 /// The filter's a posteriori σ at the last fix, per state.
-pub fn claimed_sigma(study: &Study) -> [f64; 3] {
+pub fn claimed_sigma(study: &Study) -> [f64; ErrorState::DIM] {
     let last = study.schedule.fixes.last().expect("at least two fixes");
     std::array::from_fn(|k| last.p_post[(k, k)].sqrt())
 }
 
-const UNITS: [&str; 3] = ["m", "m/s", "m/s²"];
-const STATES: [&str; 3] = ["position", "velocity", "bias"];
-
 /// "0.098 m, 0.0069 m/s and 4.7 × 10⁻⁴ m/s²".
-fn per_state(x: [f64; 3]) -> String {
+fn per_state(x: [f64; ErrorState::DIM]) -> String {
     and_list(
-        &(0..3)
-            .map(|k| format!("{} {}", sig(x[k], 2), UNITS[k]))
+        &ErrorState::VARIABLES
+            .iter()
+            .zip(x)
+            .map(|(v, x)| format!("{} {}", sig(x, 2), v.unit))
             .collect::<Vec<_>>(),
     )
 }
@@ -104,11 +103,11 @@ fn per_state(x: [f64; 3]) -> String {
 fn accuracy_sentence(study: &Study, o: &CaseOutcome) -> String {
     let claimed = claimed_sigma(study);
     let achieved = o.achieved_rms_final();
-    let ratio: [f64; 3] = std::array::from_fn(|k| achieved[k] / claimed[k]);
+    let ratio: [f64; ErrorState::DIM] = std::array::from_fn(|k| achieved[k] / claimed[k]);
     let end = fixed(study.schedule.fixes.last().expect("fixes").time_s, 0);
-    let worst = (0..3)
+    let worst = (0..ErrorState::DIM)
         .max_by(|&a, &b| (ratio[a] - 1.0).abs().total_cmp(&(ratio[b] - 1.0).abs()))
-        .expect("three states");
+        .expect("a state");
     if (ratio[worst] - 1.0).abs() <= 0.05 {
         format!(
             "With {}, the achieved RMS errors at {end} s are {}, within {} % of the filter's σ.",
@@ -125,13 +124,13 @@ fn accuracy_sentence(study: &Study, o: &CaseOutcome) -> String {
                 .map(|(rms, f)| (rms[k] / f.p_post[(k, k)].sqrt(), f.time_s))
                 .fold((0.0, 0.0), |best, x| if x.0 > best.0 { x } else { best })
         };
-        let off: Vec<String> = (0..3)
+        let off: Vec<String> = (0..ErrorState::DIM)
             .filter(|&k| (ratio[k] - 1.0).abs() > 0.05 || k == worst)
             .map(|k| {
                 let (p, t) = peak(k);
                 format!(
                     "its {} error is {} times its claim ({} at its worst, at {} s)",
-                    STATES[k],
+                    ErrorState::VARIABLES[k].key,
                     fixed(ratio[k], 2),
                     fixed(p, 2),
                     fixed(t, 1)

@@ -11,6 +11,7 @@ use crate::ensemble::Engine;
 use crate::format::{count, fixed, short, sig};
 use crate::plot::{self, SensitivitySeries};
 use crate::sensitivity::{AssumedStatistic, Sensitivity, SensitivityCase};
+use crate::state::ErrorState;
 
 /// Whether check `id` surely detects case `c`: its detection probability is at least 0.95 by a
 /// bound that holds with 95 % confidence (exact, sampled or measured).
@@ -46,12 +47,12 @@ fn capitalized(s: &str) -> String {
 
 fn findings(s: &Sensitivity) -> Vec<String> {
     let params = parameters(s);
-    let tuned_bias = s.tuned_sigma_final[2];
+    let tuned_bias = s.tuned_sigma_final[ErrorState::BIAS];
     // How much each assumption moves the actual bias σ at the last fix.
     let bias_change = |p: AssumedStatistic| {
         cases_of(s, p)
             .iter()
-            .map(|c| (c.actual_sigma_final[2] / tuned_bias - 1.0).abs())
+            .map(|c| (c.actual_sigma_final[ErrorState::BIAS] / tuned_bias - 1.0).abs())
             .fold(0.0, f64::max)
     };
     let (matter, wash): (Vec<AssumedStatistic>, Vec<AssumedStatistic>) =
@@ -181,8 +182,14 @@ pub fn view(s: &Sensitivity, numbers: &Numbers) -> Result<SensitivityView, Rende
             parameter: capitalized(c.parameter.title()),
             factor: short(c.factor),
             expected_nees: fixed(c.expected_nees_final, 2),
-            bias_ratio: fixed(c.actual_sigma_final[2] / c.claimed_sigma_final[2], 3),
-            bias_vs_tuned: fixed(c.actual_sigma_final[2] / s.tuned_sigma_final[2], 3),
+            bias_ratio: fixed(
+                c.actual_sigma_final[ErrorState::BIAS] / c.claimed_sigma_final[ErrorState::BIAS],
+                3,
+            ),
+            bias_vs_tuned: fixed(
+                c.actual_sigma_final[ErrorState::BIAS] / s.tuned_sigma_final[ErrorState::BIAS],
+                3,
+            ),
             cells: CheckId::ALL.iter().map(|&id| cell(c, id)).collect(),
         })
         .collect();

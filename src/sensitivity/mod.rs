@@ -21,6 +21,7 @@ use crate::error::{ConfigError, FilterError};
 use crate::filter::FilterSchedule;
 use crate::model::Model;
 use crate::progress::Progress;
+use crate::state::ErrorState;
 pub use covariance::{ActualFix, SampleCovariance, actual_covariance, covariance_at_samples};
 pub use detection::Detection;
 
@@ -179,9 +180,9 @@ pub struct SensitivityCase {
     /// The factor on its standard deviation.
     pub factor: f64,
     /// The filter's σ at the last fix, a posteriori.
-    pub claimed_sigma_final: [f64; 3],
+    pub claimed_sigma_final: [f64; ErrorState::DIM],
     /// The actual error's σ at the last fix, a posteriori.
-    pub actual_sigma_final: [f64; 3],
+    pub actual_sigma_final: [f64; ErrorState::DIM],
     /// Expected average a posteriori NEES at the last fix, tr(P⁻¹·P_actual).
     pub expected_nees_final: f64,
     /// Expected average NIS at the last fix, tr(S⁻¹·S_actual).
@@ -243,7 +244,7 @@ pub struct Sensitivity {
     /// The study-wide false-alarm rate of the checks.
     pub false_alarm_rate: f64,
     /// The filter's σ at the last fix when it assumes the configured statistics.
-    pub tuned_sigma_final: [f64; 3],
+    pub tuned_sigma_final: [f64; ErrorState::DIM],
     /// One per statistic and factor, statistics outer.
     pub cases: Vec<SensitivityCase>,
 }
@@ -258,7 +259,7 @@ fn world(config: &Config, realizations: u64) -> Config {
 }
 
 /// σ of the diagonal of `p`.
-fn sigma(p: &crate::filter::Matrix3) -> [f64; 3] {
+fn sigma(p: &crate::state::StateMatrix) -> [f64; ErrorState::DIM] {
     std::array::from_fn(|k| p[(k, k)].sqrt())
 }
 
