@@ -258,26 +258,40 @@ fn a_four_state_filter_that_underrates_the_scale_factor_fails() {
     );
 }
 
-/// The same model-exact engine on the error state itself: its sums equal those of an ensemble
-/// of the same law (the sample mean of the bias error is a standard normal score).
-#[test]
-fn the_model_exact_engine_runs_the_error_state_too() {
+/// The verdicts of the model-exact engine on the error state: the truth with `truth_stats`, the
+/// filter with the model's.
+fn error_state_verdicts(truth_stats: NoiseStats) -> checks::Verdicts {
     let model = model();
-    let truth = ErrorState {
-        stats: model.truth_stats,
+    let truth = ErrorState { stats: truth_stats };
+    let filter = ErrorState {
+        stats: model.filter_stats,
     };
-    let schedule = FilterSchedule::of(&truth, &model.timeline).unwrap();
+    let schedule = FilterSchedule::of(&filter, &model.timeline).unwrap();
     let run = LinearRun {
-        realizations: 1_000,
+        realizations: 2_000,
         seed: 3,
-        max_lag: Some(2),
+        max_lag: model.residual_max_lag(),
         pair: model.residual_pair,
     };
     let sums = linear::run(&truth, &schedule, &model.timeline, &run);
     let stats: EnsembleStats = EnsembleStats::from_sums(&sums, &schedule);
-    let last = stats.fixes.last().unwrap();
-    let k = ErrorState::BIAS;
-    let z = last.post.mean_error[k] / (last.post.filter_cov[k][k] / 1_000.0).sqrt();
-    // Two-sided at 1e-6: a consistent engine fails this once in a million seeds.
-    assert!(z.abs() < 4.89, "z = {z}");
+    let budget = Budget::study(Config::default().checks.false_alarm_rate);
+    checks::evaluate(&stats, &budget)
+}
+
+/// The same model-exact engine on the error state itself: a filter that assumes the truth's
+/// statistics passes every check, and one whose truth has twice the GPS position σ it assumes
+/// fails NIS (the negative control: the engine's truth is the one configured).
+#[test]
+fn the_model_exact_engine_runs_the_error_state_too() {
+    let stats = model().truth_stats;
+    for c in &error_state_verdicts(stats).checks {
+        assert_eq!(c.verdict, Verdict::Pass, "{:?}: {c:?}", c.id);
+    }
+    let noisier = NoiseStats {
+        gps_position_sigma_m: 2.0 * stats.gps_position_sigma_m,
+        ..stats
+    };
+    let v = error_state_verdicts(noisier);
+    assert_eq!(v.get(checks::CheckId::NIS).verdict, Verdict::Fail);
 }
