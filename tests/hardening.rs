@@ -100,3 +100,68 @@ fn the_smallest_accepted_false_alarm_rate_runs() {
     let json = std::fs::read_to_string(dir.path().join("out.json")).unwrap();
     assert!(!json.contains("NaN") && !json.contains("inf"), "{json}");
 }
+
+/// Writes the two shard partials `a.bin` and `b.bin` of a 200-realization ensemble into `dir`.
+fn two_partials(dir: &Path) {
+    for (k, file) in [("1/2", "a.bin"), ("2/2", "b.bin")] {
+        let args = ["ensemble", "--realizations", "200", "-q", "--shard", k];
+        let args = [&args[..], &["--partial", file]].concat();
+        let ended = run_limited(dir, &args, 60);
+        assert_eq!(ended.code, Some(0), "{}", ended.stderr);
+    }
+}
+
+/// Replaces `from` by `to` in the header line (the second line) of the partial `path`.
+fn edit_header(path: &Path, from: &str, to: &str) {
+    let bytes = std::fs::read(path).unwrap();
+    let start = bytes.iter().position(|&b| b == b'\n').unwrap() + 1;
+    let end = start + bytes[start..].iter().position(|&b| b == b'\n').unwrap();
+    let header = std::str::from_utf8(&bytes[start..end]).unwrap();
+    assert!(header.contains(from), "{header}");
+    let edited = header.replacen(from, to, 1);
+    std::fs::write(
+        path,
+        [&bytes[..start], edited.as_bytes(), &bytes[end..]].concat(),
+    )
+    .unwrap();
+}
+
+#[test]
+fn merge_refuses_headers_that_contradict_themselves() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    two_partials(d);
+    // The untouched pair merges (the control).
+    let merge = ["merge", "a.bin", "b.bin", "--json", "m.json", "-q"];
+    let ended = run_limited(d, &merge, 60);
+    assert_eq!(ended.code, Some(0), "{}", ended.stderr);
+    let cases: [(&str, &str, &[&str]); 3] = [
+        // Zero shards divided the blocks by zero.
+        (r#""shards":2"#, r#""shards":0"#, &["a.bin", "shard 1/0"]),
+        // A configuration edited in every file alike: 75 fixes over sums of 150.
+        (
+            r#""duration_s":30.0"#,
+            r#""duration_s":15.0"#,
+            &["a.bin", "75 fixes", "150 fixes"],
+        ),
+        // More shards than blocks: shard 2/9 of 4 blocks.
+        (
+            r#""shards":2"#,
+            r#""shards":9"#,
+            &["a.bin", "shard 1/9", "≤ 4"],
+        ),
+    ];
+    for (from, to, expect) in cases {
+        for file in ["a.bin", "b.bin"] {
+            std::fs::copy(d.join(file), d.join(format!("edited-{file}"))).unwrap();
+            edit_header(&d.join(format!("edited-{file}")), from, to);
+        }
+        let args = ["merge", "edited-a.bin", "edited-b.bin", "--json", "e.json"];
+        let ended = run_limited(d, &args, 60);
+        assert_refused(&ended, expect, &format!("merge with {to}"));
+        assert!(
+            !d.join("e.json").exists(),
+            "a refused merge wrote its output"
+        );
+    }
+}
