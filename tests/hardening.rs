@@ -165,3 +165,109 @@ fn merge_refuses_headers_that_contradict_themselves() {
         );
     }
 }
+
+/// Replaces field `column` (from 0) of line `line` (the header is line 1) of the CSV `path`.
+fn edit_csv(path: &Path, line: usize, column: usize, value: &str) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let edited: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i + 1 != line {
+                return l.to_string();
+            }
+            let mut fields: Vec<&str> = l.split(',').collect();
+            fields[column] = value;
+            fields.join(",")
+        })
+        .collect();
+    std::fs::write(path, edited.join("\n") + "\n").unwrap();
+}
+
+#[test]
+fn calibrate_refuses_values_that_overflow_and_names_their_row() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // The fuzzing reproducer: time stamps ±1e308 hung in the page's axis ticks.
+    std::fs::write(d.join("a.csv"), "t_s,accel_m_s2\n-1e308,1\n1e308,1\n").unwrap();
+    std::fs::write(d.join("g.csv"), "t_s,position_m,velocity_m_s\n0.01,0,100\n").unwrap();
+    let args = [
+        "calibrate",
+        "--accel",
+        "a.csv",
+        "--gps",
+        "g.csv",
+        "--out",
+        "o",
+    ];
+    let ended = run_limited(d, &args, 30);
+    assert_refused(
+        &ended,
+        &["a.csv, line 2", "overflows"],
+        "±1e308 time stamps",
+    );
+    assert!(!d.join("o").exists());
+    let ended = run_limited(d, &["simulate", "--logs", "sim", "-q"], 60);
+    assert_eq!(ended.code, Some(0), "{}", ended.stderr);
+    let (accel, gps) = (d.join("sim/accelerometer.csv"), d.join("sim/gps.csv"));
+    // (file, line, column, value, the words of the message).
+    let cases: [(&Path, usize, usize, &str, &[&str]); 3] = [
+        // One GPS position of 1e308 gave exit 0 with a bias of −9.8e303 and NaN in summary.json.
+        (
+            &gps,
+            11,
+            1,
+            "1e308",
+            &["gps.csv, line 11", "position or velocity"],
+        ),
+        (
+            &gps,
+            151,
+            2,
+            "1e308",
+            &["gps.csv, line 151", "position or velocity"],
+        ),
+        // An acceleration of 1e308 overflows at the next fix: the accelerometer is named.
+        (
+            &accel,
+            500,
+            1,
+            "1e308",
+            &["accelerometer.csv, line 482", "gps.csv line 14"],
+        ),
+    ];
+    for (file, line, column, value, expect) in cases {
+        let kept = std::fs::read(file).unwrap();
+        edit_csv(file, line, column, value);
+        let args = [
+            "calibrate",
+            "--accel",
+            "sim/accelerometer.csv",
+            "--gps",
+            "sim/gps.csv",
+        ];
+        let args = [&args[..], &["--out", "o"]].concat();
+        let ended = run_limited(d, &args, 60);
+        assert_refused(&ended, expect, &format!("{value} at line {line}"));
+        assert!(
+            !d.join("o").exists(),
+            "a refused calibration wrote its outputs"
+        );
+        std::fs::write(file, kept).unwrap();
+    }
+    // The control: the untouched logs calibrate, every number finite.
+    let args = [
+        "calibrate",
+        "--accel",
+        "sim/accelerometer.csv",
+        "--gps",
+        "sim/gps.csv",
+    ];
+    let ended = run_limited(d, &[&args[..], &["--out", "o", "-q"]].concat(), 60);
+    assert_eq!(ended.code, Some(0), "{}", ended.stderr);
+    let summary = std::fs::read_to_string(d.join("o/summary.json")).unwrap();
+    assert!(
+        !summary.contains("null") && !summary.contains("NaN"),
+        "{summary}"
+    );
+}

@@ -115,6 +115,12 @@ pub enum LogProblem {
         /// The field as written.
         text: String,
     },
+    /// A row whose values take the calibration beyond double precision.
+    #[error("the calibration overflows double precision: {what}")]
+    Overflow {
+        /// What overflowed, and which values of the row are to blame.
+        what: String,
+    },
     /// A time stamp not after the one before it.
     #[error(
         "time stamp {t_s} s is not after the previous one, {previous_s} s: time stamps must be \
