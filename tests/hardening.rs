@@ -271,3 +271,31 @@ fn calibrate_refuses_values_that_overflow_and_names_their_row() {
         "{summary}"
     );
 }
+
+#[test]
+fn a_log_header_of_a_million_columns_is_refused_at_once_in_a_short_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let header: Vec<String> = (0..1_000_000).map(|i| format!("c{i}")).collect();
+    std::fs::write(d.join("wide.csv"), header.join(",") + "\n0\n").unwrap();
+    std::fs::write(d.join("g.csv"), "t_s,position_m,velocity_m_s\n0.01,0,100\n").unwrap();
+    let started = Instant::now();
+    let args = [
+        "calibrate",
+        "--accel",
+        "wide.csv",
+        "--gps",
+        "g.csv",
+        "--out",
+        "o",
+    ];
+    let ended = run_limited(d, &args, 30);
+    assert_refused(&ended, &["wide.csv, line 1", "has no column `t_s`"], "wide");
+    assert!(
+        started.elapsed() < Duration::from_secs(10),
+        "{:?}",
+        started.elapsed()
+    );
+    // It echoed all 6.9 MB of the header.
+    assert!(ended.stderr.len() < 1000, "{} bytes", ended.stderr.len());
+}
