@@ -5,6 +5,9 @@
 mod common;
 
 use std::path::Path;
+
+use accelcal::logs::LogProblem;
+use accelcal::logs::read::{AccelReader, LogText};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -298,4 +301,46 @@ fn a_log_header_of_a_million_columns_is_refused_at_once_in_a_short_message() {
     );
     // It echoed all 6.9 MB of the header.
     assert!(ended.stderr.len() < 1000, "{} bytes", ended.stderr.len());
+}
+
+/// A header of `n` columns `c0,c1,…` followed by `last`, and one row.
+fn wide(n: usize, last: &str) -> LogText {
+    let mut header: Vec<String> = (0..n).map(|i| format!("c{i}")).collect();
+    header.push(last.to_string());
+    LogText::new("wide.csv", header.join(",") + "\n0\n")
+}
+
+/// The problem of opening `src` as an accelerometer log, found within 10 s.
+fn problem_within_10_s(src: LogText) -> LogProblem {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || tx.send(AccelReader::open(&src).err().unwrap().problem));
+    rx.recv_timeout(std::time::Duration::from_secs(10))
+        .expect("the header checked within 10 s")
+}
+
+#[test]
+fn a_header_of_a_million_columns_is_checked_at_once_and_quoted_in_short() {
+    // A repeated column at the end: every column is compared (it took minutes).
+    let problem = problem_within_10_s(wide(1_000_000, "c5"));
+    assert_eq!(
+        problem,
+        LogProblem::DuplicateColumn {
+            column: "c5".to_string()
+        }
+    );
+    // No wanted column: the message quotes the header's first characters only.
+    let LogProblem::MissingColumn { found, .. } = problem_within_10_s(wide(1_000_000, "x")) else {
+        panic!("a missing column")
+    };
+    assert!(
+        found.chars().count() < accelcal::logs::MAX_ECHO_CHARS + 40,
+        "{found}"
+    );
+    assert!(found.starts_with("c0,c1,c2,") && found.contains("7888891 characters"));
+    // A short header is quoted whole.
+    let short = LogText::new("a.csv", "t_s,accel\n0,1\n");
+    let Err(e) = AccelReader::open(&short) else {
+        panic!("a missing column")
+    };
+    assert!(matches!(e.problem, LogProblem::MissingColumn { found, .. } if found == "t_s,accel"));
 }
