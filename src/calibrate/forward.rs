@@ -44,6 +44,22 @@ pub struct FilteredFix {
     pub phi_from_previous: StateMatrix,
 }
 
+impl FilteredFix {
+    /// Whether every number the smoother and the report take from the fix is finite.
+    pub fn is_finite(&self) -> bool {
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        self.nis.is_finite()
+            && finite(self.integrated.as_slice())
+            && finite(self.residual.as_slice())
+            && finite(self.s.as_slice())
+            && finite(self.prior.as_slice())
+            && finite(self.post.as_slice())
+            && finite(self.p_prior.as_slice())
+            && finite(self.p_prior_inv.as_slice())
+            && finite(self.p_post.as_slice())
+    }
+}
+
 /// The integration and the filter at the current sample.
 pub(super) struct Forward<'m> {
     model: &'m ErrorStateModel,
@@ -119,6 +135,15 @@ impl<'m> Forward<'m> {
         }
         self.k += 1;
         self.t_s = t_next_s;
+    }
+
+    /// Whether the time stamp, the integration, the estimate and its covariance are finite.
+    pub fn is_finite(&self) -> bool {
+        [self.t_s, self.pc_m, self.vc_m_s]
+            .iter()
+            .chain(self.x.iter())
+            .chain(self.p.iter())
+            .all(|v| v.is_finite())
     }
 
     /// Transition Φ from the current sample to sample `k_to` at `t_to_s`.

@@ -173,6 +173,9 @@ impl Prepared<'_> {
             return Err(changed().into());
         };
         let s = &self.settings;
+        // The accelerometer line of the previous fix: the rows integrated since are behind the
+        // next fix's prediction.
+        let mut since_line = current.line;
         let mut fw = forward::Forward::new(
             &self.model,
             ErrorState {
@@ -189,13 +192,25 @@ impl Prepared<'_> {
                 self.scan.check_step(reader.file(), &current, n)?;
             }
             let fix = match matcher.at_sample(current.t_s, next.map(|n| n.t_s))? {
-                Some(i) => Some(fw.update(&self.scan.gps[i])?),
+                Some(i) => Some(self.update_finite(&mut fw, i, (reader.file(), since_line))?),
                 None => None,
             };
+            if fix.is_some() {
+                since_line = current.line;
+            }
             visit(&fw, fix.as_ref())?;
             match next {
                 Some(n) => {
                     fw.advance(current.accel_m_s2, n.t_s);
+                    // Overflow in the step or the integration: the row integrated is to blame.
+                    if !fw.is_finite() {
+                        let what = "the step to the next row, the integrated velocity and \
+                                    position or their covariance is no longer a finite number: \
+                                    a time stamp or acceleration here is too large"
+                            .to_string();
+                        let problem = LogProblem::Overflow { what };
+                        return Err(LogError::at(reader.file(), current.line, problem).into());
+                    }
                     current = n;
                 }
                 None => break,
@@ -206,6 +221,44 @@ impl Prepared<'_> {
             return Err(changed().into());
         }
         Ok(fw.k + 1)
+    }
+
+    /// The measurement update with fix `i` of the scan; `accel` is the accelerometer log's name
+    /// and the line of the previous fix's sample.
+    ///
+    /// # Errors
+    /// [`FilterError`] as [`forward::Forward::update`]; [`LogProblem::Overflow`] when the fix's
+    /// residual, NIS or estimate is not finite: naming the fix's line when the fix is the larger
+    /// of the fix and the integrated (p_c, v_c) it is compared with, else the accelerometer rows
+    /// integrated since the previous fix.
+    fn update_finite(
+        &self,
+        fw: &mut forward::Forward<'_>,
+        i: usize,
+        (accel, since_line): (&str, u64),
+    ) -> Result<FilteredFix, CalibrateError> {
+        let gps = &self.scan.gps[i];
+        let fix = fw.update(gps)?;
+        if fix.is_finite() {
+            return Ok(fix);
+        }
+        let largest = |v: &[f64]| v.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
+        let error = if largest(fix.z.as_slice()) >= largest(fix.integrated.as_slice()) {
+            let what = "the filter's residual, NIS or estimate at this fix is no longer a \
+                        finite number: its position or velocity is too large"
+                .to_string();
+            LogError::at(&self.scan.gps_name, gps.line, LogProblem::Overflow { what })
+        } else {
+            let what = format!(
+                "the residual of the fix at {} line {} is no longer a finite number: the velocity \
+                 and position integrated from this row to that fix's sample are too large (an \
+                 acceleration of those rows is)",
+                self.scan.gps_name, gps.line
+            );
+            let line = since_line.max(1);
+            LogError::at(accel, line, LogProblem::Overflow { what })
+        };
+        Err(error.into())
     }
 
     /// Pass 3: writes `estimates.csv` to `out`, one row per sample in time order.

@@ -42,7 +42,7 @@ pub struct NisTest {
     pub expected_outside_per_fix: f64,
 }
 
-/// Tests the NIS of every fix, `nis`, at the false-alarm rate `false_alarm_rate` (in (0, 0.5]).
+/// Tests the NIS of every fix, `nis`, at the false-alarm rate `false_alarm_rate` (in [1e-6, 0.5] from the configuration).
 pub fn nis_test(nis: &[f64], false_alarm_rate: f64) -> NisTest {
     let n = nis.len();
     let dof = MEASUREMENT_DIM * n as u64;

@@ -47,6 +47,22 @@ fn line_words(line: &Option<u64>) -> String {
     line.map(|l| format!(", line {l}")).unwrap_or_default()
 }
 
+/// The most characters of a log's text a message quotes.
+pub const MAX_ECHO_CHARS: usize = 200;
+
+/// `text` as a message quotes it: whole up to [`MAX_ECHO_CHARS`] characters, else its first
+/// ones followed by how long it is, so that a hostile header does not flood the terminal.
+pub fn echo(text: &str) -> String {
+    match text.char_indices().nth(MAX_ECHO_CHARS) {
+        None => text.to_string(),
+        Some((end, _)) => format!(
+            "{}… ({} characters in all)",
+            &text[..end],
+            text.chars().count()
+        ),
+    }
+}
+
 /// What is wrong with a log, with what was expected.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum LogProblem {
@@ -114,6 +130,12 @@ pub enum LogProblem {
         column: &'static str,
         /// The field as written.
         text: String,
+    },
+    /// A row whose values take the calibration beyond double precision.
+    #[error("the calibration overflows double precision: {what}")]
+    Overflow {
+        /// What overflowed, and which values of the row are to blame.
+        what: String,
     },
     /// A time stamp not after the one before it.
     #[error(

@@ -7,6 +7,10 @@ use super::{
 };
 use crate::config::Config;
 use crate::error::ConfigError;
+use crate::stats::MIN_ACCURATE_RATE;
+
+/// The smallest accepted `checks.false_alarm_rate` (see [`validate_false_alarm_rate`]).
+const MIN_FALSE_ALARM_RATE: f64 = 1e-6;
 
 /// `x` rounded to the nearest whole number when it is one within [`WHOLE_TOL`].
 pub(super) fn whole(x: f64) -> Option<u64> {
@@ -74,13 +78,7 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
         "sensitivity.draws",
     ])?;
     let k = &c.checks;
-    finite_in(
-        "checks.false_alarm_rate",
-        k.false_alarm_rate,
-        0.0,
-        0.5,
-        true,
-    )?;
+    validate_false_alarm_rate(k.false_alarm_rate)?;
     if k.residual_max_lag == Some(0) {
         return Err(ConfigError::invalid(
             "checks.residual_max_lag",
@@ -90,6 +88,30 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
     }
     validate_sums_memory(c, grid.fixes)?;
     validate_residual_pair(c, &grid)
+}
+
+/// The study-wide false-alarm rate α must be in [[`MIN_FALSE_ALARM_RATE`], 0.5].
+///
+/// Each member of a check is tested at α over the number of checks and over its members, up to
+/// about 10⁷ members within the memory budget of the running sums; at α = 10⁻⁶ those shares stay
+/// above [`MIN_ACCURATE_RATE`], the smallest rate whose normal bound double precision computes
+/// accurately.
+fn validate_false_alarm_rate(alpha: f64) -> Result<(), ConfigError> {
+    if alpha.is_finite() && (MIN_FALSE_ALARM_RATE..=0.5).contains(&alpha) {
+        return Ok(());
+    }
+    Err(ConfigError::invalid(
+        "checks.false_alarm_rate",
+        show(alpha),
+        format!(
+            "must be a finite number in [{}, 0.5]: below {}, the share of each member of a large \
+             check falls under {}, where the normal quantile Φ⁻¹(1 − p/2) is no longer accurate \
+             in double precision",
+            show(MIN_FALSE_ALARM_RATE),
+            show(MIN_FALSE_ALARM_RATE),
+            show(MIN_ACCURATE_RATE)
+        ),
+    ))
 }
 
 /// The time grid a valid configuration has: accelerometer samples, samples per fix, fixes.

@@ -13,6 +13,12 @@ use crate::format::{fixed, power_of_ten};
 /// Length of the tick marks, px; plotters keeps labels two tick lengths from the axis.
 pub(crate) const TICK_PX: i32 = 4;
 
+/// The widest range of a linear axis: plotters searches its ticks (for our labels and for the
+/// grid it draws itself) from a step of 10^⌊log₁₀ width⌋ down by factors of 10, and when the
+/// width overflows (data near ±f64::MAX) that step is ∞ at every turn and the search never ends;
+/// near the overflow its remainders overflow too. Far below it, the search ends.
+const MAX_WIDTH: f64 = 1e300;
+
 /// One axis: its range, its title, and how its ticks are labelled.
 #[derive(Clone, Debug)]
 pub(crate) struct Axis {
@@ -206,9 +212,11 @@ impl Axis {
     }
 }
 
-/// `lo..hi` when it is a finite, non-empty interval; otherwise a small interval around it.
+/// `lo..hi` when it is a finite, non-empty interval; otherwise a small interval around it. Either
+/// no wider than [`MAX_WIDTH`]: a wider one has its ends brought in to ±[`MAX_WIDTH`]/2 (data
+/// beyond are clipped at the edge), so that the tick search ends.
 fn sane_range(lo: f64, hi: f64) -> Range<f64> {
-    match (lo.is_finite(), hi.is_finite()) {
+    let range = match (lo.is_finite(), hi.is_finite()) {
         (true, true) if hi > lo => lo..hi,
         (true, true) => {
             let c = 0.5 * (lo + hi);
@@ -216,7 +224,13 @@ fn sane_range(lo: f64, hi: f64) -> Range<f64> {
             c - h..c + h
         }
         _ => -1.0..1.0,
+    };
+    if range.end - range.start <= MAX_WIDTH {
+        return range;
     }
+    let half = MAX_WIDTH / 2.0;
+    let (lo, hi) = (range.start.clamp(-half, half), range.end.clamp(-half, half));
+    if hi > lo { lo..hi } else { -half..half }
 }
 
 /// Width of the left label area that fits the tick labels and the rotated title of every axis
@@ -265,5 +279,41 @@ mod tests {
         assert_eq!(a.range(), -3.0..2.0);
         let labels: Vec<String> = a.ticks().iter().map(|&v| a.label(v)).collect();
         assert_eq!(labels, ["10⁻³", "10⁻²", "10⁻¹", "1", "10", "10²"]);
+    }
+
+    /// Runs `f` on another thread and fails when it has not returned within 10 s.
+    fn within_10_s<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || tx.send(f()));
+        rx.recv_timeout(std::time::Duration::from_secs(10))
+            .expect("returned within 10 s")
+    }
+
+    #[test]
+    fn ticks_of_any_finite_data_are_found_and_lie_on_the_axis() {
+        let max = f64::MAX;
+        // (range, whether it must have a tick): plotters finds none on a range narrower than
+        // the spacing of the numbers around it, which ends but labels nothing.
+        let ranges = [
+            ((-1e308, 1e308), true),
+            ((-max, max), true),
+            ((0.0, max), true),
+            ((-max, 0.0), true),
+            ((-8e307, 8e307), true),
+            ((-1e-300, 1e-300), true),
+            ((1e300, 1.000_000_1e300), false),
+            ((0.0, 5e-324), false),
+            ((1e308, 1e308), false),
+        ];
+        for ((lo, hi), ticked) in ranges {
+            let axis = within_10_s(move || Axis::linear("x", "m", (lo, hi), 6));
+            let r = axis.range();
+            assert!(r.end - r.start <= MAX_WIDTH, "{r:?}");
+            let ticks = within_10_s(move || axis.ticks());
+            assert!(!ticked || !ticks.is_empty(), "no tick on [{lo:e}, {hi:e}]");
+            for v in ticks {
+                assert!(v.is_finite() && r.start <= v && v <= r.end, "{v} on {r:?}");
+            }
+        }
     }
 }

@@ -6,6 +6,7 @@ use crate::config::Config;
 use crate::ensemble::layout::ResidualLayout;
 use crate::ensemble::sums::Accumulator;
 use crate::ensemble::{Engine, Partition, Shard};
+use crate::model::Model;
 
 /// The dotted path of the first field where `a` and `b` differ.
 fn first_difference(a: &Config, b: &Config) -> String {
@@ -61,14 +62,19 @@ pub fn merge<R: std::io::BufRead>(files: Vec<(String, R)>) -> Result<Merged, Par
         return Err(mismatch("(none)", "no partial file given".to_string()));
     };
     let (first_name, first) = (first.name.clone(), first.header.clone());
+    let partition = Partition::new(first.config.ensemble.realizations);
+    if let Some(why) = header_agrees_with_its_configuration(&first) {
+        return Err(mismatch(&first_name, why));
+    }
     for o in &opened {
-        if let Some(why) = same_ensemble(&o.header, &first, &first_name) {
+        if let Some(why) = same_ensemble(&o.header, &first, &first_name)
+            .or_else(|| shard_of_partition(&o.header, &partition))
+        {
             return Err(mismatch(&o.name, why));
         }
     }
     opened.sort_by_key(|o| o.header.shard);
     every_shard_once(&opened, &first_name, first.shards)?;
-    let partition = Partition::new(first.config.ensemble.realizations);
     let layout = ResidualLayout::new(first.fixes, first.max_lag);
     let mut sums = Accumulator::new(&layout, first.pair);
     let mut elapsed_s = 0.0;
@@ -137,6 +143,46 @@ fn same_ensemble(h: &PartialHeader, first: &PartialHeader, first_name: &str) -> 
     } else {
         None
     }
+}
+
+/// Why the header `h` does not describe the sums its configuration makes, if it does not: the
+/// configuration must be valid and give the header's fixes, residual lag and residual pair (the
+/// shape of every block), so that an edited configuration is never reported over data made with
+/// another.
+fn header_agrees_with_its_configuration(h: &PartialHeader) -> Option<String> {
+    let model = match Model::new(&h.config) {
+        Ok(model) => model,
+        Err(e) => return Some(format!("the configuration in its header is not valid: {e}")),
+    };
+    let layout = ResidualLayout::new(model.timeline.fixes(), model.residual_max_lag());
+    let made = (layout.fixes(), layout.max_lag(), model.residual_pair);
+    let said = (h.fixes, h.max_lag, h.pair);
+    (made != said).then(|| {
+        let lag = |l: Option<usize>| l.map_or("every pair".to_string(), |l| l.to_string());
+        format!(
+            "its header is inconsistent: its configuration makes {} fixes, residual lag {} and \
+             residual pair {:?}, but the header says {} fixes, residual lag {} and pair {:?}",
+            made.0,
+            lag(made.1),
+            made.2,
+            said.0,
+            lag(said.1),
+            said.2
+        )
+    })
+}
+
+/// Why the shard numbers of `h` are not a shard k of m of `partition`, 1 ≤ k ≤ m ≤ its blocks,
+/// if they are not.
+fn shard_of_partition(h: &PartialHeader, partition: &Partition) -> Option<String> {
+    let (k, m) = (h.shard, h.shards);
+    (!(1 <= k && k <= m && m <= partition.blocks)).then(|| {
+        format!(
+            "its header says shard {k}/{m}, but a shard k/m has 1 ≤ k ≤ m ≤ {} (the blocks of \
+             N = {})",
+            partition.blocks, partition.realizations
+        )
+    })
 }
 
 /// Checks that the files `opened`, sorted by shard, hold each of the `shards` shards once.
