@@ -1,5 +1,8 @@
 //! Writing results without clobbering: every file is written beside its destination under a
 //! temporary name and renamed into place, so a run that fails leaves earlier files untouched.
+//! A destination that exists and is neither a regular file nor a directory (a character device
+//! such as `/dev/null` or `/dev/stdout`, a FIFO) is written in place: renaming onto it would
+//! replace the device with a regular file.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -44,7 +47,22 @@ fn temporary_beside(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
-/// Writes `bytes` to `path` atomically (temporary file, then rename).
+/// Whether `path` exists and is something other than a regular file or a directory (a device, a
+/// FIFO, a socket), which is written in place rather than replaced.
+fn is_special(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
+/// Opens the special file `path` for writing, in place.
+fn open_in_place(path: &Path) -> Result<std::fs::File, OutputError> {
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(path)
+        .map_err(io("open", path))
+}
+
+/// Writes `bytes` to `path` atomically (temporary file, then rename), or in place when `path` is
+/// a device or a FIFO.
 ///
 /// # Errors
 /// [`OutputError`] when the destination is a directory or a step fails; the destination is then
@@ -54,6 +72,13 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
         return Err(OutputError::IsDirectory {
             path: path.to_path_buf(),
         });
+    }
+    if is_special(path) {
+        let mut f = open_in_place(path)?;
+        return f
+            .write_all(bytes)
+            .and_then(|()| f.flush())
+            .map_err(io("write", path));
     }
     let tmp = temporary_beside(path);
     let result = (|| {
@@ -76,6 +101,8 @@ pub struct AtomicFile {
     tmp: PathBuf,
     dest: PathBuf,
     file: Option<std::io::BufWriter<std::fs::File>>,
+    /// The destination is a device or a FIFO, written in place (`tmp` is `dest`).
+    in_place: bool,
 }
 
 impl AtomicFile {
@@ -89,12 +116,19 @@ impl AtomicFile {
                 path: dest.to_path_buf(),
             });
         }
-        let tmp = temporary_beside(dest);
-        let file = std::fs::File::create(&tmp).map_err(io("create", &tmp))?;
+        let in_place = is_special(dest);
+        let (tmp, file) = if in_place {
+            (dest.to_path_buf(), open_in_place(dest)?)
+        } else {
+            let tmp = temporary_beside(dest);
+            let file = std::fs::File::create(&tmp).map_err(io("create", &tmp))?;
+            (tmp, file)
+        };
         Ok(Self {
             tmp,
             dest: dest.to_path_buf(),
             file: Some(std::io::BufWriter::new(file)),
+            in_place,
         })
     }
 
@@ -123,6 +157,12 @@ impl AtomicFile {
     /// [`OutputError`] when the flush or the rename fails; the temporary is then removed.
     pub fn commit(mut self) -> Result<(), OutputError> {
         let file = self.file.take().expect("committed once");
+        if self.in_place {
+            return file
+                .into_inner()
+                .map(drop)
+                .map_err(|e| io("write", &self.dest)(e.into_error()));
+        }
         let result = file
             .into_inner()
             .map_err(|e| e.into_error())
@@ -142,7 +182,9 @@ impl Drop for AtomicFile {
     fn drop(&mut self) {
         if self.file.is_some() {
             self.file = None;
-            let _ = std::fs::remove_file(&self.tmp);
+            if !self.in_place {
+                let _ = std::fs::remove_file(&self.tmp);
+            }
         }
     }
 }
@@ -309,6 +351,42 @@ impl Drop for StagedFiles {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A FIFO at `dir/name` and a thread reading it to its end.
+    fn fifo_with_reader(dir: &Path, name: &str) -> (PathBuf, std::thread::JoinHandle<Vec<u8>>) {
+        let fifo = dir.join(name);
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+        let path = fifo.clone();
+        let reader = std::thread::spawn(move || std::fs::read(path).unwrap());
+        (fifo, reader)
+    }
+
+    fn is_fifo(path: &Path) -> bool {
+        use std::os::unix::fs::FileTypeExt;
+        std::fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo())
+    }
+
+    /// An output that is a FIFO (like `/dev/null` or `/dev/stdout`, a file that is not a regular
+    /// file) is written in place and stays what it was; renamed onto, it would become a regular
+    /// file.
+    #[test]
+    fn a_fifo_is_written_in_place_not_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        let (fifo, reader) = fifo_with_reader(dir.path(), "out.json");
+        write_atomic(&fifo, b"{\"a\": 1}").unwrap();
+        assert!(is_fifo(&fifo), "the FIFO was replaced");
+        assert_eq!(reader.join().unwrap(), b"{\"a\": 1}");
+
+        let (fifo, reader) = fifo_with_reader(dir.path(), "streamed.csv");
+        let mut f = AtomicFile::create(&fifo).unwrap();
+        f.write(b"t_s\n0\n").unwrap();
+        f.commit().unwrap();
+        assert!(is_fifo(&fifo), "the FIFO was replaced");
+        assert_eq!(reader.join().unwrap(), b"t_s\n0\n");
+        // Nothing else appeared beside it.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
 
     #[test]
     fn a_directory_in_the_way_leaves_everything_untouched() {
