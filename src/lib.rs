@@ -33,3 +33,5 @@ pub mod simulation;
 pub mod state;
 pub mod stats;
 pub mod study;
+#[cfg(test)]
+mod test_support;

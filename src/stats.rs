@@ -221,13 +221,7 @@ mod tests {
         approx::assert_relative_eq!(hi, 25.188_179_571_971_17, max_relative = 1e-9);
     }
 
-    /// Runs `f` on another thread and fails when it has not returned within 10 s.
-    fn within_10_s<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
-        let (tx, rx) = std::sync::mpsc::channel();
-        std::thread::spawn(move || tx.send(f()));
-        rx.recv_timeout(std::time::Duration::from_secs(10))
-            .expect("returned within 10 s")
-    }
+    use crate::test_support::within_10_s;
 
     #[test]
     fn quantiles_return_for_any_input_without_panic() {

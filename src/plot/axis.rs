@@ -281,13 +281,7 @@ mod tests {
         assert_eq!(labels, ["10⁻³", "10⁻²", "10⁻¹", "1", "10", "10²"]);
     }
 
-    /// Runs `f` on another thread and fails when it has not returned within 10 s.
-    fn within_10_s<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
-        let (tx, rx) = std::sync::mpsc::channel();
-        std::thread::spawn(move || tx.send(f()));
-        rx.recv_timeout(std::time::Duration::from_secs(10))
-            .expect("returned within 10 s")
-    }
+    use crate::test_support::within_10_s;
 
     #[test]
     fn ticks_of_any_finite_data_are_found_and_lie_on_the_axis() {
