@@ -139,7 +139,7 @@ fn partials_of_another_ensemble_or_split_are_refused() {
         d,
         &["p1.bin", "absent.bin", "p3.bin"],
         "absent.bin",
-        "cannot open",
+        "cannot read",
     );
     for bad in ["0/3", "4/3", "2", "a/b", "1/999"] {
         let o = accelcal(

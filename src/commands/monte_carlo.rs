@@ -1,6 +1,7 @@
 //! The commands of the Monte Carlo study: the report, one ensemble or one shard of it, the merge
 //! of shards, and the sensitivity study.
 
+use std::io::Write as _;
 use std::path::Path;
 
 use super::{Bar, load_model, verdict_lines, write};
@@ -192,7 +193,7 @@ fn run_shard(
         |done| bar.advance(done),
         |index, acc| {
             if written.is_ok() {
-                written = partial::write_block(&mut spool_w, index, acc);
+                written = spool_w.write_all(&partial::encode_block(index, acc));
             }
         },
     );
@@ -212,11 +213,10 @@ fn run_shard(
     };
     let result = (|| -> Result<()> {
         written?;
-        use std::io::Write;
         spool_w.flush()?;
         drop(spool_w);
-        partial::write_header(file.writer(), &header)?;
-        std::io::copy(&mut std::fs::File::open(&spool)?, file.writer())?;
+        let mut blocks = std::io::BufReader::new(std::fs::File::open(&spool)?);
+        partial::write_partial(file.writer(), &header, &mut blocks)?;
         file.commit()?;
         Ok(())
     })();
@@ -246,9 +246,9 @@ pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
     let mut files = Vec::with_capacity(args.files.len());
     for path in &args.files {
         let name = path.display().to_string();
-        let file = std::fs::File::open(path).map_err(|e| partial::PartialError::Format {
+        let file = std::fs::File::open(path).map_err(|e| partial::PartialError::Unreadable {
             file: name.clone(),
-            why: format!("cannot open: {e}"),
+            why: e.to_string(),
         })?;
         files.push((name, std::io::BufReader::new(file)));
     }

@@ -1,7 +1,7 @@
 //! The merge of the partial files of an ensemble's shards: every shard exactly once, folded in
 //! block order into the sums of one run.
 
-use super::{PartialError, PartialHeader, read_block, read_header};
+use super::{HeaderDigest, PartialError, PartialHeader, read_block, read_header};
 use crate::config::Config;
 use crate::ensemble::layout::ResidualLayout;
 use crate::ensemble::sums::Accumulator;
@@ -50,13 +50,19 @@ pub struct Merged {
 /// shard of one ensemble exactly once, and folds their blocks in block order.
 ///
 /// # Errors
-/// [`PartialError`] naming the file that is unreadable, truncated, of another ensemble, or a
-/// repeated shard; or, naming the first file, a missing shard.
+/// [`PartialError`] naming the file that is unreadable, damaged or edited (its digests),
+/// truncated, of another ensemble, or a repeated shard; or a missing shard, listing which file
+/// holds which shard.
 pub fn merge<R: std::io::BufRead>(files: Vec<(String, R)>) -> Result<Merged, PartialError> {
     let mut opened = Vec::with_capacity(files.len());
     for (name, mut r) in files {
-        let header = read_header(&mut r, &name)?;
-        opened.push(Opened { name, header, r });
+        let (header, key) = read_header(&mut r, &name)?;
+        opened.push(Opened {
+            name,
+            header,
+            key,
+            r,
+        });
     }
     let Some(first) = opened.first() else {
         return Err(mismatch("(none)", "no partial file given".to_string()));
@@ -74,7 +80,7 @@ pub fn merge<R: std::io::BufRead>(files: Vec<(String, R)>) -> Result<Merged, Par
         }
     }
     opened.sort_by_key(|o| o.header.shard);
-    every_shard_once(&opened, &first_name, first.shards)?;
+    every_shard_once(&opened, first.shards)?;
     let layout = ResidualLayout::new(first.fixes, first.max_lag);
     let mut sums = Accumulator::new(&layout, first.pair);
     let mut elapsed_s = 0.0;
@@ -95,6 +101,8 @@ pub fn merge<R: std::io::BufRead>(files: Vec<(String, R)>) -> Result<Merged, Par
 struct Opened<R> {
     name: String,
     header: PartialHeader,
+    /// The header's digest, which keys its blocks'.
+    key: HeaderDigest,
     r: R,
 }
 
@@ -186,11 +194,7 @@ fn shard_of_partition(h: &PartialHeader, partition: &Partition) -> Option<String
 }
 
 /// Checks that the files `opened`, sorted by shard, hold each of the `shards` shards once.
-fn every_shard_once<R>(
-    opened: &[Opened<R>],
-    first_name: &str,
-    shards: u64,
-) -> Result<(), PartialError> {
+fn every_shard_once<R>(opened: &[Opened<R>], shards: u64) -> Result<(), PartialError> {
     for pair in opened.windows(2) {
         if pair[0].header.shard == pair[1].header.shard {
             return Err(mismatch(
@@ -204,10 +208,15 @@ fn every_shard_once<R>(
     }
     let present: Vec<u64> = opened.iter().map(|o| o.header.shard).collect();
     match (1..=shards).find(|k| !present.contains(k)) {
-        Some(missing) => Err(mismatch(
-            first_name,
-            format!("shard {missing}/{shards} is missing"),
-        )),
+        Some(missing) => Err(PartialError::Missing {
+            shard: missing,
+            shards,
+            given: opened
+                .iter()
+                .map(|o| format!("{} (shard {}/{shards})", o.name, o.header.shard))
+                .collect::<Vec<_>>()
+                .join(", "),
+        }),
         None => Ok(()),
     }
 }
@@ -224,6 +233,7 @@ fn fold_shard<R: std::io::BufRead>(
     let Opened {
         name,
         header,
+        key,
         mut r,
     } = o;
     let expected = partition.shard_blocks(Shard {
@@ -236,8 +246,8 @@ fn fold_shard<R: std::io::BufRead>(
             "its blocks are not those of its shard".to_string(),
         ));
     }
-    for b in expected {
-        let Some((index, block)) = read_block(&mut r, &header, &name)? else {
+    for b in expected.clone() {
+        let Some((index, block)) = read_block(&mut r, &header, &key, &name, b)? else {
             return Err(PartialError::Truncated {
                 file: name,
                 why: format!("block {b} is missing"),
@@ -255,7 +265,7 @@ fn fold_shard<R: std::io::BufRead>(
         }
         sums.merge(&block);
     }
-    if read_block(&mut r, &header, &name)?.is_some() {
+    if read_block(&mut r, &header, &key, &name, expected.end)?.is_some() {
         return Err(mismatch(
             &name,
             "more blocks than its shard holds".to_string(),

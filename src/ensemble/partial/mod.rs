@@ -1,14 +1,27 @@
 //! Partial sums of a shard of an ensemble, as a file, and their merge.
 //!
-//! A partial file holds the sums of the blocks of one shard (see [`super::Partition`]): a line
-//! `accelcal-partial 1`, a JSON header line describing the ensemble and the shard, then for every
-//! block its index and its sums as little-endian 64-bit floats, in a fixed order. Floats are
-//! stored bit for bit, so merging the shards in block order gives the sums of one run, number for
-//! number ([`merge()`]).
+//! A partial file holds the sums of the blocks of one shard (see [`super::Partition`]):
+//!
+//! 1. the line `accelcal-partial 2`;
+//! 2. a JSON header line describing the ensemble and the shard ([`PartialHeader`]);
+//! 3. the line `sha256 <64 hex digits>`: the SHA-256 digest of lines 1 and 2, the *header
+//!    digest*;
+//! 4. for every block of the shard: its index and its realization count as little-endian 64-bit
+//!    integers, its sums as little-endian 64-bit floats in a fixed order, then the 32-byte
+//!    SHA-256 digest of the header digest followed by those bytes.
+//!
+//! Floats are stored bit for bit, so merging the shards in block order gives the sums of one run,
+//! number for number ([`merge()`]). The digests make any damage (one changed bit anywhere) or an
+//! edit of the header a refusal rather than wrong numbers: each block's digest is keyed with the
+//! header digest, so a header edited and given a new digest of its own no longer matches any
+//! block, and the configuration it reports stays bound to the data made with it. A digest is a
+//! check against accidents and casual edits, not a signature: whoever recomputes every digest on
+//! purpose can forge a file.
 
-use std::io::{Read, Write};
+use std::io::{BufRead, Read, Write};
 
 use serde::{Deserialize, Serialize};
+use sha2::{Digest as _, Sha256};
 
 mod merge;
 
@@ -22,8 +35,69 @@ use nalgebra::SMatrix;
 
 const MEAS: usize = ErrorState::MEAS;
 
+/// The version of the partial file format this accelcal writes and reads.
+pub const FORMAT: u32 = 2;
+
 /// The first line of every partial file.
-pub const MAGIC: &str = "accelcal-partial 1\n";
+pub const MAGIC: &str = "accelcal-partial 2\n";
+
+/// The first line of a partial file of the first format, whose blocks had no digests.
+const MAGIC_1: &str = "accelcal-partial 1\n";
+
+/// The longest header line read, bytes: a configuration is a few kilobytes, and an input that is
+/// not a partial file (a device such as `/dev/zero`) must not be read without bound.
+pub const MAX_HEADER_BYTES: u64 = 1 << 20;
+
+/// Bytes of a SHA-256 digest.
+pub const DIGEST_BYTES: usize = 32;
+
+/// The SHA-256 digest of a partial file's first two lines, which keys the digest of each block.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HeaderDigest([u8; DIGEST_BYTES]);
+
+impl HeaderDigest {
+    /// The digest of the magic line and the header line `json` (with its line end).
+    fn of(magic: &[u8], json: &[u8]) -> Self {
+        Self(
+            Sha256::new()
+                .chain_update(magic)
+                .chain_update(json)
+                .finalize()
+                .into(),
+        )
+    }
+
+    /// The digest of a block's bytes `block` keyed with this header digest.
+    fn of_block(&self, block: &[u8]) -> [u8; DIGEST_BYTES] {
+        Sha256::new()
+            .chain_update(self.0)
+            .chain_update(block)
+            .finalize()
+            .into()
+    }
+
+    /// The digest line, `sha256 <hex>` and its line end.
+    fn line(&self) -> String {
+        let hex: String = self.0.iter().map(|b| format!("{b:02x}")).collect();
+        format!("sha256 {hex}\n")
+    }
+
+    /// The digest of a digest line, if it is one.
+    fn parse_line(line: &str) -> Option<Self> {
+        let hex = line.strip_prefix("sha256 ")?.strip_suffix('\n')?;
+        // Lower case only: the line is compared as written, so that a changed bit is never read
+        // as the same digest.
+        let lower_hex = |b: u8| b.is_ascii_digit() || (b'a'..=b'f').contains(&b);
+        if hex.len() != 2 * DIGEST_BYTES || !hex.bytes().all(lower_hex) {
+            return None;
+        }
+        let mut d = [0u8; DIGEST_BYTES];
+        for (i, byte) in d.iter_mut().enumerate() {
+            *byte = u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).ok()?;
+        }
+        Some(Self(d))
+    }
+}
 
 /// What a partial file says about itself.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -52,15 +126,45 @@ pub struct PartialHeader {
     pub engine: Engine,
 }
 
+impl PartialHeader {
+    /// Floats of the sums of one block: per fix, the a priori and a posteriori stages' sums and
+    /// Σ NIS; the kept residual products; the single residual pair's products.
+    fn block_floats(&self) -> usize {
+        let layout = ResidualLayout::new(self.fixes, self.max_lag);
+        self.fixes * FIX_LEN + layout.len() + PAIR_LEN
+    }
+
+    /// Bytes of one block without its digest: index, count and sums.
+    pub fn block_bytes(&self) -> usize {
+        16 + 8 * self.block_floats()
+    }
+}
+
 /// A partial file that cannot be read or does not belong with the others.
 #[derive(Debug, thiserror::Error)]
 pub enum PartialError {
+    /// The file cannot be opened or read.
+    #[error("{file}: cannot read: {why}")]
+    Unreadable {
+        /// The file.
+        file: String,
+        /// The operating system's error.
+        why: String,
+    },
     /// The file is not a partial file of this version.
-    #[error("{file}: not an accelcal partial file (version 1): {why}")]
+    #[error("{file}: not an accelcal partial file (format {FORMAT}): {why}")]
     Format {
         /// The file.
         file: String,
         /// What is wrong.
+        why: String,
+    },
+    /// A part of the file does not match its digest: changed since it was written.
+    #[error("{file}: damaged or edited: {why}")]
+    Damaged {
+        /// The file.
+        file: String,
+        /// Which part does not match.
         why: String,
     },
     /// The file ends before its last block.
@@ -71,13 +175,24 @@ pub enum PartialError {
         /// What is missing.
         why: String,
     },
-    /// The file belongs to another ensemble, or repeats or misses a shard.
+    /// The file belongs to another ensemble, or repeats a shard, or holds values that are not
+    /// sums.
     #[error("{file}: {why}")]
     Mismatch {
         /// The file.
         file: String,
         /// What differs.
         why: String,
+    },
+    /// No file holds a shard.
+    #[error("shard {shard}/{shards} is missing: the files given hold {given}")]
+    Missing {
+        /// The shard k missing.
+        shard: u64,
+        /// The number of shards m.
+        shards: u64,
+        /// Which file holds which shard.
+        given: String,
     },
 }
 
@@ -88,22 +203,23 @@ const FIX_LEN: usize = <FixSums>::FLOATS;
 /// Floats of the single residual pair's products.
 const PAIR_LEN: usize = MEAS * MEAS;
 
-/// Writes the header of a partial file.
+/// Writes the header of a partial file: the magic line, the header line and its digest line.
+/// Returns the header digest, which keys the digest of every block ([`write_block`]).
 ///
 /// # Errors
 /// The writer's error.
-pub fn write_header(w: &mut impl Write, header: &PartialHeader) -> std::io::Result<()> {
+pub fn write_header(w: &mut impl Write, header: &PartialHeader) -> std::io::Result<HeaderDigest> {
+    let mut json = serde_json::to_string(header).expect("a header serializes");
+    json.push('\n');
+    let digest = HeaderDigest::of(MAGIC.as_bytes(), json.as_bytes());
     w.write_all(MAGIC.as_bytes())?;
-    let json = serde_json::to_string(header).expect("a header serializes");
     w.write_all(json.as_bytes())?;
-    w.write_all(b"\n")
+    w.write_all(digest.line().as_bytes())?;
+    Ok(digest)
 }
 
-/// Writes block `index`'s sums.
-///
-/// # Errors
-/// The writer's error.
-pub fn write_block(w: &mut impl Write, index: u64, acc: &Accumulator) -> std::io::Result<()> {
+/// Block `index`'s bytes without their digest: index, realization count, sums.
+pub fn encode_block(index: u64, acc: &Accumulator) -> Vec<u8> {
     let mut floats =
         Vec::with_capacity(acc.fixes.len() * FIX_LEN + acc.residual_products.len() + PAIR_LEN);
     for f in &acc.fixes {
@@ -114,74 +230,207 @@ pub fn write_block(w: &mut impl Write, index: u64, acc: &Accumulator) -> std::io
     floats.extend(&acc.residual_products);
     // Row-major (j, k).
     floats.extend(acc.pair_products.transpose().iter());
-    w.write_all(&index.to_le_bytes())?;
-    w.write_all(&acc.count.to_le_bytes())?;
-    let mut bytes = Vec::with_capacity(8 * floats.len());
+    let mut bytes = Vec::with_capacity(16 + 8 * floats.len());
+    bytes.extend_from_slice(&index.to_le_bytes());
+    bytes.extend_from_slice(&acc.count.to_le_bytes());
     for x in floats {
         bytes.extend_from_slice(&x.to_le_bytes());
     }
-    w.write_all(&bytes)
+    bytes
 }
 
-/// Reads the header of a partial file named `file`.
+/// Writes block `index`'s sums and their digest keyed with the header digest `key`.
 ///
 /// # Errors
-/// [`PartialError::Format`] when the file is not a partial file.
-pub fn read_header(
-    r: &mut impl std::io::BufRead,
-    file: &str,
-) -> Result<PartialHeader, PartialError> {
-    let format = |why: String| PartialError::Format {
-        file: file.to_string(),
-        why,
-    };
-    let mut magic = String::new();
-    r.read_line(&mut magic).map_err(|e| format(e.to_string()))?;
-    if magic != MAGIC {
-        return Err(format(
-            "the first line is not `accelcal-partial 1`".to_string(),
-        ));
-    }
-    let mut json = String::new();
-    r.read_line(&mut json).map_err(|e| format(e.to_string()))?;
-    serde_json::from_str(&json).map_err(|e| format(format!("header: {e}")))
+/// The writer's error.
+pub fn write_block(
+    w: &mut impl Write,
+    key: &HeaderDigest,
+    index: u64,
+    acc: &Accumulator,
+) -> std::io::Result<()> {
+    let bytes = encode_block(index, acc);
+    w.write_all(&bytes)?;
+    w.write_all(&key.of_block(&bytes))
 }
 
-/// Reads the next block of a partial file with `header`; `None` at the end of the file.
+/// Writes a whole partial file: `header`, then the blocks of `blocks`, a stream of
+/// [`encode_block`] outputs (spooled while the shard ran, before its header was known), each with
+/// its digest.
 ///
 /// # Errors
-/// [`PartialError::Truncated`] when the file ends inside a block.
-pub fn read_block(
-    r: &mut impl Read,
+/// The reader's or the writer's error; [`std::io::ErrorKind::InvalidData`] when `blocks` does
+/// not hold whole blocks of `header`'s size.
+pub fn write_partial(
+    w: &mut impl Write,
     header: &PartialHeader,
+    blocks: &mut impl Read,
+) -> std::io::Result<()> {
+    let key = write_header(w, header)?;
+    let mut block = vec![0u8; header.block_bytes()];
+    loop {
+        match read_whole(blocks, &mut block)? {
+            0 => return Ok(()),
+            n if n == block.len() => {}
+            _ => {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    "the spooled blocks end inside a block",
+                ));
+            }
+        }
+        w.write_all(&block)?;
+        w.write_all(&key.of_block(&block))?;
+    }
+}
+
+/// Fills `buf` from `r` as far as `r` goes; the bytes read (fewer than `buf.len()` only at the
+/// end of `r`).
+fn read_whole(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut filled = 0;
+    while filled < buf.len() {
+        match r.read(&mut buf[filled..]) {
+            Ok(0) => break,
+            Ok(n) => filled += n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(filled)
+}
+
+/// Reads one line of at most `limit` bytes (its line end included) as raw bytes; `None` when
+/// the line is longer or has no line end.
+fn read_line_within(r: &mut impl BufRead, limit: u64) -> std::io::Result<Option<Vec<u8>>> {
+    let mut line = Vec::new();
+    r.take(limit).read_until(b'\n', &mut line)?;
+    Ok(line.ends_with(b"\n").then_some(line))
+}
+
+/// Reads the header of a partial file named `file` and checks it against its digest.
+///
+/// # Errors
+/// [`PartialError::Format`] when the file is not a partial file of this format;
+/// [`PartialError::Damaged`] when its header does not match its digest;
+/// [`PartialError::Unreadable`] when reading fails.
+pub fn read_header(
+    r: &mut impl BufRead,
     file: &str,
-) -> Result<Option<(u64, Accumulator)>, PartialError> {
-    let truncated = |why: &str| PartialError::Truncated {
+) -> Result<(PartialHeader, HeaderDigest), PartialError> {
+    let format = |why: &str| PartialError::Format {
         file: file.to_string(),
         why: why.to_string(),
     };
-    let mut word = [0u8; 8];
-    // The end of the file is allowed only between blocks.
-    match r.read(&mut word[..1]) {
-        Ok(0) => return Ok(None),
-        Ok(_) => {}
-        Err(e) => return Err(truncated(&e.to_string())),
+    let unreadable = |e: std::io::Error| PartialError::Unreadable {
+        file: file.to_string(),
+        why: e.to_string(),
+    };
+    let magic = read_line_within(r, MAGIC.len() as u64).map_err(unreadable)?;
+    if magic.as_deref() == Some(MAGIC_1.as_bytes()) {
+        return Err(format(&format!(
+            "it is of format 1, written by an earlier accelcal without digests; run its shard \
+             again with this accelcal (format {FORMAT})"
+        )));
     }
-    r.read_exact(&mut word[1..])
-        .map_err(|_| truncated("a block index is cut"))?;
-    let index = u64::from_le_bytes(word);
-    r.read_exact(&mut word)
-        .map_err(|_| truncated("a block count is cut"))?;
-    let count = u64::from_le_bytes(word);
-    let layout = ResidualLayout::new(header.fixes, header.max_lag);
-    let len = header.fixes * FIX_LEN + layout.len() + PAIR_LEN;
-    let mut bytes = vec![0u8; 8 * len];
-    r.read_exact(&mut bytes)
-        .map_err(|_| truncated(&format!("block {index} is cut")))?;
-    let floats: Vec<f64> = bytes
+    if magic.as_deref() != Some(MAGIC.as_bytes()) {
+        return Err(format("the first line is not `accelcal-partial 2`"));
+    }
+    let Some(json) = read_line_within(r, MAX_HEADER_BYTES).map_err(unreadable)? else {
+        return Err(format(&format!(
+            "its header line does not end within {MAX_HEADER_BYTES} bytes"
+        )));
+    };
+    let line = read_line_within(r, 8 + 2 * DIGEST_BYTES as u64).map_err(unreadable)?;
+    let said = line
+        .as_deref()
+        .and_then(|l| std::str::from_utf8(l).ok())
+        .and_then(HeaderDigest::parse_line);
+    let Some(said) = said else {
+        return Err(PartialError::Damaged {
+            file: file.to_string(),
+            why: "the header's digest line is not `sha256 <64 lower-case hex digits>`".to_string(),
+        });
+    };
+    let digest = HeaderDigest::of(MAGIC.as_bytes(), &json);
+    if digest != said {
+        return Err(PartialError::Damaged {
+            file: file.to_string(),
+            why: "its header does not match the digest written with it (the configuration or \
+                  the shard in it was changed, or the file damaged)"
+                .to_string(),
+        });
+    }
+    let header = serde_json::from_slice(&json).map_err(|e| format(&format!("header: {e}")))?;
+    Ok((header, digest))
+}
+
+/// Reads the next block of a partial file with `header` and header digest `key`, checked
+/// against its digest; `None` at the end of the file. `position` is the block expected there,
+/// for messages.
+///
+/// # Errors
+/// [`PartialError::Truncated`] when the file ends inside a block; [`PartialError::Damaged`] when
+/// the block does not match its digest; [`PartialError::Mismatch`] when a sum is not finite.
+pub fn read_block(
+    r: &mut impl Read,
+    header: &PartialHeader,
+    key: &HeaderDigest,
+    file: &str,
+    position: u64,
+) -> Result<Option<(u64, Accumulator)>, PartialError> {
+    let truncated = |why: String| PartialError::Truncated {
+        file: file.to_string(),
+        why,
+    };
+    let mut bytes = vec![0u8; header.block_bytes() + DIGEST_BYTES];
+    let read = read_whole(r, &mut bytes).map_err(|e| PartialError::Unreadable {
+        file: file.to_string(),
+        why: e.to_string(),
+    })?;
+    // The end of the file is allowed only between blocks.
+    match read {
+        0 => return Ok(None),
+        n if n < bytes.len() => {
+            return Err(truncated(format!(
+                "block {position} is cut after {n} of its {} bytes",
+                bytes.len()
+            )));
+        }
+        _ => {}
+    }
+    let (block, digest) = bytes.split_at(header.block_bytes());
+    if key.of_block(block) != digest {
+        return Err(PartialError::Damaged {
+            file: file.to_string(),
+            why: format!(
+                "block {position} does not match the digest written with it (a changed bit, or \
+                 sums made with another header)"
+            ),
+        });
+    }
+    let word = |i: usize| u64::from_le_bytes(block[8 * i..8 * i + 8].try_into().expect("8 bytes"));
+    let (index, count) = (word(0), word(1));
+    let floats: Vec<f64> = block[16..]
         .chunks_exact(8)
         .map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes")))
         .collect();
+    if let Some((i, x)) = floats.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+        return Err(PartialError::Mismatch {
+            file: file.to_string(),
+            why: format!(
+                "block {index} holds a sum that is not finite ({x} at float {i} of {}): the \
+                 shard's computation overflowed, and it cannot be merged",
+                floats.len()
+            ),
+        });
+    }
+    Ok(Some((index, decode_sums(header, count, &floats))))
+}
+
+/// The sums of a block of `count` realizations from its `floats`, in the order of
+/// [`encode_block`].
+fn decode_sums(header: &PartialHeader, count: u64, floats: &[f64]) -> Accumulator {
+    let layout = ResidualLayout::new(header.fixes, header.max_lag);
     let mut acc = Accumulator::new(&layout, header.pair);
     acc.count = count;
     for (i, f) in acc.fixes.iter_mut().enumerate() {
@@ -197,7 +446,7 @@ pub fn read_block(
         .copy_from_slice(&floats[products..products + layout.len()]);
     let pair = &floats[products + layout.len()..];
     acc.pair_products = SMatrix::from_row_slice(&pair[..PAIR_LEN]);
-    Ok(Some((index, acc)))
+    acc
 }
 
 #[cfg(test)]
@@ -208,8 +457,8 @@ mod tests {
     use crate::filter::FilterSchedule;
     use crate::model::Model;
 
-    #[test]
-    fn blocks_read_back_bit_for_bit() {
+    /// A header and the sums of one block of a short ensemble.
+    fn small() -> (PartialHeader, Accumulator) {
         let mut c = Config::default();
         c.profile.duration_s = 2.0;
         c.checks.residual_max_lag = Some(3);
@@ -228,20 +477,112 @@ mod tests {
             elapsed_s: 0.5,
             engine: Engine::Sample,
         };
+        (header, acc)
+    }
+
+    /// Reads every block of the partial file `bytes`.
+    fn read_all(bytes: &[u8]) -> Result<Vec<(u64, Accumulator)>, PartialError> {
+        let mut r = std::io::BufReader::new(bytes);
+        let (header, key) = read_header(&mut r, "f")?;
+        let mut blocks = Vec::new();
+        while let Some(b) = read_block(&mut r, &header, &key, "f", blocks.len() as u64)? {
+            blocks.push(b);
+        }
+        Ok(blocks)
+    }
+
+    #[test]
+    fn blocks_read_back_bit_for_bit() {
+        let (header, acc) = small();
         let mut bytes = Vec::new();
-        write_header(&mut bytes, &header).unwrap();
-        write_block(&mut bytes, 7, &acc).unwrap();
+        let key = write_header(&mut bytes, &header).unwrap();
+        write_block(&mut bytes, &key, 7, &acc).unwrap();
         let mut r = std::io::BufReader::new(&bytes[..]);
-        assert_eq!(read_header(&mut r, "f").unwrap(), header);
-        let (index, back) = read_block(&mut r, &header, "f").unwrap().unwrap();
+        assert_eq!(read_header(&mut r, "f").unwrap(), (header.clone(), key));
+        let (index, back) = read_block(&mut r, &header, &key, "f", 0).unwrap().unwrap();
         assert_eq!((index, &back), (7, &acc));
-        assert!(read_block(&mut r, &header, "f").unwrap().is_none());
+        assert!(read_block(&mut r, &header, &key, "f", 1).unwrap().is_none());
         // A file cut inside a block is an error, not a short ensemble.
-        let mut r = std::io::BufReader::new(&bytes[..bytes.len() - 3]);
-        read_header(&mut r, "f").unwrap();
         assert!(matches!(
-            read_block(&mut r, &header, "f"),
+            read_all(&bytes[..bytes.len() - 3]),
             Err(PartialError::Truncated { .. })
         ));
+        // Blocks spooled without digests and written with the header make the same file.
+        let mut spooled = Vec::new();
+        write_partial(&mut spooled, &header, &mut &encode_block(7, &acc)[..]).unwrap();
+        assert_eq!(spooled, bytes);
+    }
+
+    /// One changed bit anywhere in a partial file, in its header, its digests or any block's
+    /// index, count or sums, makes it unreadable; the untouched file reads.
+    #[test]
+    fn every_single_bit_flip_is_refused() {
+        let (header, acc) = small();
+        let mut bytes = Vec::new();
+        let key = write_header(&mut bytes, &header).unwrap();
+        write_block(&mut bytes, &key, 0, &acc).unwrap();
+        write_block(&mut bytes, &key, 1, &acc).unwrap();
+        assert_eq!(read_all(&bytes).unwrap().len(), 2);
+        for i in 0..bytes.len() {
+            for bit in [i % 8, (i + 3) % 8] {
+                let mut damaged = bytes.clone();
+                damaged[i] ^= 1 << bit;
+                assert!(
+                    read_all(&damaged).is_err(),
+                    "byte {i} bit {bit} of {} accepted",
+                    bytes.len()
+                );
+            }
+        }
+    }
+
+    /// A header edited alike in every file and given a digest of its own no longer matches the
+    /// blocks: the digest binds the configuration to the sums made with it.
+    #[test]
+    fn a_header_rewritten_with_its_own_digest_does_not_match_its_blocks() {
+        let (header, acc) = small();
+        let mut honest = Vec::new();
+        let key = write_header(&mut honest, &header).unwrap();
+        write_block(&mut honest, &key, 0, &acc).unwrap();
+        let block = &honest[honest.len() - header.block_bytes() - DIGEST_BYTES..];
+        let mut edited_header = header.clone();
+        edited_header.config.ensemble.seed += 1;
+        let mut edited = Vec::new();
+        write_header(&mut edited, &edited_header).unwrap();
+        edited.extend_from_slice(block);
+        let err = read_all(&edited).unwrap_err();
+        assert!(
+            matches!(&err, PartialError::Damaged { why, .. } if why.contains("block 0")),
+            "{err}"
+        );
+    }
+
+    /// Non-finite sums written with a valid digest (a shard whose computation overflowed) are
+    /// refused, naming the block.
+    #[test]
+    fn sums_that_are_not_finite_are_refused() {
+        let (header, mut acc) = small();
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            acc.fixes[1].nis = bad;
+            let mut bytes = Vec::new();
+            let key = write_header(&mut bytes, &header).unwrap();
+            write_block(&mut bytes, &key, 0, &acc).unwrap();
+            let err = read_all(&bytes).unwrap_err().to_string();
+            assert!(
+                err.contains("block 0") && err.contains("not finite"),
+                "{err}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_partial_of_the_first_format_is_refused_with_the_way_out() {
+        let bytes = b"accelcal-partial 1\n{}\n";
+        let err = read_all(bytes).unwrap_err().to_string();
+        assert!(err.contains("format 1") && err.contains("again"), "{err}");
+        // And a device without line ends is read no further than the magic line's length.
+        let zeros = std::io::repeat(0).take(1 << 30);
+        let err = read_header(&mut std::io::BufReader::new(zeros), "z").unwrap_err();
+        assert!(matches!(err, PartialError::Format { .. }), "{err}");
     }
 }
