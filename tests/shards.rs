@@ -196,43 +196,53 @@ fn long_runs_test_lags_and_say_so() {
     assert_eq!(e["residual_whiteness_by_lag"].as_array().unwrap().len(), 20);
 }
 
+/// Runs examples/slurm-ensemble.sh in `d` as array task `task` of the array `first..=last` with
+/// `args`, the built binary on the PATH when `on_path`.
+fn slurm_task(
+    d: &Path,
+    (task, first, last): (u64, u64, u64),
+    args: &[&str],
+    on_path: bool,
+) -> Output {
+    let bin_dir = Path::new(common::bin()).parent().unwrap();
+    let path = if on_path {
+        format!("{}:/usr/bin:/bin", bin_dir.display())
+    } else {
+        "/usr/bin:/bin".to_string()
+    };
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/slurm-ensemble.sh");
+    Command::new("bash")
+        .arg(&script)
+        .args(args)
+        .current_dir(d)
+        .env("PATH", &path)
+        .env("SLURM_ARRAY_TASK_COUNT", (last - first + 1).to_string())
+        .env("SLURM_ARRAY_TASK_MIN", first.to_string())
+        .env("SLURM_ARRAY_TASK_MAX", last.to_string())
+        .env("SLURM_ARRAY_TASK_ID", task.to_string())
+        .env_remove("SLURM_CPUS_PER_TASK")
+        .output()
+        .unwrap()
+}
+
 #[test]
 fn the_slurm_example_runs_each_array_task_as_a_shard() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     std::fs::write(d.join("c.toml"), CONFIG).unwrap();
-    let bin_dir = Path::new(common::bin()).parent().unwrap();
-    let path = format!(
-        "{}:{}",
-        bin_dir.display(),
-        std::env::var("PATH").unwrap_or_default()
-    );
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/slurm-ensemble.sh");
     for task in 1..=3 {
-        let o = Command::new("bash")
-            .arg(&script)
-            .args(["c.toml", "out"])
-            .current_dir(d)
-            .env("PATH", &path)
-            .env("SLURM_ARRAY_TASK_COUNT", "3")
-            .env("SLURM_ARRAY_TASK_ID", task.to_string())
-            .output()
-            .unwrap();
-        ok(&o);
+        ok(&slurm_task(d, (task, 1, 3), &["c.toml", "out"], true));
     }
-    ok(&accelcal(
-        &[
-            "merge",
-            "out/part-1.bin",
-            "out/part-2.bin",
-            "out/part-3.bin",
-            "--json",
-            "m.json",
-            "--quiet",
-        ],
-        d,
-        2,
-    ));
+    let merge = [
+        "merge",
+        "out/part-1.bin",
+        "out/part-2.bin",
+        "out/part-3.bin",
+        "--json",
+        "m.json",
+        "--quiet",
+    ];
+    ok(&accelcal(&merge, d, 2));
     ok(&accelcal(
         &[
             "ensemble",
@@ -245,8 +255,33 @@ fn the_slurm_example_runs_each_array_task_as_a_shard() {
         d,
         2,
     ));
+    let whole = common::summary_without_timing(&d.join("whole.json"));
+    assert_eq!(common::summary_without_timing(&d.join("m.json")), whole);
+
+    // A lost shard rerun alone, as the array 2-2 with M given: the merge is exact again.
+    std::fs::remove_file(d.join("out/part-2.bin")).unwrap();
+    ok(&slurm_task(d, (2, 2, 2), &["c.toml", "out", "3"], true));
+    ok(&accelcal(&merge, d, 2));
+    assert_eq!(common::summary_without_timing(&d.join("m.json")), whole);
     assert_eq!(
-        common::summary_without_timing(&d.join("m.json")),
-        common::summary_without_timing(&d.join("whole.json"))
+        std::fs::read_dir(d.join("out")).unwrap().count(),
+        3,
+        "hidden files left"
+    );
+
+    // The same without M would run shard 2/1: refused, as an array that is not 1-M.
+    for (task, first, last) in [(2, 2, 2), (3, 2, 4)] {
+        let o = slurm_task(d, (task, first, last), &["c.toml", "out"], true);
+        let msg = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{msg}");
+        assert!(msg.contains("must be exactly 1-M"), "{msg}");
+    }
+    // accelcal not on the PATH: said so, with the way out.
+    let o = slurm_task(d, (1, 1, 3), &["c.toml", "out"], false);
+    let msg = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{msg}");
+    assert!(
+        msg.contains("not on the PATH") && msg.contains("ACCELCAL="),
+        "{msg}"
     );
 }
