@@ -24,6 +24,8 @@ pub(super) fn run_allan(args: &AllanArgs) -> Result<()> {
             eprintln!("{text}");
         }
     };
+    // An output that cannot be written is refused before the log is read.
+    accelcal::output::check_directory(&args.out, &[JSON_FILE, TOML_FILE, YAML_FILE, PAGE_FILE])?;
     let source = LogFile::new(&args.accel);
     // The reader names its columns with static strings; one name per run is leaked on purpose.
     let column: &'static str = Box::leak(args.column.clone().into_boxed_str());

@@ -11,14 +11,18 @@ use accelcal::ensemble::{Engine, Ensemble, EnsembleRun, EnsembleStats, Partition
 use accelcal::error::ConfigError;
 use accelcal::filter::FilterSchedule;
 use accelcal::model::Model;
-use accelcal::output::write_all_atomic;
+use accelcal::output::{AtomicFile, ScratchFile, check_directory, check_file, write_all_atomic};
 use accelcal::sensitivity::{self, AssumedStatistic, Plan};
 use accelcal::study::{self, Progress, Study};
 use accelcal::{export, report};
 use anyhow::Result;
 
+/// The files `report` writes into its directory.
+const REPORT_FILES: [&str; 3] = ["index.html", "data.json", "view.json"];
+
 pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
     let model = load_model(&args.model, &CaseArgs::default(), args.realizations)?;
+    check_directory(&args.out, &REPORT_FILES)?;
     let mut bar = Bar::new(args.model.quiet);
     let study = Study::run(&model, &mut bar)?.with_sensitivity(&mut bar)?;
     let static_noise = accelcal::allan::section::report_coverage()?;
@@ -33,9 +37,9 @@ pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
     write_all_atomic(
         &args.out,
         &[
-            ("index.html", page.html.as_bytes()),
-            ("data.json", data.as_bytes()),
-            ("view.json", page.view_json.as_bytes()),
+            (REPORT_FILES[0], page.html.as_bytes()),
+            (REPORT_FILES[1], data.as_bytes()),
+            (REPORT_FILES[2], page.view_json.as_bytes()),
         ],
     )?;
     for o in &study.cases {
@@ -69,6 +73,9 @@ fn reproduce_command(args: &ReportArgs) -> String {
 pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
     let model = load_model(&args.model, &args.case, args.realizations)?;
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
+    if let Some(path) = &args.json {
+        check_file(path)?;
+    }
     if let (Some(shard), Some(path)) = (&args.shard, &args.partial) {
         return run_shard(
             &model,
@@ -139,6 +146,9 @@ fn sensitivity_plan(args: &SensitivityArgs, config: &Config) -> Result<Plan, Con
 pub(super) fn run_sensitivity(args: &SensitivityArgs) -> Result<()> {
     let model = load_model(&args.model, &CaseArgs::default(), args.realizations)?;
     let plan = sensitivity_plan(args, &model.config)?;
+    if let Some(path) = &args.json {
+        check_file(path)?;
+    }
     let result = sensitivity::run(&model.config, &plan, &mut Bar::new(args.model.quiet))?;
     let json = export::sensitivity::sensitivity_json(&result);
     match &args.json {
@@ -181,14 +191,16 @@ fn run_shard(
     let blocks = ensemble.block_range();
     let realizations = partition.realizations_in(&blocks);
     let (k, m) = (shard.index, shard.of);
-    let mut file = accelcal::output::AtomicFile::create(path)?;
+    // Both files are made before the run: a destination that cannot be written is refused at
+    // once, and neither is left behind by a failure (or by SIGINT or SIGTERM).
+    let mut file = AtomicFile::create(path)?;
+    // The header carries the run time, so blocks wait in a scratch file until the run ends.
+    let (spool, spool_file) = ScratchFile::beside(path, "blocks")?;
+    let mut spool_w = std::io::BufWriter::new(spool_file);
     let mut bar = Bar::new(quiet);
     bar.start(&format!("shard {k}/{m}"), realizations);
     let start = std::time::Instant::now();
     let mut written = Ok(());
-    // The header carries the run time, so blocks wait in a second temporary until the run ends.
-    let spool = tempfile_beside(path)?;
-    let mut spool_w = std::io::BufWriter::new(std::fs::File::create(&spool)?);
     ensemble.blocks(
         |done| bar.advance(done),
         |index, acc| {
@@ -211,17 +223,13 @@ fn run_shard(
         elapsed_s: start.elapsed().as_secs_f64(),
         engine,
     };
-    let result = (|| -> Result<()> {
-        written?;
-        spool_w.flush()?;
-        drop(spool_w);
-        let mut blocks = std::io::BufReader::new(std::fs::File::open(&spool)?);
-        partial::write_partial(file.writer(), &header, &mut blocks)?;
-        file.commit()?;
-        Ok(())
-    })();
-    let _ = std::fs::remove_file(&spool);
-    result?;
+    written
+        .and_then(|()| spool_w.flush())
+        .map_err(|e| spool.error(e))?;
+    drop(spool_w);
+    let mut blocks_read = std::io::BufReader::new(spool.open()?);
+    partial::write_partial(file.writer(), &header, &mut blocks_read).map_err(|e| file.error(e))?;
+    file.commit()?;
     if !quiet {
         println!(
             "shard {k}/{m}: blocks {}..{} ({realizations} realizations) written to {}",
@@ -233,16 +241,10 @@ fn run_shard(
     Ok(())
 }
 
-/// A temporary file name beside `path` for spooled output.
-fn tempfile_beside(path: &Path) -> Result<std::path::PathBuf> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    Ok(path.with_file_name(format!(".{name}.{}.blocks", std::process::id())))
-}
-
 pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
+    if let Some(path) = &args.json {
+        check_file(path)?;
+    }
     let mut files = Vec::with_capacity(args.files.len());
     for path in &args.files {
         let name = path.display().to_string();
