@@ -378,8 +378,8 @@ fn an_output_that_cannot_be_replaced_leaves_the_earlier_report_alone() {
     let o = report(dir.path(), SMALL);
     assert_eq!(
         o.status.code(),
-        Some(1),
-        "an output problem is not bad input"
+        Some(2),
+        "an output that cannot be written is the user's to fix, like bad input"
     );
     assert!(String::from_utf8_lossy(&o.stderr).contains("directory"));
     assert_eq!(
