@@ -165,6 +165,25 @@ fn a_configuration_edited_in_every_header_is_refused() {
     }
 }
 
+/// The issue's reproducer: with one file's header edited, the intact file was blamed. The edited
+/// one is named, whichever comes first.
+#[test]
+fn the_edited_file_is_named_not_the_intact_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    two_partials(d);
+    std::fs::copy(d.join("b.bin"), d.join("e-b.bin")).unwrap();
+    partials::edit_header(&d.join("e-b.bin"), r#""seed":2017"#, r#""seed":5"#, false);
+    for files in [["a.bin", "e-b.bin"], ["e-b.bin", "a.bin"]] {
+        refused(
+            d,
+            &files,
+            &["e-b.bin: damaged or edited"],
+            &format!("{files:?}"),
+        );
+    }
+}
+
 #[test]
 fn a_partial_of_the_first_format_is_refused_with_the_way_out() {
     let dir = tempfile::tempdir().unwrap();
