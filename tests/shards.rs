@@ -285,3 +285,43 @@ fn the_slurm_example_runs_each_array_task_as_a_shard() {
         "{msg}"
     );
 }
+
+/// The script's threads follow the CPUs Slurm gives the task (`SLURM_CPUS_PER_TASK`), or the
+/// node's when none is set (it fixed 4 CPUs, and a smaller node left the array pending); the
+/// command it runs is shard K/M of the array. Seen through a stand-in for accelcal (`ACCELCAL`)
+/// that prints its thread count and arguments.
+#[test]
+fn the_slurm_example_takes_its_threads_from_the_task() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let stand_in = d.join("stand-in");
+    std::fs::write(&stand_in, "#!/bin/sh\necho \"$RAYON_NUM_THREADS $*\"\n").unwrap();
+    let executable = std::os::unix::fs::PermissionsExt::from_mode(0o755);
+    std::fs::set_permissions(&stand_in, executable).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/slurm-ensemble.sh");
+    let nproc = String::from_utf8(Command::new("nproc").output().unwrap().stdout).unwrap();
+    for cpus in [Some("3"), None] {
+        let mut c = Command::new("bash");
+        c.arg(&script)
+            .args(["c.toml", "out"])
+            .current_dir(d)
+            .env("ACCELCAL", &stand_in)
+            .env("SLURM_ARRAY_TASK_COUNT", "3")
+            .env("SLURM_ARRAY_TASK_MIN", "1")
+            .env("SLURM_ARRAY_TASK_MAX", "3")
+            .env("SLURM_ARRAY_TASK_ID", "2");
+        match cpus {
+            Some(n) => c.env("SLURM_CPUS_PER_TASK", n),
+            None => c.env_remove("SLURM_CPUS_PER_TASK"),
+        };
+        let o = c.output().unwrap();
+        ok(&o);
+        let threads = cpus.unwrap_or(nproc.trim());
+        assert_eq!(
+            String::from_utf8_lossy(&o.stdout).trim(),
+            format!(
+                "{threads} ensemble --config c.toml --shard 2/3 --partial out/part-2.bin --quiet"
+            )
+        );
+    }
+}
