@@ -36,7 +36,25 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
             || e.downcast_ref::<CalibrateError>()
                 .is_some_and(CalibrateError::is_bad_input)
     });
-    if bad_input { 2 } else { 1 }
+    if bad_input || err.chain().any(|e| e.is::<StdoutError>()) {
+        2
+    } else {
+        1
+    }
+}
+
+/// Standard output could not take what a command printed (`/dev/full`, a closed pipe).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write to standard output: {0}")]
+pub(crate) struct StdoutError(std::io::Error);
+
+/// Writes `text` to standard output; an error is returned, not a panic as `print!` would.
+pub(crate) fn say(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| StdoutError(e).into())
 }
 
 /// Runs the parsed command line.
@@ -50,10 +68,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Merge(args)) => monte_carlo::run_merge(&args),
         Some(Command::Calibrate(args)) => logs::run_calibrate(&args),
         Some(Command::Allan(args)) => allan::run_allan(&args),
-        Some(Command::Config) => {
-            print!("{DEFAULT_TOML}");
-            Ok(())
-        }
+        Some(Command::Config) => say(DEFAULT_TOML),
     }
 }
 

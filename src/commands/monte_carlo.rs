@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{Bar, load_model, verdict_lines, write};
+use super::{Bar, load_model, say, verdict_lines, write};
 use crate::cli::{CaseArgs, EnsembleArgs, MergeArgs, ReportArgs, SensitivityArgs};
 use accelcal::config::{Config, SensitivityConfig};
 use accelcal::ensemble::{Engine, Ensemble, EnsembleRun, EnsembleStats, Partition, Shard, partial};
@@ -38,16 +38,12 @@ pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
         ],
     )?;
     for o in &study.cases {
-        print!(
-            "{}",
-            verdict_lines(&o.case.to_string(), &o.run, &o.verdicts)
-        );
+        say(&verdict_lines(&o.case.to_string(), &o.run, &o.verdicts))?;
     }
-    println!(
-        "report written to {}",
+    say(&format!(
+        "report written to {}\n",
         args.out.join("index.html").display()
-    );
-    Ok(())
+    ))
 }
 
 /// The command line that reproduces a report.
@@ -88,9 +84,9 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         Some(path) => {
             write(path, json.as_bytes())?;
             let label = model.case().to_string();
-            print!("{}", verdict_lines(&label, &outcome.run, &outcome.verdicts));
+            say(&verdict_lines(&label, &outcome.run, &outcome.verdicts))?;
         }
-        None => println!("{json}"),
+        None => say(&format!("{json}\n"))?,
     }
     Ok(())
 }
@@ -143,9 +139,13 @@ pub(super) fn run_sensitivity(args: &SensitivityArgs) -> Result<()> {
     match &args.json {
         Some(path) => {
             write(path, json.as_bytes())?;
-            println!("{} cases written to {}", result.cases.len(), path.display());
+            say(&format!(
+                "{} cases written to {}\n",
+                result.cases.len(),
+                path.display()
+            ))?;
         }
-        None => println!("{json}"),
+        None => say(&format!("{json}\n"))?,
     }
     Ok(())
 }
@@ -223,12 +223,12 @@ fn run_shard(
     let _ = std::fs::remove_file(&spool);
     result?;
     if !quiet {
-        println!(
-            "shard {k}/{m}: blocks {}..{} ({realizations} realizations) written to {}",
+        say(&format!(
+            "shard {k}/{m}: blocks {}..{} ({realizations} realizations) written to {}\n",
             blocks.start,
             blocks.end,
             path.display()
-        );
+        ))?;
     }
     Ok(())
 }
@@ -268,10 +268,10 @@ pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
             write(path, json.as_bytes())?;
             if !args.quiet {
                 let label = format!("{} (merged from {} shards)", model.case(), args.files.len());
-                print!("{}", verdict_lines(&label, &outcome.run, &outcome.verdicts));
+                say(&verdict_lines(&label, &outcome.run, &outcome.verdicts))?;
             }
         }
-        None => println!("{json}"),
+        None => say(&format!("{json}\n"))?,
     }
     Ok(())
 }

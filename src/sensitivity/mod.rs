@@ -21,7 +21,7 @@ use crate::error::{ConfigError, FilterError};
 use crate::filter::FilterSchedule;
 use crate::model::Model;
 use crate::progress::Progress;
-use crate::state::ErrorState;
+use crate::state::{ErrorState, NoiseStats};
 pub use covariance::{ActualFix, SampleCovariance, actual_covariance, covariance_at_samples};
 pub use detection::Detection;
 
@@ -113,6 +113,35 @@ impl AssumedStatistic {
     }
 }
 
+impl AssumedStatistic {
+    /// `stats` with this statistic's standard deviation times `factor` (a variance times
+    /// `factor²`), as [`AssumedStatistic::scaled`] does to a configuration.
+    pub fn scaled_stats(self, stats: &NoiseStats, factor: f64) -> NoiseStats {
+        let mut s = *stats;
+        let (value, power) = self.value_mut(&mut s);
+        *value *= factor.powi(power);
+        s
+    }
+
+    /// The value this statistic takes in `stats`, and the power of a factor on σ that scales it.
+    fn value_mut(self, s: &mut NoiseStats) -> (&mut f64, i32) {
+        match self {
+            AssumedStatistic::AccelNoise => (&mut s.accel_noise_var_m2_s4, 2),
+            AssumedStatistic::BiasPrior => (&mut s.bias_var_m2_s4, 2),
+            AssumedStatistic::GpsPosition => (&mut s.gps_position_sigma_m, 1),
+            AssumedStatistic::GpsVelocity => (&mut s.gps_velocity_sigma_m_s, 1),
+            AssumedStatistic::InitialPosition => (&mut s.initial_position_sigma_m, 1),
+            AssumedStatistic::InitialVelocity => (&mut s.initial_velocity_sigma_m_s, 1),
+        }
+    }
+
+    /// The value this statistic takes in `stats`.
+    pub fn value(self, stats: &NoiseStats) -> f64 {
+        let mut s = *stats;
+        *self.value_mut(&mut s).0
+    }
+}
+
 /// What the sensitivity study runs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Plan {
@@ -150,6 +179,18 @@ impl Plan {
 /// Why a sensitivity plan cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum SensitivityError {
+    /// The configuration in the study's world (euler truth, point samples) is out of range.
+    #[error("the sensitivity study's world (euler truth, point samples)")]
+    World {
+        /// The configuration's complaint.
+        source: ConfigError,
+    },
+    /// The configured filter's covariance stops being positive definite.
+    #[error("the sensitivity study's filter as configured")]
+    Configured {
+        /// The filter's complaint.
+        source: FilterError,
+    },
     /// A scaled statistic leaves the accepted range.
     #[error("the filter assuming {parameter} × {factor}")]
     Config {
@@ -161,12 +202,18 @@ pub enum SensitivityError {
         source: ConfigError,
     },
     /// A scaled filter's covariance stops being positive definite.
-    #[error("the filter assuming {parameter} × {factor}")]
+    #[error(
+        "the sensitivity study's filter assuming σ × {factor} for filter.{parameter}, which \
+         takes it to {}",
+        crate::config::show(*value)
+    )]
     Filter {
         /// The statistic.
         parameter: &'static str,
-        /// The factor.
+        /// The factor on its standard deviation.
         factor: f64,
+        /// The scaled value (a variance scales by the factor's square).
+        value: f64,
         /// The filter's complaint.
         source: FilterError,
     },
@@ -263,35 +310,39 @@ fn sigma(p: &crate::state::StateMatrix) -> [f64; ErrorState::DIM] {
     std::array::from_fn(|k| p[(k, k)].sqrt())
 }
 
-/// The model and filter schedule of `config`, whose filter assumes `parameter` × `factor` (named
-/// in errors).
-fn filter_of(
-    config: &Config,
-    parameter: &'static str,
-    factor: f64,
-) -> Result<(Model, FilterSchedule), SensitivityError> {
-    let model = Model::new(config).map_err(|source| SensitivityError::Config {
-        parameter,
-        factor,
-        source,
-    })?;
-    let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats).map_err(|source| {
-        SensitivityError::Filter {
-            parameter,
-            factor,
-            source,
-        }
-    })?;
-    Ok((model, schedule))
+/// The filter schedule of the configured filter in `world`.
+fn configured(world: &Config) -> Result<FilterSchedule, SensitivityError> {
+    let model = Model::new(world).map_err(|source| SensitivityError::World { source })?;
+    FilterSchedule::new(&model.timeline, &model.filter_stats)
+        .map_err(|source| SensitivityError::Configured { source })
 }
 
 /// The filter of `parameter` × `factor` in `world`, with its schedule.
+///
+/// The scaled statistic is not held to the range a configuration may set (`ensemble` accepts a
+/// `[filter]` value at the range's edge, which the factors then carry beyond it): the filter's
+/// covariance recursion, which refuses a covariance that is not positive definite, is its check.
 fn mistuned(
     world: &Config,
     parameter: AssumedStatistic,
     factor: f64,
 ) -> Result<(Model, FilterSchedule), SensitivityError> {
-    filter_of(&parameter.scaled(world, factor), parameter.name(), factor)
+    let mut model = Model::new(world).map_err(|source| SensitivityError::Config {
+        parameter: parameter.name(),
+        factor,
+        source,
+    })?;
+    model.filter_stats = parameter.scaled_stats(&model.filter_stats, factor);
+    model.config = parameter.scaled(world, factor);
+    let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats).map_err(|source| {
+        SensitivityError::Filter {
+            parameter: parameter.name(),
+            factor,
+            value: parameter.value(&model.filter_stats),
+            source,
+        }
+    })?;
+    Ok((model, schedule))
 }
 
 /// Runs `plan` on `base` (its statistics are the truth's; its `[filter]` the starting point).
@@ -308,14 +359,18 @@ pub fn run(
 ) -> Result<Sensitivity, SensitivityError> {
     let world = world(base, plan.realizations);
     let budget = Budget::study(base.checks.false_alarm_rate);
-    let (_, tuned_schedule) = filter_of(&world, "configured", 1.0)?;
+    let tuned_schedule = configured(&world)?;
     let grid: Vec<(AssumedStatistic, f64)> = plan
         .parameters
         .iter()
         .flat_map(|&p| plan.factors.iter().map(move |&f| (p, f)))
         .collect();
-    // The sampler needs more realizations than the joint state has dimensions.
-    let draws = if plan.realizations > 6 { plan.draws } else { 0 };
+    // The sampler's Wishart draws need enough realizations (smaller ensembles are not sampled).
+    let draws = if plan.realizations >= sampler::Sampler::MIN_REALIZATIONS {
+        plan.draws
+    } else {
+        0
+    };
     let seed = base.ensemble.seed;
 
     // Exact and sampled predictions, no simulation.
