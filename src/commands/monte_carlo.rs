@@ -3,13 +3,13 @@
 
 use std::path::Path;
 
-use super::{Bar, load_model, say, verdict_lines, write};
+use super::{Bar, check_memory, load_model, say, verdict_lines, write};
 use crate::cli::{CaseArgs, EnsembleArgs, MergeArgs, ReportArgs, SensitivityArgs};
 use accelcal::config::{Config, SensitivityConfig};
 use accelcal::ensemble::{Engine, Ensemble, EnsembleRun, EnsembleStats, Partition, Shard, partial};
 use accelcal::error::ConfigError;
 use accelcal::filter::FilterSchedule;
-use accelcal::model::Model;
+use accelcal::model::{Model, Work};
 use accelcal::output::write_all_atomic;
 use accelcal::sensitivity::{self, AssumedStatistic, Plan};
 use accelcal::study::{self, Progress, Study};
@@ -18,6 +18,7 @@ use anyhow::Result;
 
 pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
     let model = load_model(&args.model, &CaseArgs::default(), args.realizations)?;
+    check_memory(&model, Work::Report, &args.model)?;
     let mut bar = Bar::new(args.model.quiet);
     let study = Study::run(&model, &mut bar)?.with_sensitivity(&mut bar)?;
     let static_noise = accelcal::allan::section::report_coverage()?;
@@ -63,6 +64,7 @@ fn reproduce_command(args: &ReportArgs) -> String {
 
 pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
     let model = load_model(&args.model, &args.case, args.realizations)?;
+    check_memory(&model, Work::Ensemble, &args.model)?;
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
     if let (Some(shard), Some(path)) = (&args.shard, &args.partial) {
         return run_shard(
@@ -133,6 +135,7 @@ fn sensitivity_plan(args: &SensitivityArgs, config: &Config) -> Result<Plan, Con
 
 pub(super) fn run_sensitivity(args: &SensitivityArgs) -> Result<()> {
     let model = load_model(&args.model, &CaseArgs::default(), args.realizations)?;
+    check_memory(&model, Work::Sensitivity, &args.model)?;
     let plan = sensitivity_plan(args, &model.config)?;
     let result = sensitivity::run(&model.config, &plan, &mut Bar::new(args.model.quiet))?;
     let json = export::sensitivity::sensitivity_json(&result);

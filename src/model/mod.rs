@@ -5,6 +5,7 @@ mod validate;
 
 use crate::config::{AccelerometerOutput, Case, Config, TruthModel};
 use crate::error::ConfigError;
+pub use validate::{MemoryEstimate, Work};
 use validate::{validate, whole};
 
 use crate::state::ErrorState;
