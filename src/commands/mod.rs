@@ -162,7 +162,13 @@ pub(crate) fn check_memory(model: &Model, work: Work, args: &ModelArgs) -> Resul
             .residual_max_lag
             .map_or("its default".to_string(), |l| l.to_string()),
     };
-    let gb = |b: f64| format!("{:.2} GB", b / 1e9);
+    let gb = |b: f64| {
+        if b < 1e9 {
+            format!("{:.0} MB", b / 1e6)
+        } else {
+            format!("{:.2} GB", b / 1e9)
+        }
+    };
     let err = ConfigError::invalid(
         estimate.key,
         value,

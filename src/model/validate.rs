@@ -346,8 +346,9 @@ impl super::Model {
     ///
     /// # Formula
     /// bytes = 8 MiB + c + samples·s + fixes·f + blocks·B, where c, s and f are the work's
-    /// fixed bytes and bytes per sample and per fix, B the bytes of one block's running sums, and blocks = 2·threads + 1
-    /// for the ensembles (each thread merges into its own sums while a block runs, and the
+    /// fixed bytes and bytes per sample and per fix, B the bytes of one block's running sums,
+    /// and blocks = min(2·threads, N) + 1 for the ensembles (each thread merges into its own
+    /// sums while a block runs, a block holds at least one of the N realizations, and the
     /// total) and 0 for a simulation.
     pub fn peak_memory(&self, work: Work, threads: usize) -> MemoryEstimate {
         let (fixed, per_sample, per_fix) = work.bytes_fixed_per_sample_and_fix();
@@ -355,7 +356,7 @@ impl super::Model {
         let fixes = self.timeline.fixes() as f64;
         let blocks = match work {
             Work::Simulate => 0.0,
-            _ => 2.0 * threads.max(1) as f64 + 1.0,
+            _ => (2 * threads.max(1) as u64).min(self.config.ensemble.realizations) as f64 + 1.0,
         };
         let sums = blocks * sums_bytes(&self.config, self.timeline.fixes() as u64);
         let terms = [
