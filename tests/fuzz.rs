@@ -397,14 +397,9 @@ const KNOWN: &[Known] = &[
     (
         |_, _, what| {
             what.starts_with("exit code 1")
-                && [
-                    "cannot create",
-                    "cannot write",
-                    "cannot rename",
-                    "cannot open",
-                ]
-                .iter()
-                .any(|w| what.contains(w))
+                && ["cannot create", "cannot write", "cannot rename"]
+                    .iter()
+                    .any(|w| what.contains(w))
         },
         "an output path that cannot be written exits 1 (outputs, issue 22 point 3)",
     ),
