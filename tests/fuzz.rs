@@ -879,3 +879,35 @@ fn thousands_of_hostile_inputs_end_in_0_or_2_and_clobber_nothing() {
         "every share of the inputs ran"
     );
 }
+
+#[test]
+fn the_judge_fails_what_it_must() {
+    let ended = |code, hung, stderr: &str| Ended {
+        code,
+        hung,
+        stderr: stderr.to_string(),
+    };
+    assert!(fault(&ended(Some(0), false, "")).is_none());
+    assert!(fault(&ended(Some(2), false, "error: bad")).is_none());
+    assert!(fault(&ended(Some(101), false, "")).is_some());
+    assert!(fault(&ended(Some(2), false, "thread 'main' panicked at")).is_some());
+    assert!(fault(&ended(Some(1), false, "error: x")).is_some());
+    assert!(fault(&ended(None, true, "")).is_some());
+    assert!(
+        fault(&ended(None, false, "")).is_some(),
+        "killed by a signal"
+    );
+    // A changed sentinel is seen, an untouched one is not.
+    let dir = tempfile::tempdir().unwrap();
+    plant(dir.path(), &["a/out.json", "b.csv"]);
+    assert!(clobbered(dir.path(), &["a/out.json", "b.csv"]).is_empty());
+    std::fs::write(dir.path().join("b.csv"), "changed").unwrap();
+    assert_eq!(clobbered(dir.path(), &["a/out.json", "b.csv"]), ["b.csv"]);
+    // Keys are set in their table, or their table is added.
+    let text = set_key(TINY, "ensemble", "realizations", "99");
+    assert!(text.contains("realizations = 99\n") && !text.contains("realizations = 12"));
+    assert!(
+        set_key(TINY, "checks", "false_alarm_rate", "0.1")
+            .ends_with("[checks]\nfalse_alarm_rate = 0.1\n")
+    );
+}
