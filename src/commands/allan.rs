@@ -51,7 +51,7 @@ pub(super) fn run_allan(args: &AllanArgs) -> Result<()> {
             .with_context(|| format!("cannot write {}", args.out.join(file).display()))?;
     }
     staged.commit()?;
-    println!("{}", summary(&a, &args.out));
+    super::say(&format!("{}\n", summary(&a, &args.out)))?;
     Ok(())
 }
 

@@ -21,6 +21,7 @@ use anyhow::{Context, Result};
 
 pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
     let model = load_model(&args.model, &args.case, None)?;
+    super::check_memory(&model, accelcal::model::Work::Simulate, &args.model)?;
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
     let seed = model.config.ensemble.seed;
     if let Some(dir) = &args.logs {

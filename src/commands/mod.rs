@@ -16,16 +16,23 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use crate::cli::{CaseArgs, Cli, Command, ModelArgs, ReportArgs};
 use accelcal::calibrate::CalibrateError;
 use accelcal::checks::{Untestable, Verdict, Verdicts};
+use accelcal::config::show;
 use accelcal::config::{Config, ConfigText, DEFAULT_TOML};
 use accelcal::ensemble::{EnsembleRun, partial};
 use accelcal::error::{ConfigError, FilterError};
 use accelcal::format::{count, sig};
 use accelcal::logs::LogError;
-use accelcal::model::Model;
+use accelcal::model::{Model, Work};
 use accelcal::output::write_atomic;
 use accelcal::study::Progress;
 
-/// Exit code for `err`: 2 for bad input (configuration, filter statistics, logs), 1 otherwise.
+/// Exit code for `err`: 2 for what the user can fix — bad input (configuration, filter
+/// statistics, logs, partials), an output that cannot be written (a path that is a directory,
+/// in a missing or read-only directory, a full device) and standard output refusing what is
+/// printed; 1 otherwise (a fault of the program or the machine).
+///
+/// Results are written only through [`accelcal::output`], so an operating system's error that
+/// reaches here is one of an output's.
 pub fn exit_code(err: &anyhow::Error) -> u8 {
     let bad_input = err.chain().any(|e| {
         e.is::<ConfigError>()
@@ -36,7 +43,24 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
             || e.downcast_ref::<CalibrateError>()
                 .is_some_and(CalibrateError::is_bad_input)
     });
-    if bad_input { 2 } else { 1 }
+    let output = err.chain().any(|e| {
+        e.is::<StdoutError>() || e.is::<accelcal::output::OutputError>() || e.is::<std::io::Error>()
+    });
+    if bad_input || output { 2 } else { 1 }
+}
+
+/// Standard output could not take what a command printed (`/dev/full`, a closed pipe).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write to standard output: {0}")]
+pub(crate) struct StdoutError(std::io::Error);
+
+/// Writes `text` to standard output; an error is returned, not a panic as `print!` would.
+pub(crate) fn say(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| StdoutError(e).into())
 }
 
 /// Runs the parsed command line.
@@ -50,10 +74,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Merge(args)) => monte_carlo::run_merge(&args),
         Some(Command::Calibrate(args)) => logs::run_calibrate(&args),
         Some(Command::Allan(args)) => allan::run_allan(&args),
-        Some(Command::Config) => {
-            print!("{DEFAULT_TOML}");
-            Ok(())
-        }
+        Some(Command::Config) => say(DEFAULT_TOML),
     }
 }
 
@@ -96,6 +117,83 @@ pub(crate) fn load_model(
     })
 }
 
+/// The memory this machine can give a run, bytes, and where the figure comes from:
+/// `ACCELCAL_MEMORY_AVAILABLE` (bytes) when set, else `MemAvailable` of /proc/meminfo, lowered
+/// to what the cgroup v2 limit leaves (memory.max − memory.current); `None` where neither is
+/// known (the run is then not checked).
+fn available_memory() -> Option<(f64, &'static str)> {
+    if let Ok(v) = std::env::var("ACCELCAL_MEMORY_AVAILABLE") {
+        return v
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .map(|b| (b, "ACCELCAL_MEMORY_AVAILABLE"));
+    }
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kb: f64 = meminfo
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    let read = |p: &str| -> Option<f64> { std::fs::read_to_string(p).ok()?.trim().parse().ok() };
+    let cgroup = read("/sys/fs/cgroup/memory.max")
+        .zip(read("/sys/fs/cgroup/memory.current"))
+        .map(|(max, current)| max - current);
+    match cgroup {
+        Some(left) if left < kb * 1024.0 => Some((left, "the cgroup's memory.max")),
+        _ => Some((kb * 1024.0, "MemAvailable")),
+    }
+}
+
+/// Refuses a run of `work` on `model` predicted to need more memory than the machine has,
+/// naming the figure and the key to change (at its line of the configuration named by `args`).
+pub(crate) fn check_memory(model: &Model, work: Work, args: &ModelArgs) -> Result<(), ConfigError> {
+    let Some((available, source)) = available_memory() else {
+        return Ok(());
+    };
+    let estimate = model.peak_memory(work, rayon::current_num_threads());
+    if estimate.bytes <= available {
+        return Ok(());
+    }
+    let c = &model.config;
+    let value = match estimate.key {
+        "profile.duration_s" => show(c.profile.duration_s),
+        "gps.sample_rate_hz" => show(c.gps.sample_rate_hz),
+        _ => c
+            .checks
+            .residual_max_lag
+            .map_or("its default".to_string(), |l| l.to_string()),
+    };
+    let gb = |b: f64| {
+        if b < 1e9 {
+            format!("{:.0} MB", b / 1e6)
+        } else {
+            format!("{:.2} GB", b / 1e9)
+        }
+    };
+    let err = ConfigError::invalid(
+        estimate.key,
+        value,
+        format!(
+            "this {} run is predicted to need about {} of memory at its peak ({}), more \
+             than the {} this machine has available ({source}): lower {} (or run on a larger \
+             machine)",
+            format!("{work:?}").to_lowercase(),
+            gb(estimate.bytes),
+            estimate.terms,
+            gb(available),
+            estimate.key
+        ),
+    );
+    Err(match args.config.as_deref().map(ConfigText::read) {
+        Some(Ok(text)) => text.locate(err),
+        _ => err,
+    })
+}
+
 /// A progress bar on standard error when it is a terminal and not silenced, hidden otherwise.
 pub(crate) struct Bar {
     quiet: bool,
@@ -129,6 +227,8 @@ impl Progress for Bar {
             .progress_chars("=> "),
         );
         bar.set_prefix(label.to_string());
+        // The clock moves while a long step (a case of the sensitivity study) reports nothing.
+        bar.enable_steady_tick(std::time::Duration::from_millis(500));
         bar.set_message(unit.to_string());
         self.bar = Some(bar);
     }

@@ -4,13 +4,13 @@
 use std::io::Write as _;
 use std::path::Path;
 
-use super::{Bar, load_model, verdict_lines, write};
+use super::{Bar, check_memory, load_model, say, verdict_lines, write};
 use crate::cli::{CaseArgs, EnsembleArgs, MergeArgs, ReportArgs, SensitivityArgs};
 use accelcal::config::{Config, SensitivityConfig};
 use accelcal::ensemble::{Engine, Ensemble, EnsembleRun, EnsembleStats, Partition, Shard, partial};
 use accelcal::error::ConfigError;
 use accelcal::filter::FilterSchedule;
-use accelcal::model::Model;
+use accelcal::model::{Model, Work};
 use accelcal::output::{AtomicFile, ScratchFile, check_directory, check_file, write_all_atomic};
 use accelcal::sensitivity::{self, AssumedStatistic, Plan};
 use accelcal::study::{self, Progress, Study};
@@ -23,6 +23,7 @@ const REPORT_FILES: [&str; 3] = ["index.html", "data.json", "view.json"];
 pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
     let model = load_model(&args.model, &CaseArgs::default(), args.realizations)?;
     check_directory(&args.out, &REPORT_FILES)?;
+    check_memory(&model, Work::Report, &args.model)?;
     let mut bar = Bar::new(args.model.quiet);
     let study = Study::run(&model, &mut bar)?.with_sensitivity(&mut bar)?;
     let static_noise = accelcal::allan::section::report_coverage()?;
@@ -43,16 +44,12 @@ pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
         ],
     )?;
     for o in &study.cases {
-        print!(
-            "{}",
-            verdict_lines(&o.case.to_string(), &o.run, &o.verdicts)
-        );
+        say(&verdict_lines(&o.case.to_string(), &o.run, &o.verdicts))?;
     }
-    println!(
-        "report written to {}",
+    say(&format!(
+        "report written to {}\n",
         args.out.join("index.html").display()
-    );
-    Ok(())
+    ))
 }
 
 /// The command line that reproduces a report.
@@ -72,6 +69,7 @@ fn reproduce_command(args: &ReportArgs) -> String {
 
 pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
     let model = load_model(&args.model, &args.case, args.realizations)?;
+    check_memory(&model, Work::Ensemble, &args.model)?;
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
     if let Some(path) = &args.json {
         check_file(path)?;
@@ -96,9 +94,9 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         Some(path) => {
             write(path, json.as_bytes())?;
             let label = model.case().to_string();
-            print!("{}", verdict_lines(&label, &outcome.run, &outcome.verdicts));
+            say(&verdict_lines(&label, &outcome.run, &outcome.verdicts))?;
         }
-        None => println!("{json}"),
+        None => say(&format!("{json}\n"))?,
     }
     Ok(())
 }
@@ -145,6 +143,7 @@ fn sensitivity_plan(args: &SensitivityArgs, config: &Config) -> Result<Plan, Con
 
 pub(super) fn run_sensitivity(args: &SensitivityArgs) -> Result<()> {
     let model = load_model(&args.model, &CaseArgs::default(), args.realizations)?;
+    check_memory(&model, Work::Sensitivity, &args.model)?;
     let plan = sensitivity_plan(args, &model.config)?;
     if let Some(path) = &args.json {
         check_file(path)?;
@@ -154,9 +153,13 @@ pub(super) fn run_sensitivity(args: &SensitivityArgs) -> Result<()> {
     match &args.json {
         Some(path) => {
             write(path, json.as_bytes())?;
-            println!("{} cases written to {}", result.cases.len(), path.display());
+            say(&format!(
+                "{} cases written to {}\n",
+                result.cases.len(),
+                path.display()
+            ))?;
         }
-        None => println!("{json}"),
+        None => say(&format!("{json}\n"))?,
     }
     Ok(())
 }
@@ -231,12 +234,12 @@ fn run_shard(
     partial::write_partial(file.writer(), &header, &mut blocks_read).map_err(|e| file.error(e))?;
     file.commit()?;
     if !quiet {
-        println!(
-            "shard {k}/{m}: blocks {}..{} ({realizations} realizations) written to {}",
+        say(&format!(
+            "shard {k}/{m}: blocks {}..{} ({realizations} realizations) written to {}\n",
             blocks.start,
             blocks.end,
             path.display()
-        );
+        ))?;
     }
     Ok(())
 }
@@ -270,10 +273,10 @@ pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
             write(path, json.as_bytes())?;
             if !args.quiet {
                 let label = format!("{} (merged from {} shards)", model.case(), args.files.len());
-                print!("{}", verdict_lines(&label, &outcome.run, &outcome.verdicts));
+                say(&verdict_lines(&label, &outcome.run, &outcome.verdicts))?;
             }
         }
-        None => println!("{json}"),
+        None => say(&format!("{json}\n"))?,
     }
     Ok(())
 }

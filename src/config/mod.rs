@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{ConfigError, Position};
 pub use case::{AccelerometerOutput, Case, TruthModel};
 pub use sensitivity::SensitivityConfig;
-pub use source::ConfigText;
+pub use source::{ConfigText, MAX_CONFIG_BYTES};
 
 /// Every parameter of the study.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -213,6 +213,16 @@ impl Default for ChecksConfig {
     }
 }
 
+/// `x` as a person would write it and as it reads back: the shortest decimal that round-trips,
+/// in exponent notation when it is very small or very large (1e-300, not 300 digits).
+pub fn show(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e7).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 /// The default configuration as an annotated TOML file (what `accelcal config` prints).
 pub const DEFAULT_TOML: &str = include_str!("default_config.toml");
 
@@ -223,13 +233,17 @@ impl Config {
     /// [`ConfigError::Parse`] with the parser's message, the line and column, the field's
     /// dotted path and the offending line where the parser gives a span.
     pub fn from_toml_str(text: &str) -> Result<Self, ConfigError> {
+        if let Some(err) = source::lone_carriage_return(text) {
+            return Err(err);
+        }
         toml::from_str(text).map_err(|e| {
             let span = e.span();
+            let message = source::explain(text, span.clone(), e.message().trim_end());
             ConfigError::Parse {
                 file: None,
                 position: span.clone().map(|s| Box::new(Position::of(text, s))),
                 field: span.and_then(|s| source::field_at(text, s.start)),
-                message: e.message().trim_end().to_string(),
+                message,
             }
         })
     }

@@ -52,7 +52,7 @@ impl SensitivityConfig {
         {
             return Err(ConfigError::invalid(
                 factors,
-                f,
+                super::show(*f),
                 "every factor must be a finite number in (0, 1000]",
             ));
         }

@@ -1,10 +1,12 @@
 //! The validated study model: time grid, acceleration profile, truth, and the noise statistics of
 //! the truth and of the filter. Built once from a [`Config`]; everything downstream reads it.
 
+mod memory;
 mod validate;
 
 use crate::config::{AccelerometerOutput, Case, Config, TruthModel};
 use crate::error::ConfigError;
+pub use memory::{MemoryEstimate, Work};
 use validate::{validate, whole};
 
 use crate::state::ErrorState;

@@ -1,11 +1,12 @@
 //! Validation of a parsed [`Config`]: every field against its accepted range, once, naming the
 //! first offending field. A configuration that passes builds a [`super::Model`].
 
+use super::memory::sums_bytes;
 use super::{
-    ALL_PAIRS_MAX_FIXES, DEFAULT_MAX_LAG, FILTER_FLOOR, MAX_FIXES, MAX_REALIZATIONS, MAX_STEPS,
-    MAX_SUMS_BYTES, RESIDUAL_WIDTH, SUM_FLOATS_PER_FIX, WHOLE_TOL,
+    FILTER_FLOOR, MAX_FIXES, MAX_REALIZATIONS, MAX_STEPS, MAX_SUMS_BYTES, RESIDUAL_WIDTH,
+    SUM_FLOATS_PER_FIX, WHOLE_TOL,
 };
-use crate::config::Config;
+use crate::config::{Config, show};
 use crate::error::ConfigError;
 use crate::stats::MIN_ACCURATE_RATE;
 
@@ -16,15 +17,6 @@ const MIN_FALSE_ALARM_RATE: f64 = 1e-6;
 pub(super) fn whole(x: f64) -> Option<u64> {
     let r = x.round();
     (x.is_finite() && r >= 0.0 && (x - r).abs() <= WHOLE_TOL * r.max(1.0)).then_some(r as u64)
-}
-
-/// A number as a person would write it: exponent notation when it is very small or large.
-fn show(x: f64) -> String {
-    if x != 0.0 && x.is_finite() && !(1e-4..1e7).contains(&x.abs()) {
-        format!("{x:e}")
-    } else {
-        format!("{x}")
-    }
 }
 
 fn finite_in(
@@ -143,25 +135,40 @@ fn validate_grid(c: &Config) -> Result<Grid, ConfigError> {
     else {
         return Err(ConfigError::invalid(
             "profile.duration_s",
-            p.duration_s,
+            show(p.duration_s),
             format!(
                 "duration_s × accelerometer.sample_rate_hz ({} Hz) must be a whole number of \
                  samples in [1, {MAX_STEPS}]",
-                a.sample_rate_hz
+                show(a.sample_rate_hz)
             ),
         ));
     };
 
     let g = &c.gps;
     positive("gps.sample_rate_hz", g.sample_rate_hz, a.sample_rate_hz)?;
+    // Two fixes need two GPS periods within the run (one with a fix at the start): a slower GPS
+    // is the rate's fault, whatever the run's length.
+    let slowest_hz = (2.0 - f64::from(u8::from(g.fix_at_start))) / p.duration_s;
+    if g.sample_rate_hz < slowest_hz * (1.0 - WHOLE_TOL) {
+        return Err(ConfigError::invalid(
+            "gps.sample_rate_hz",
+            show(g.sample_rate_hz),
+            format!(
+                "a run of profile.duration_s = {} s holds fewer than 2 fixes at this rate: it must \
+                 be at least {} Hz (or lengthen the run)",
+                show(p.duration_s),
+                show(slowest_hz)
+            ),
+        ));
+    }
     let Some(per_fix) = whole(a.sample_rate_hz / g.sample_rate_hz) else {
         return Err(ConfigError::invalid(
             "gps.sample_rate_hz",
-            g.sample_rate_hz,
+            show(g.sample_rate_hz),
             format!(
                 "must divide accelerometer.sample_rate_hz ({} Hz) into a whole number of samples \
                  per fix",
-                a.sample_rate_hz
+                show(a.sample_rate_hz)
             ),
         ));
     };
@@ -171,11 +178,11 @@ fn validate_grid(c: &Config) -> Result<Grid, ConfigError> {
     if !(2..=MAX_FIXES as u64).contains(&fixes) {
         return Err(ConfigError::invalid(
             "profile.duration_s",
-            p.duration_s,
+            show(p.duration_s),
             format!(
                 "must hold between 2 and {MAX_FIXES} GPS fixes at gps.sample_rate_hz = {} Hz \
                  (it holds {fixes})",
-                g.sample_rate_hz
+                show(g.sample_rate_hz)
             ),
         ));
     }
@@ -231,30 +238,44 @@ fn validate_filter(c: &Config) -> Result<(), ConfigError> {
             finite_in(field, x, FILTER_FLOOR, 1e6, false)?;
         }
     }
-    let resolved: [(&'static str, f64); 4] = [
-        ("accel_noise_var_m2_s4", c.filter_accel_noise_var_m2_s4()),
-        ("bias_var_m2_s4", c.filter_bias_var_m2_s4()),
+    // A [filter] key left out takes the truth's value: one below the floor is the truth's key's
+    // to name, at its line.
+    let resolved: [(&'static str, &'static str, f64); 4] = [
+        (
+            "accel_noise_var_m2_s4",
+            "accelerometer.noise_var_m2_s4",
+            c.filter_accel_noise_var_m2_s4(),
+        ),
+        (
+            "bias_var_m2_s4",
+            "accelerometer.bias_var_m2_s4",
+            c.filter_bias_var_m2_s4(),
+        ),
         (
             "initial_position_sigma_m",
+            "initial.position_sigma_m",
             c.filter_initial_position_sigma_m(),
         ),
         (
             "initial_velocity_sigma_m_s",
+            "initial.velocity_sigma_m_s",
             c.filter_initial_velocity_sigma_m_s(),
         ),
     ];
-    for (name, x) in resolved {
-        if x < FILTER_FLOOR {
-            return Err(ConfigError::invalid(
-                "filter",
-                format!("{name} = {x} (taken from the truth)"),
-                format!(
-                    "the filter needs {name} ≥ {FILTER_FLOOR}; set filter.{name} to a value in [{FILTER_FLOOR}, 1000000]"
-                ),
-            ));
-        }
+    match resolved.iter().find(|(_, _, x)| *x < FILTER_FLOOR) {
+        Some(&(name, truth, x)) => Err(ConfigError::invalid(
+            truth,
+            show(x),
+            format!(
+                "the filter takes its {name} from this key (filter.{name} is not set) and needs \
+                 at least {}: set filter.{name} to a value in [{}, {}]",
+                show(FILTER_FLOOR),
+                show(FILTER_FLOOR),
+                show(1e6)
+            ),
+        )),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// The running sums of one block of realizations must fit the memory budget: the fix-level sums
@@ -263,21 +284,10 @@ fn validate_filter(c: &Config) -> Result<(), ConfigError> {
 fn validate_sums_memory(c: &Config, fixes: u64) -> Result<(), ConfigError> {
     let (k, g) = (&c.checks, &c.gps);
     let f = fixes as f64;
-    let lag = match k.residual_max_lag {
-        Some(l) => Some(f64::from(l)),
-        None if fixes as usize <= ALL_PAIRS_MAX_FIXES => None,
-        None => Some(DEFAULT_MAX_LAG as f64),
-    };
-    // The residual stacks M components per fix: M·f rows, of which a band of lags up to l keeps
-    // M·(l + 1) columns each, every pair the M·f·(M·f + 1)/2 of the lower triangle.
     let m = RESIDUAL_WIDTH as f64;
     let per_fix = SUM_FLOATS_PER_FIX as f64;
-    let products = match lag {
-        Some(l) if l + 1.0 < f => m * f * (m * l + m),
-        _ => m * f * (m * f + 1.0) / 2.0,
-    };
     let float_bytes = std::mem::size_of::<f64>() as f64;
-    let bytes = float_bytes * (per_fix * f + products);
+    let bytes = sums_bytes(c, fixes);
     if bytes > MAX_SUMS_BYTES as f64 {
         let budget = MAX_SUMS_BYTES as f64 / float_bytes - per_fix * f;
         let most = ((budget / (m * f) - m) / m).floor();
@@ -296,7 +306,7 @@ fn validate_sums_memory(c: &Config, fixes: u64) -> Result<(), ConfigError> {
             ),
             _ => ConfigError::invalid(
                 "gps.sample_rate_hz",
-                g.sample_rate_hz,
+                show(g.sample_rate_hz),
                 format!(
                     "the run would hold {fixes} fixes, whose running sums would take {} per block \
                      of realizations (at most {}): lower the GPS rate or shorten the run",
@@ -329,10 +339,13 @@ fn validate_residual_pair(c: &Config, grid: &Grid) -> Result<(), ConfigError> {
     if !ordered {
         return Err(ConfigError::invalid(
             "checks.residual_pair_s",
-            format!("[{tm}, {ti}]"),
+            format!("[{}, {}]", show(tm), show(ti)),
             format!(
-                "must be two GPS fix times [t_m, t_i] with t_m < t_i, multiples of {period} s in \
-                 [{first}, {last}]"
+                "must be two GPS fix times [t_m, t_i] with t_m < t_i, multiples of {} s in \
+                 [{}, {}]",
+                show(period),
+                show(first),
+                show(last)
             ),
         ));
     }
@@ -384,7 +397,7 @@ mod tests {
         assert_eq!(field_of(&c), "filter.gps_position_sigma_m");
         let mut c = Config::default();
         c.accelerometer.noise_var_m2_s4 = 0.0;
-        assert_eq!(field_of(&c), "filter");
+        assert_eq!(field_of(&c), "accelerometer.noise_var_m2_s4");
         let mut c = Config::default();
         c.filter.gps_position_sigma_m = Some(1e-200);
         assert_eq!(field_of(&c), "filter.gps_position_sigma_m");

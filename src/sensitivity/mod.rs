@@ -13,6 +13,7 @@ pub mod covariance;
 pub mod detection;
 mod prediction;
 pub mod sampler;
+mod scaled;
 
 use crate::checks::{self, Budget, CheckId, Verdict};
 use crate::config::{Case, Config};
@@ -150,6 +151,18 @@ impl Plan {
 /// Why a sensitivity plan cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum SensitivityError {
+    /// The configuration in the study's world (euler truth, point samples) is out of range.
+    #[error("the sensitivity study's world (euler truth, point samples)")]
+    World {
+        /// The configuration's complaint.
+        source: ConfigError,
+    },
+    /// The configured filter's covariance stops being positive definite.
+    #[error("the sensitivity study's filter as configured")]
+    Configured {
+        /// The filter's complaint.
+        source: FilterError,
+    },
     /// A scaled statistic leaves the accepted range.
     #[error("the filter assuming {parameter} × {factor}")]
     Config {
@@ -161,12 +174,18 @@ pub enum SensitivityError {
         source: ConfigError,
     },
     /// A scaled filter's covariance stops being positive definite.
-    #[error("the filter assuming {parameter} × {factor}")]
+    #[error(
+        "the sensitivity study's filter assuming σ × {factor} for filter.{parameter}, which \
+         takes it to {}",
+        crate::config::show(*value)
+    )]
     Filter {
         /// The statistic.
         parameter: &'static str,
-        /// The factor.
+        /// The factor on its standard deviation.
         factor: f64,
+        /// The scaled value (a variance scales by the factor's square).
+        value: f64,
         /// The filter's complaint.
         source: FilterError,
     },
@@ -263,35 +282,39 @@ fn sigma(p: &crate::state::StateMatrix) -> [f64; ErrorState::DIM] {
     std::array::from_fn(|k| p[(k, k)].sqrt())
 }
 
-/// The model and filter schedule of `config`, whose filter assumes `parameter` × `factor` (named
-/// in errors).
-fn filter_of(
-    config: &Config,
-    parameter: &'static str,
-    factor: f64,
-) -> Result<(Model, FilterSchedule), SensitivityError> {
-    let model = Model::new(config).map_err(|source| SensitivityError::Config {
-        parameter,
-        factor,
-        source,
-    })?;
-    let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats).map_err(|source| {
-        SensitivityError::Filter {
-            parameter,
-            factor,
-            source,
-        }
-    })?;
-    Ok((model, schedule))
+/// The filter schedule of the configured filter in `world`.
+fn configured(world: &Config) -> Result<FilterSchedule, SensitivityError> {
+    let model = Model::new(world).map_err(|source| SensitivityError::World { source })?;
+    FilterSchedule::new(&model.timeline, &model.filter_stats)
+        .map_err(|source| SensitivityError::Configured { source })
 }
 
 /// The filter of `parameter` × `factor` in `world`, with its schedule.
+///
+/// The scaled statistic is not held to the range a configuration may set (`ensemble` accepts a
+/// `[filter]` value at the range's edge, which the factors then carry beyond it): the filter's
+/// covariance recursion, which refuses a covariance that is not positive definite, is its check.
 fn mistuned(
     world: &Config,
     parameter: AssumedStatistic,
     factor: f64,
 ) -> Result<(Model, FilterSchedule), SensitivityError> {
-    filter_of(&parameter.scaled(world, factor), parameter.name(), factor)
+    let mut model = Model::new(world).map_err(|source| SensitivityError::Config {
+        parameter: parameter.name(),
+        factor,
+        source,
+    })?;
+    model.filter_stats = parameter.scaled_stats(&model.filter_stats, factor);
+    model.config = parameter.scaled(world, factor);
+    let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats).map_err(|source| {
+        SensitivityError::Filter {
+            parameter: parameter.name(),
+            factor,
+            value: parameter.value(&model.filter_stats),
+            source,
+        }
+    })?;
+    Ok((model, schedule))
 }
 
 /// Runs `plan` on `base` (its statistics are the truth's; its `[filter]` the starting point).
@@ -308,14 +331,18 @@ pub fn run(
 ) -> Result<Sensitivity, SensitivityError> {
     let world = world(base, plan.realizations);
     let budget = Budget::study(base.checks.false_alarm_rate);
-    let (_, tuned_schedule) = filter_of(&world, "configured", 1.0)?;
+    let tuned_schedule = configured(&world)?;
     let grid: Vec<(AssumedStatistic, f64)> = plan
         .parameters
         .iter()
         .flat_map(|&p| plan.factors.iter().map(move |&f| (p, f)))
         .collect();
-    // The sampler needs more realizations than the joint state has dimensions.
-    let draws = if plan.realizations > 6 { plan.draws } else { 0 };
+    // The sampler's Wishart draws need enough realizations (smaller ensembles are not sampled).
+    let draws = if plan.realizations >= sampler::Sampler::MIN_REALIZATIONS {
+        plan.draws
+    } else {
+        0
+    };
     let seed = base.ensemble.seed;
 
     // Exact and sampled predictions, no simulation.

@@ -75,7 +75,11 @@ pub struct Sampler {
 }
 
 impl Sampler {
-    /// The sampler of ensembles of `realizations` (more than the joint dimension 2N) of
+    /// The fewest realizations the sampler draws for: the Bartlett factors of the propagation's
+    /// Wishart(n − 1 − 2N, I_N) need n − 1 − 2N − (N − 1) ≥ 1 degrees of freedom, n ≥ 3N + 1.
+    pub const MIN_REALIZATIONS: u64 = (JOINT + N + 1) as u64;
+
+    /// The sampler of ensembles of `realizations` (at least [`Sampler::MIN_REALIZATIONS`]) of
     /// the filter `schedule` over `timeline`, in the model-exact world with the statistics
     /// `truth`. The residual products are kept at lag 0 only and the single pair `pair` is not
     /// drawn (its products are NaN).
@@ -87,8 +91,9 @@ impl Sampler {
         pair: [usize; 2],
     ) -> Self {
         assert!(
-            realizations > JOINT as u64,
-            "the joint state has {JOINT} dimensions"
+            realizations >= Self::MIN_REALIZATIONS,
+            "the sampler needs at least {} realizations",
+            Self::MIN_REALIZATIONS
         );
         let world = ErrorStateModel::new(timeline.dt_s, truth);
         let h = schedule.model.h;
