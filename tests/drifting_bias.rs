@@ -259,13 +259,10 @@ fn the_covariance_is_the_exact_discretization_at_every_fix() {
             let what = format!("{}, fix {i}", a.bias_model);
             assert_close(&fix.p_prior, prior, &format!("P⁻ {what}"));
             assert_close(&fix.p_post, post, &format!("P⁺ {what}"));
-            for r in 0..3 {
-                for c in 0..3 {
-                    let err = (fix.phi_from_previous[(r, c)] - phi_n[r][c]).abs();
-                    assert!(
-                        err <= 1e-9 * phi_n[r][c].abs().max(1e-3),
-                        "Φ {what} ({r}, {c})"
-                    );
+            for (r, row) in phi_n.iter().enumerate() {
+                for (c, want) in row.iter().enumerate() {
+                    let err = (fix.phi_from_previous[(r, c)] - want).abs();
+                    assert!(err <= 1e-9 * want.abs().max(1e-3), "Φ {what} ({r}, {c})");
                 }
             }
         }
@@ -441,4 +438,121 @@ fn bad_bias_keys_are_refused_by_name() {
         "[accelerometer]\nbias_model = \"wandering\"\n",
         "bias_model",
     );
+}
+
+/// The drifting-bias section of a small study's report: the constant-bias filter fails NEES and
+/// claims far less error than it makes, the random-walk filter passes every check and achieves
+/// what it claims, and the page's sentence says so; the same section with the filters' numbers
+/// exchanged says the opposite (the words follow the numbers, not the filters' names).
+#[test]
+fn the_report_shows_what_a_drifting_bias_costs() {
+    use accelcal::report::{ReportInput, render};
+    use accelcal::study::Study;
+    let mut config = Config::default();
+    config.ensemble.realizations = 500;
+    let model = accelcal::model::Model::new(&config).unwrap();
+    let study = Study::run(&model, &mut Silent)
+        .unwrap()
+        .with_drift(&mut Silent)
+        .unwrap();
+    let d = study.drift.as_ref().expect("the drifting-bias study ran");
+    assert_eq!(
+        d.constant.verdicts.get(CheckId::NEES).verdict,
+        Verdict::Fail
+    );
+    assert!(d.random_walk.verdicts.all_passed());
+    let bias = |f: &accelcal::study::drift::DriftFilter| {
+        let i = f.nearest(120.0);
+        (f.claimed_sigma[i][2], f.achieved_rms[i][2])
+    };
+    let ((cc, ca), (rc, ra)) = (bias(&d.constant), bias(&d.random_walk));
+    assert!(ca > 10.0 * cc, "constant: claims {cc}, achieves {ca}");
+    assert!(
+        (ra / rc - 1.0).abs() < 1e-9,
+        "random walk: claims {rc}, achieves {ra}"
+    );
+    let input = |study| ReportInput {
+        study,
+        command: "accelcal report",
+        threads: 1,
+        static_noise: None,
+    };
+    let page = render(&input(&study)).unwrap();
+    assert!(page.view.toc.iter().any(|t| t.anchor == "drifting-bias"));
+    assert!(page.html.contains("<section id=\"drifting-bias\">"));
+    assert!(page.html.contains("id=\"fig-drift\"") && page.html.contains("<svg"));
+    let sentence = format!(
+        "The constant-bias filter claims {} mm/s² at 120 s",
+        fmt_mm(cc)
+    );
+    assert!(page.html.contains(&sentence), "{sentence}");
+    assert!(page.html.contains("times worse than it claims"));
+    assert!(page.html.contains("its claim holds (every check passes)"));
+    let data: serde_json::Value =
+        serde_json::from_str(&accelcal::export::report_data_json(&study)).unwrap();
+    let filters = &data["drifting_bias"]["filters"];
+    assert_eq!(filters[0]["bias_model"], "constant");
+    assert_eq!(filters[0]["verdicts"]["nees"], "fail");
+    assert_eq!(filters[1]["bias_model"], "random_walk");
+    // The negative control: the numbers exchanged, the words follow them.
+    let mut swapped = study.clone();
+    let s = swapped.drift.as_mut().unwrap();
+    std::mem::swap(&mut s.constant, &mut s.random_walk);
+    let html = render(&input(&swapped)).unwrap().html;
+    let sentence = format!(
+        "The constant-bias filter claims {} mm/s² at 120 s and achieves {} mm/s²: its claim holds",
+        fmt_mm(rc),
+        fmt_mm(ra)
+    );
+    assert!(html.contains(&sentence), "{sentence}");
+    assert!(html.contains("the random-walk filter claims") && html.contains("nees, nis fail"));
+}
+
+/// x in mm/s² with two significant digits, as the report writes it.
+fn fmt_mm(x_m_s2: f64) -> String {
+    accelcal::format::sig(1e3 * x_m_s2, 2)
+}
+
+/// K is a parameter of the sensitivity study for a filter that assumes a random walk: the filter
+/// with the truth's K claims what it achieves, one that assumes a quarter of it claims less and
+/// is detected by NEES, one that assumes four times it claims more; a filter without a random
+/// walk is not offered K, and a truth whose Φ differs from the filter's is refused.
+#[test]
+fn the_random_walk_is_a_parameter_of_the_sensitivity_study() {
+    use accelcal::ensemble::Engine;
+    use accelcal::sensitivity::{self, AssumedStatistic, Plan, SensitivityError};
+    assert!(!AssumedStatistic::of(&Config::default()).contains(&AssumedStatistic::BiasRandomWalk));
+    let config = random_walk();
+    assert!(AssumedStatistic::of(&config).contains(&AssumedStatistic::BiasRandomWalk));
+    let plan = Plan {
+        parameters: vec![AssumedStatistic::BiasRandomWalk],
+        factors: vec![0.25, 1.0, 4.0],
+        realizations: 1_000,
+        ensembles: 1,
+        draws: 200,
+        engine: Engine::Epoch,
+    };
+    let s = sensitivity::run(&config, &plan, &mut Silent).unwrap();
+    let ratio = |i: usize| {
+        let c = &s.cases[i];
+        c.actual_sigma_final[2] / c.claimed_sigma_final[2]
+    };
+    assert!(ratio(0) > 1.5, "K × 0.25: {}", ratio(0));
+    assert!((ratio(1) - 1.0).abs() < 1e-9, "K × 1: {}", ratio(1));
+    assert!((s.cases[1].expected_nees_final - 3.0).abs() < 1e-9);
+    assert!(ratio(2) < 0.9, "K × 4: {}", ratio(2));
+    assert!(s.cases[0].expected_nees_final > 4.0);
+    assert_eq!(s.cases[0].detection(CheckId::NEES), Some(1.0));
+    let measured = s.cases[0].detected.as_ref().unwrap();
+    assert_eq!(measured[CheckId::NEES.index()], 1.0);
+    // A Gauss–Markov truth under a constant-bias filter: Φ differs, refused.
+    let mut gm = gauss_markov();
+    gm.filter.bias_model = Some(BiasModelKind::Constant);
+    let plan = Plan {
+        parameters: vec![AssumedStatistic::GpsPosition],
+        factors: vec![2.0],
+        ..plan
+    };
+    let err = sensitivity::run(&gm, &plan, &mut Silent).unwrap_err();
+    assert!(matches!(err, SensitivityError::Transition { .. }), "{err}");
 }

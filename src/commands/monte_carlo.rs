@@ -19,7 +19,9 @@ use anyhow::Result;
 pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
     let model = load_model(&args.model, &CaseArgs::default(), args.realizations)?;
     let mut bar = Bar::new(args.model.quiet);
-    let study = Study::run(&model, &mut bar)?.with_sensitivity(&mut bar)?;
+    let study = Study::run(&model, &mut bar)?
+        .with_sensitivity(&mut bar)?
+        .with_drift(&mut bar)?;
     let static_noise = accelcal::allan::section::report_coverage()?;
     let command = reproduce_command(args);
     let page = report::render(&report::ReportInput {
@@ -107,7 +109,7 @@ fn sensitivity_plan(args: &SensitivityArgs, config: &Config) -> Result<Plan, Con
     };
     sizes.check(["--factors", "--ensembles", "--draws"])?;
     let parameters = if args.parameters.is_empty() {
-        AssumedStatistic::ALL.to_vec()
+        AssumedStatistic::of(config)
     } else {
         args.parameters
             .iter()

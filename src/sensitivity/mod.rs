@@ -13,6 +13,7 @@ pub mod covariance;
 pub mod detection;
 mod prediction;
 pub mod sampler;
+mod statistic;
 
 use crate::checks::{self, Budget, CheckId, Verdict};
 use crate::config::{Case, Config};
@@ -24,94 +25,7 @@ use crate::progress::Progress;
 use crate::state::ErrorState;
 pub use covariance::{ActualFix, SampleCovariance, actual_covariance, covariance_at_samples};
 pub use detection::Detection;
-
-/// A statistic the filter assumes (a key of the configuration's `[filter]` section).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum AssumedStatistic {
-    /// Accelerometer noise variance W.
-    AccelNoise,
-    /// Bias prior variance.
-    BiasPrior,
-    /// GPS position noise σ.
-    GpsPosition,
-    /// GPS velocity noise σ.
-    GpsVelocity,
-    /// Initial position σ.
-    InitialPosition,
-    /// Initial velocity σ.
-    InitialVelocity,
-}
-
-impl AssumedStatistic {
-    /// Every assumed statistic, in the configuration's order.
-    pub const ALL: [AssumedStatistic; 6] = [
-        AssumedStatistic::AccelNoise,
-        AssumedStatistic::BiasPrior,
-        AssumedStatistic::GpsPosition,
-        AssumedStatistic::GpsVelocity,
-        AssumedStatistic::InitialPosition,
-        AssumedStatistic::InitialVelocity,
-    ];
-
-    /// The `[filter]` key.
-    pub fn name(self) -> &'static str {
-        match self {
-            AssumedStatistic::AccelNoise => "accel_noise_var_m2_s4",
-            AssumedStatistic::BiasPrior => "bias_var_m2_s4",
-            AssumedStatistic::GpsPosition => "gps_position_sigma_m",
-            AssumedStatistic::GpsVelocity => "gps_velocity_sigma_m_s",
-            AssumedStatistic::InitialPosition => "initial_position_sigma_m",
-            AssumedStatistic::InitialVelocity => "initial_velocity_sigma_m_s",
-        }
-    }
-
-    /// The statistic in words, as a standard deviation (the factor scales it).
-    pub fn title(self) -> &'static str {
-        match self {
-            AssumedStatistic::AccelNoise => "accelerometer noise σ",
-            AssumedStatistic::BiasPrior => "bias prior σ",
-            AssumedStatistic::GpsPosition => "GPS position σ",
-            AssumedStatistic::GpsVelocity => "GPS velocity σ",
-            AssumedStatistic::InitialPosition => "initial position σ",
-            AssumedStatistic::InitialVelocity => "initial velocity σ",
-        }
-    }
-
-    /// The statistic named `name`, if any.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|s| s.name() == name)
-    }
-
-    /// `config` with the filter assuming this statistic's standard deviation times `factor` (a
-    /// variance times `factor²`), starting from the value the filter assumes in `config`.
-    pub fn scaled(self, config: &Config, factor: f64) -> Config {
-        let mut c = config.clone();
-        let f = &mut c.filter;
-        match self {
-            AssumedStatistic::AccelNoise => {
-                f.accel_noise_var_m2_s4 =
-                    Some(config.filter_accel_noise_var_m2_s4() * factor * factor)
-            }
-            AssumedStatistic::BiasPrior => {
-                f.bias_var_m2_s4 = Some(config.filter_bias_var_m2_s4() * factor * factor)
-            }
-            AssumedStatistic::GpsPosition => {
-                f.gps_position_sigma_m = Some(config.filter_gps_position_sigma_m() * factor)
-            }
-            AssumedStatistic::GpsVelocity => {
-                f.gps_velocity_sigma_m_s = Some(config.filter_gps_velocity_sigma_m_s() * factor)
-            }
-            AssumedStatistic::InitialPosition => {
-                f.initial_position_sigma_m = Some(config.filter_initial_position_sigma_m() * factor)
-            }
-            AssumedStatistic::InitialVelocity => {
-                f.initial_velocity_sigma_m_s =
-                    Some(config.filter_initial_velocity_sigma_m_s() * factor)
-            }
-        }
-        c
-    }
-}
+pub use statistic::AssumedStatistic;
 
 /// What the sensitivity study runs.
 #[derive(Clone, Debug, PartialEq)]
@@ -137,7 +51,7 @@ impl Plan {
     /// `sensitivity.draws` draws.
     pub fn of(config: &Config) -> Self {
         Self {
-            parameters: AssumedStatistic::ALL.to_vec(),
+            parameters: AssumedStatistic::of(config),
             factors: config.sensitivity.factors.clone(),
             realizations: config.ensemble.realizations,
             ensembles: config.sensitivity.ensembles,
@@ -159,6 +73,20 @@ pub enum SensitivityError {
         factor: f64,
         /// The configuration's complaint.
         source: ConfigError,
+    },
+    /// The filter's transition Φ is not the truth's (a Gauss–Markov bias of another τ_b, or
+    /// another bias model where one of them is Gauss–Markov): the actual covariance of the error
+    /// alone is then not a recursion of its own.
+    #[error(
+        "the filter assuming {parameter} × {factor} has another transition Φ than the truth (its \
+         bias model differs from the truth's Gauss–Markov one or the other way round); the \
+         sensitivity study needs the filter's Φ to be the truth's"
+    )]
+    Transition {
+        /// The statistic.
+        parameter: &'static str,
+        /// The factor.
+        factor: f64,
     },
     /// A scaled filter's covariance stops being positive definite.
     #[error("the filter assuming {parameter} × {factor}")]
@@ -282,6 +210,10 @@ fn filter_of(
             source,
         }
     })?;
+    let truth = crate::filter::ErrorStateModel::new(model.timeline.dt_s, &model.truth_stats);
+    if truth.phi != schedule.model.phi {
+        return Err(SensitivityError::Transition { parameter, factor });
+    }
     Ok((model, schedule))
 }
 
