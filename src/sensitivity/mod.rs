@@ -74,20 +74,6 @@ pub enum SensitivityError {
         /// The configuration's complaint.
         source: ConfigError,
     },
-    /// The filter's transition Φ is not the truth's (a Gauss–Markov bias of another τ_b, or
-    /// another bias model where one of them is Gauss–Markov): the actual covariance of the error
-    /// alone is then not a recursion of its own.
-    #[error(
-        "the filter assuming {parameter} × {factor} has another transition Φ than the truth (its \
-         bias model differs from the truth's Gauss–Markov one or the other way round); the \
-         sensitivity study needs the filter's Φ to be the truth's"
-    )]
-    Transition {
-        /// The statistic.
-        parameter: &'static str,
-        /// The factor.
-        factor: f64,
-    },
     /// A scaled filter's covariance stops being positive definite.
     #[error("the filter assuming {parameter} × {factor}")]
     Filter {
@@ -210,10 +196,6 @@ fn filter_of(
             source,
         }
     })?;
-    let truth = crate::filter::ErrorStateModel::new(model.timeline.dt_s, &model.truth_stats);
-    if truth.phi != schedule.model.phi {
-        return Err(SensitivityError::Transition { parameter, factor });
-    }
     Ok((model, schedule))
 }
 

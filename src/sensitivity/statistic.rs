@@ -19,12 +19,14 @@ pub enum AssumedStatistic {
     InitialVelocity,
     /// K of a random-walk bias (only for a filter that assumes one).
     BiasRandomWalk,
+    /// τ_b of a Gauss–Markov bias (only for a filter that assumes one).
+    BiasCorrelationTime,
 }
 
 impl AssumedStatistic {
     /// Every assumed statistic, in the configuration's order (the bias model's parameter last,
     /// so that the others keep their seeds).
-    pub const ALL: [AssumedStatistic; 7] = [
+    pub const ALL: [AssumedStatistic; 8] = [
         AssumedStatistic::AccelNoise,
         AssumedStatistic::BiasPrior,
         AssumedStatistic::GpsPosition,
@@ -32,15 +34,21 @@ impl AssumedStatistic {
         AssumedStatistic::InitialPosition,
         AssumedStatistic::InitialVelocity,
         AssumedStatistic::BiasRandomWalk,
+        AssumedStatistic::BiasCorrelationTime,
     ];
 
-    /// The statistics the filter of `config` assumes: every one but the random walk's K, which
-    /// only a filter with `bias_model = "random_walk"` has.
+    /// The statistics the filter of `config` assumes: every one but the bias model's
+    /// parameters, of which only the filter's own model's is (K for `"random_walk"`, τ_b for
+    /// `"gauss_markov"`).
     pub fn of(config: &Config) -> Vec<Self> {
-        let walks = config.filter_bias_model_kind() == BiasModelKind::RandomWalk;
+        let kind = config.filter_bias_model_kind();
         Self::ALL
             .into_iter()
-            .filter(|s| *s != AssumedStatistic::BiasRandomWalk || walks)
+            .filter(|s| match s {
+                AssumedStatistic::BiasRandomWalk => kind == BiasModelKind::RandomWalk,
+                AssumedStatistic::BiasCorrelationTime => kind == BiasModelKind::GaussMarkov,
+                _ => true,
+            })
             .collect()
     }
 
@@ -54,6 +62,7 @@ impl AssumedStatistic {
             AssumedStatistic::InitialPosition => "initial_position_sigma_m",
             AssumedStatistic::InitialVelocity => "initial_velocity_sigma_m_s",
             AssumedStatistic::BiasRandomWalk => "bias_random_walk_m_s2_per_sqrt_s",
+            AssumedStatistic::BiasCorrelationTime => "bias_correlation_time_s",
         }
     }
 
@@ -67,6 +76,7 @@ impl AssumedStatistic {
             AssumedStatistic::InitialPosition => "initial position σ",
             AssumedStatistic::InitialVelocity => "initial velocity σ",
             AssumedStatistic::BiasRandomWalk => "bias random walk K",
+            AssumedStatistic::BiasCorrelationTime => "bias correlation time τ_b",
         }
     }
 
@@ -110,6 +120,11 @@ impl AssumedStatistic {
                         .unwrap_or(0.0)
                         * factor,
                 )
+            }
+            // τ_b is a time, not a σ: the factor multiplies it.
+            AssumedStatistic::BiasCorrelationTime => {
+                f.bias_correlation_time_s =
+                    Some(config.filter_bias_correlation_time_s().unwrap_or(f64::NAN) * factor)
             }
         }
         c
