@@ -13,12 +13,14 @@
 //! rate R measured in the same session (`python3 benches/numpy_reference.py`).
 //!
 //! Run with `cargo bench --bench throughput` (options: `-- --realizations N --repeats R
-//! --numpy R --truth analytic|euler`; defaults N = 100 000, R = 9).
+//! --numpy R --truth analytic|euler --bias-random-walk K`; defaults N = 100 000, R = 9, a constant
+//! bias; `--bias-random-walk K` makes the truth's and the filter's bias a random walk of K
+//! m/s²/√s).
 
 use std::hint::black_box;
 use std::time::Instant;
 
-use accelcal::config::{Config, TruthModel};
+use accelcal::config::{BiasModelKind, Config, TruthModel};
 use accelcal::ensemble::{Engine, Ensemble, kernel};
 use accelcal::filter::FilterSchedule;
 use accelcal::lanes::LANES;
@@ -84,6 +86,8 @@ struct Options {
     /// The numpy reference's rate, realizations/s, measured in the same session.
     numpy: Option<f64>,
     truth: TruthModel,
+    /// K of a random-walk bias (truth and filter), m/s²/√s; `None`: a constant bias.
+    random_walk: Option<f64>,
 }
 
 impl Options {
@@ -98,6 +102,7 @@ impl Options {
                 Some("euler") => TruthModel::Euler,
                 _ => TruthModel::Analytic,
             },
+            random_walk: arg("--bias-random-walk").and_then(|v| v.parse().ok()),
         }
     }
 
@@ -120,11 +125,17 @@ fn random_numbers(o: &Options, key: u64, draws: usize) -> f64 {
 fn main() {
     let o = Options::parse();
     println!(
-        "threads: {}, truth: {}",
+        "threads: {}, truth: {}, bias: {}",
         rayon::current_num_threads(),
-        o.truth
+        o.truth,
+        o.random_walk
+            .map_or("constant".to_string(), |k| format!("random walk, K = {k}"))
     );
-    let config = Config::default();
+    let mut config = Config::default();
+    if let Some(k) = o.random_walk {
+        config.accelerometer.bias_model = BiasModelKind::RandomWalk;
+        config.accelerometer.bias_random_walk_m_s2_per_sqrt_s = Some(k);
+    }
     let model = Model::new(&config)
         .expect("default configuration is valid")
         .with_truth(o.truth);

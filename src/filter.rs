@@ -206,7 +206,7 @@ impl<const N: usize, const M: usize> FilterSchedule<N, M> {
     /// Runs the covariance recursion of `model` over `timeline`: P ← Φ(t_j, Δt)·P·Φᵀ + Q(t_j, Δt)
     /// at every accelerometer sample, a Joseph-form update at every fix. The estimate's transition
     /// between fixes is the product of the steps' Φ (the model's Φ over the whole interval when it
-    /// does not depend on time).
+    /// does not depend on time and composes, [`StateModel::transition_composes`]).
     ///
     /// # Errors
     /// [`FilterError`] when S or P stops being positive definite.
@@ -215,16 +215,18 @@ impl<const N: usize, const M: usize> FilterSchedule<N, M> {
         let mut p = system.p0;
         let mut j = 0;
         let mut fixes = Vec::with_capacity(timeline.fixes());
+        let in_one_piece = S::TIME_INVARIANT && model.transition_composes();
         for &jf in &timeline.fix_steps {
-            // A time-invariant model's transition over the interval in one piece (exact for the
-            // error state, whose Φ is unipotent); otherwise the product of the steps.
-            let mut phi_from_previous = if S::TIME_INVARIANT {
+            // A time-invariant model's transition over the interval in one piece when it composes
+            // (exact for the error state with a constant or random-walk bias, whose Φ is
+            // unipotent); otherwise the product of the steps.
+            let mut phi_from_previous = if in_one_piece {
                 model.transition(timeline.time_s(j), (jf - j) as f64 * timeline.dt_s)
             } else {
                 SMatrix::identity()
             };
             while j < jf {
-                if !S::TIME_INVARIANT {
+                if !in_one_piece {
                     phi_from_previous =
                         model.transition(timeline.time_s(j), timeline.dt_s) * phi_from_previous;
                 }

@@ -63,7 +63,7 @@ pub struct SampleState {
     pub computed_p_m: f64,
     /// Integrated accelerometer velocity v_c(t_j), m/s.
     pub computed_v_m_s: f64,
-    /// The realization's bias b, m/s².
+    /// The realization's bias b(t_j), m/s² (constant unless the truth's bias drifts).
     pub bias_m_s2: f64,
     /// The accelerometer's output a_c(t_j) = a + b + w, eq. (2): what a log of the sensor holds.
     /// It is integrated over [t_j, t_{j+1}]; at the last sample, which no step integrates, it is
@@ -119,14 +119,15 @@ pub struct Draws {
     pub p0_m: f64,
     /// True initial velocity v(0), m/s.
     pub v0_m_s: f64,
-    /// Bias b, m/s².
+    /// Bias b(0), m/s².
     pub bias_m_s2: f64,
 }
 
 /// Runs realization `index` of `model` under `seed` through the filter `schedule`, reporting to
-/// `observer`. Draw order: p(0), v(0), b; then, fix by fix, w at every sample up to the fix and
-/// (η_p, η_v) at the fix; then, for an observer that records samples, w after the last fix and
-/// w of the last sample's output.
+/// `observer`. Draw order: p(0), v(0), b; then, fix by fix, w at every sample up to the fix (each
+/// followed by the bias's increment η_b when the truth's bias drifts) and (η_p, η_v) at the fix;
+/// then, for an observer that records samples, the same after the last fix and w of the last
+/// sample's output.
 pub fn run_realization<O: Observer>(
     model: &Model,
     schedule: &FilterSchedule,
@@ -177,10 +178,17 @@ fn run_with<N: Noise, O: Observer>(
     ];
     let mut estimate = StateVector::zeros();
     let mut j = 0;
+    let mut bias = draws.bias_m_s2;
     for (i, (&jf, fix)) in tl.fix_steps.iter().zip(&schedule.fixes).enumerate() {
-        s = run.integrate(j, jf, s, rng, observer);
+        // The constant bias keeps its own loop, so that it costs what it did before drift existed.
+        match run.drift {
+            None => s = run.integrate(j, jf, s, rng, observer),
+            Some(drift) => {
+                (s, bias) = run.integrate_drifting(j, jf, (s, bias), drift, rng, observer)
+            }
+        }
         j = jf;
-        let (delta_x, z, dz) = run.measure(i, jf, s, rng);
+        let (delta_x, z, dz) = run.measure(i, jf, s, bias, rng);
         let (prior, post, residual) = fix.step(&estimate.into(), &dz.into());
         let (prior, post, residual) = (prior.into(), post.into(), MeasVector::from(residual));
         estimate = post;
@@ -195,17 +203,50 @@ fn run_with<N: Noise, O: Observer>(
         });
     }
     if O::SAMPLES {
-        let end = run.integrate(j, tl.steps, s, rng, observer);
-        let ac = model.accel_m_s2[tl.steps] + draws.bias_m_s2 + run.w_sigma * rng.normal();
-        observer.sample(&run.sample(tl.steps, end, ac));
+        let end = match run.drift {
+            None => run.integrate(j, tl.steps, s, rng, observer),
+            Some(drift) => {
+                let end;
+                (end, bias) = run.integrate_drifting(j, tl.steps, (s, bias), drift, rng, observer);
+                end
+            }
+        };
+        let ac = model.accel_m_s2[tl.steps] + bias + run.w_sigma * rng.normal();
+        observer.sample(&run.sample(tl.steps, end, bias, ac));
     }
     draws
+}
+
+/// The truth's drifting bias over one accelerometer step: b ← φ·b + √q_b·η_b (see
+/// [`crate::state::BiasModel::step`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BiasDrift {
+    /// φ(Δt).
+    pub phi: f64,
+    /// √q_b(Δt), m/s².
+    pub sigma_m_s2: f64,
+}
+
+impl BiasDrift {
+    /// The drift of `model`'s truth over one step, `None` for a constant bias.
+    pub fn of(model: &Model) -> Option<Self> {
+        let ts = &model.truth_stats;
+        ts.bias_model.drifts().then(|| {
+            let (phi, q) = ts.bias_model.step(model.timeline.dt_s, ts.bias_var_m2_s4);
+            BiasDrift {
+                phi,
+                sigma_m_s2: q.sqrt(),
+            }
+        })
+    }
 }
 
 /// What stays fixed through one realization: the model, the initial draws and the step constants.
 struct Run<'a> {
     model: &'a Model,
     draws: Draws,
+    /// The bias's step, when it drifts.
+    drift: Option<BiasDrift>,
     /// σ of the accelerometer's white noise w, m/s².
     w_sigma: f64,
     /// Sample interval Δt, s.
@@ -220,6 +261,7 @@ impl<'a> Run<'a> {
         Run {
             model,
             draws,
+            drift: BiasDrift::of(model),
             w_sigma: model.truth_stats.accel_noise_var_m2_s4.sqrt(),
             dt,
             half_dt2: 0.5 * dt * dt,
@@ -238,8 +280,9 @@ impl<'a> Run<'a> {
         }
     }
 
-    /// The state at sample `j` from the integration state (p_c, v_c, p_E, v_E) and the output a_c.
-    fn sample(&self, j: usize, [pc, vc, pe, ve]: [f64; 4], ac: f64) -> SampleState {
+    /// The state at sample `j` from the integration state (p_c, v_c, p_E, v_E), the bias b(t_j)
+    /// and the output a_c.
+    fn sample(&self, j: usize, [pc, vc, pe, ve]: [f64; 4], bias: f64, ac: f64) -> SampleState {
         let (tp, tv) = self.truth_at(j, pe, ve);
         SampleState {
             step: j,
@@ -247,7 +290,7 @@ impl<'a> Run<'a> {
             truth_v_m_s: tv,
             computed_p_m: pc,
             computed_v_m_s: vc,
-            bias_m_s2: self.draws.bias_m_s2,
+            bias_m_s2: bias,
             accel_output_m_s2: ac,
         }
     }
@@ -270,7 +313,7 @@ impl<'a> Run<'a> {
             // eq. (2): the accelerometer's output.
             let ac = a + b + w_sigma * rng.normal();
             if O::SAMPLES {
-                obs.sample(&self.sample(j + k, [pc, vc, pe, ve], ac));
+                obs.sample(&self.sample(j + k, [pc, vc, pe, ve], b, ac));
             }
             // eq. (3): position uses the velocity before the step.
             pc += vc * dt + ac * half_dt2;
@@ -282,13 +325,45 @@ impl<'a> Run<'a> {
         [pc, vc, pe, ve]
     }
 
+    /// [`Run::integrate`] with a drifting bias: after each sample's w, the bias's increment η_b
+    /// moves b(t_j) to b(t_{j+1}) = φ·b(t_j) + √q_b·η_b. Returns the integration state and the
+    /// bias at `end`.
+    #[inline(always)]
+    fn integrate_drifting<N: Noise, O: Observer>(
+        &self,
+        j: usize,
+        end: usize,
+        (state, bias): ([f64; 4], f64),
+        drift: BiasDrift,
+        rng: &mut N,
+        obs: &mut O,
+    ) -> ([f64; 4], f64) {
+        let (w_sigma, dt, half_dt2) = (self.w_sigma, self.dt, self.half_dt2);
+        let [mut pc, mut vc, mut pe, mut ve] = state;
+        let mut b = bias;
+        for (k, &a) in self.model.accel_m_s2[j..end].iter().enumerate() {
+            // eq. (2): the accelerometer's output, the bias held over the step.
+            let ac = a + b + w_sigma * rng.normal();
+            if O::SAMPLES {
+                obs.sample(&self.sample(j + k, [pc, vc, pe, ve], b, ac));
+            }
+            pc += vc * dt + ac * half_dt2;
+            vc += ac * dt;
+            pe += ve * dt + a * half_dt2;
+            ve += a * dt;
+            b = drift.phi * b + drift.sigma_m_s2 * rng.normal();
+        }
+        ([pc, vc, pe, ve], b)
+    }
+
     /// The true error state δx, the GPS fix z and the filter's measurement δz at fix `i` (sample
-    /// `jf`), from the integration state (p_c, v_c, p_E, v_E).
+    /// `jf`), from the integration state (p_c, v_c, p_E, v_E) and the bias b(t_i).
     fn measure<N: Noise>(
         &self,
         i: usize,
         jf: usize,
         [pc, vc, pe, ve]: [f64; 4],
+        bias: f64,
         rng: &mut N,
     ) -> (StateVector, MeasVector, MeasVector) {
         let d = &self.draws;
@@ -299,7 +374,7 @@ impl<'a> Run<'a> {
             }
             TruthModel::Euler => (pe, ve),
         };
-        let delta_x = error_state(tp - pc, tv - vc, d.bias_m_s2);
+        let delta_x = error_state(tp - pc, tv - vc, bias);
         // eq. (6): δz = z − (p_c, v_c), with z the receiver's fix.
         let ts = &self.model.truth_stats;
         // Drawn in this order: η_p, then η_v.

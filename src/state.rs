@@ -14,6 +14,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
+mod bias;
+
+pub use bias::BiasModel;
+
 /// Noise statistics of the error-state system: the truth's, or the ones the filter assumes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NoiseStats {
@@ -29,6 +33,8 @@ pub struct NoiseStats {
     pub initial_position_sigma_m: f64,
     /// Initial velocity σ, m/s.
     pub initial_velocity_sigma_m_s: f64,
+    /// How the bias moves between samples.
+    pub bias_model: BiasModel,
 }
 
 /// One variable of a state or of a measurement.
@@ -66,6 +72,12 @@ pub trait StateModel<const N: usize, const M: usize> {
     /// Whether Φ(t, τ) and Q(t, τ) do not depend on t, so that a filter may compute one step
     /// once and reuse it.
     const TIME_INVARIANT: bool = false;
+
+    /// Whether the transition over an interval of n steps of Δt is Φ(t, n·Δt) itself, so that a
+    /// time-invariant model may compute it in one piece instead of as the product of its steps.
+    fn transition_composes(&self) -> bool {
+        false
+    }
 
     /// Transition Φ(t, τ) of the state over [t, t + τ].
     fn transition(&self, t_s: f64, tau_s: f64) -> SMatrix<f64, N, N>;
@@ -219,14 +231,36 @@ impl StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }> for ErrorState {
 
     const TIME_INVARIANT: bool = true;
 
-    /// See [`transition`].
+    /// Φ(τ) = [[1, τ, −τ²/2], [0, 1, −τ], [0, 0, φ(τ)]]: [`transition`] with the bias's own
+    /// φ(τ) of [`BiasModel::step`] (1 for a constant bias, the same matrix bit for bit).
     fn transition(&self, _t_s: f64, tau_s: f64) -> StateMatrix {
-        transition(tau_s)
+        match self.stats.bias_model {
+            BiasModel::Constant => transition(tau_s),
+            drifting => {
+                let mut phi = transition(tau_s);
+                phi[(Self::BIAS, Self::BIAS)] = drifting.step(tau_s, self.stats.bias_var_m2_s4).0;
+                phi
+            }
+        }
     }
 
-    /// See [`process_noise`].
+    /// Q(τ) = Γ·W·Γᵀ + diag(0, 0, q_b(τ)): [`process_noise`] with the bias's own q_b(τ) of
+    /// [`BiasModel::step`] (0 for a constant bias, the same matrix bit for bit).
     fn process_noise(&self, _t_s: f64, tau_s: f64) -> StateMatrix {
-        process_noise(tau_s, self.stats.accel_noise_var_m2_s4)
+        let q = process_noise(tau_s, self.stats.accel_noise_var_m2_s4);
+        match self.stats.bias_model {
+            BiasModel::Constant => q,
+            drifting => {
+                let mut q = q;
+                q[(Self::BIAS, Self::BIAS)] = drifting.step(tau_s, self.stats.bias_var_m2_s4).1;
+                q
+            }
+        }
+    }
+
+    /// Φ composes over n·Δt unless the bias is Gauss–Markov (see [`BiasModel::composes`]).
+    fn transition_composes(&self) -> bool {
+        self.stats.bias_model.composes()
     }
 
     /// GPS sees the position and velocity errors.
@@ -262,13 +296,14 @@ mod tests {
     type Matrix2x3Lit = SMatrix<f64, 2, 3>;
 
     /// The default configuration's statistics.
-    const STATS: NoiseStats = NoiseStats {
+    pub(super) const STATS: NoiseStats = NoiseStats {
         accel_noise_var_m2_s4: 4e-4,
         bias_var_m2_s4: 0.01,
         gps_position_sigma_m: 1.0,
         gps_velocity_sigma_m_s: 0.04,
         initial_position_sigma_m: 10.0,
         initial_velocity_sigma_m_s: 1.0,
+        bias_model: BiasModel::Constant,
     };
 
     /// The model's matrices are the problem statement's, bit for bit.

@@ -35,13 +35,15 @@ fn diff(a: &Value, b: &Value, path: &str) -> Option<String> {
     }
 }
 
-/// The default study with its sensitivity, as `cargo run --release` writes it; run once.
+/// The default study with its sensitivity and its drifting bias, as `cargo run --release` writes it; run once.
 fn default_study() -> &'static Study {
     static STUDY: std::sync::OnceLock<Study> = std::sync::OnceLock::new();
     STUDY.get_or_init(|| {
         Study::run(&Model::new(&Config::default()).unwrap(), &mut Silent)
             .unwrap()
             .with_sensitivity(&mut Silent)
+            .unwrap()
+            .with_drift(&mut Silent)
             .unwrap()
     })
 }

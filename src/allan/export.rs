@@ -173,12 +173,13 @@ pub fn noise_toml(a: &Analysis, source: &str) -> String {
             let sigma_b = b_value / GAUSS_MARKOV_PEAK_RATIO;
             s.push_str(&format!(
                 "# B = {} m/s² dominates: a first-order Gauss–Markov bias, τ_b from the Allan\n\
-                 # minimum (τ_min/1.89), σ_b = B/{GAUSS_MARKOV_PEAK_RATIO}, driving noise √(2σ_b²/τ_b).\n\
+                 # minimum (τ_min/1.89), stationary σ_b = B/{GAUSS_MARKOV_PEAK_RATIO} (variance\n\
+                 # σ_b², driving noise √(2σ_b²/τ_b)).\n\
                  bias_model = \"gauss_markov\"\nbias_correlation_time_s = {}\n\
-                 bias_random_walk_m_s2_per_sqrt_s = {}\n",
+                 bias_var_m2_s4 = {}\n",
                 sig(b_value, 4),
                 num(tau_b),
-                num((2.0 * sigma_b * sigma_b / tau_b).sqrt())
+                num(sigma_b * sigma_b)
             ));
         }
         _ => {
@@ -219,5 +220,57 @@ fn comment(note: &str) -> String {
         String::new()
     } else {
         format!("  #{note}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::allan::{analyse, simulate::StaticLog};
+    use crate::config::Config;
+    use crate::model::Model;
+
+    /// The analysis of a white-noise log with K or B set as resolved, as `noise_toml` sees it.
+    fn analysis_with(term: Term, value: f64) -> Analysis {
+        let log = StaticLog {
+            sample_period_s: 0.01,
+            velocity_random_walk_m_s_per_sqrt_s: 2e-3,
+            acceleration_random_walk_m_s2_per_sqrt_s: 0.0,
+            offset_m_s2: 0.0,
+        };
+        let mut a = analyse(&log.samples(20_000, 3), 0.01, 0.683).unwrap();
+        for t in &mut a.fit.terms {
+            if t.term == term {
+                t.value = Some(value);
+            } else if t.term != Term::VelocityRandomWalk {
+                t.value = None;
+            }
+        }
+        if a.fit.term(term).is_none() {
+            let mut t = a.fit.terms[0];
+            t.term = term;
+            t.value = Some(value);
+            a.fit.terms.push(t);
+        }
+        a
+    }
+
+    /// Both bias models `noise.toml` can choose are configurations the model accepts as they are
+    /// (a Gauss–Markov bias takes σ_b² as `bias_var_m2_s4`, not a random walk's K, which the
+    /// model refuses as a key it does not use).
+    #[test]
+    fn noise_toml_is_a_configuration_the_model_accepts() {
+        for (term, model) in [
+            (Term::AccelerationRandomWalk, "random_walk"),
+            (Term::BiasInstability, "gauss_markov"),
+        ] {
+            let text = noise_toml(&analysis_with(term, 1e-4), "test.csv");
+            assert!(
+                text.contains(&format!("bias_model = \"{model}\"")),
+                "{text}"
+            );
+            let config = Config::from_toml_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+            Model::new(&config).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        }
     }
 }

@@ -25,7 +25,9 @@ pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
     check_directory(&args.out, &REPORT_FILES)?;
     check_memory(&model, Work::Report, &args.model)?;
     let mut bar = Bar::new(args.model.quiet);
-    let study = Study::run(&model, &mut bar)?.with_sensitivity(&mut bar)?;
+    let study = Study::run(&model, &mut bar)?
+        .with_sensitivity(&mut bar)?
+        .with_drift(&mut bar)?;
     let static_noise = accelcal::allan::section::report_coverage()?;
     let command = reproduce_command(args);
     let page = report::render(&report::ReportInput {
@@ -113,7 +115,7 @@ fn sensitivity_plan(args: &SensitivityArgs, config: &Config) -> Result<Plan, Con
     };
     sizes.check(["--factors", "--ensembles", "--draws"])?;
     let parameters = if args.parameters.is_empty() {
-        AssumedStatistic::ALL.to_vec()
+        AssumedStatistic::of(config)
     } else {
         args.parameters
             .iter()

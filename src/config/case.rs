@@ -35,6 +35,43 @@ impl fmt::Display for TruthModel {
     }
 }
 
+/// Which model the accelerometer bias follows (`bias_model`); its parameters are keys of their
+/// own (see [`crate::state::BiasModel`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BiasModelKind {
+    /// A constant bias, the problem statement's model.
+    #[default]
+    Constant,
+    /// A random walk of `bias_random_walk_m_s2_per_sqrt_s`.
+    RandomWalk,
+    /// A first-order Gauss–Markov process of `bias_correlation_time_s`.
+    GaussMarkov,
+}
+
+impl BiasModelKind {
+    /// The name used in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            BiasModelKind::Constant => "constant",
+            BiasModelKind::RandomWalk => "random_walk",
+            BiasModelKind::GaussMarkov => "gauss_markov",
+        }
+    }
+
+    /// Whether this is the default constant bias (left out when a configuration is written, so
+    /// that every output of a constant-bias study stays as it was).
+    pub fn is_constant(&self) -> bool {
+        *self == BiasModelKind::Constant
+    }
+}
+
+impl fmt::Display for BiasModelKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// What the accelerometer reports at each sample t_j.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

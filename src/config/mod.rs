@@ -4,6 +4,7 @@
 //! Validation happens once, when a [`crate::model::Model`] is built from the parsed configuration,
 //! and names the offending field with its accepted range.
 
+mod bias;
 mod case;
 mod sensitivity;
 mod source;
@@ -13,7 +14,7 @@ use std::f64::consts::PI;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{ConfigError, Position};
-pub use case::{AccelerometerOutput, Case, TruthModel};
+pub use case::{AccelerometerOutput, BiasModelKind, Case, TruthModel};
 pub use sensitivity::SensitivityConfig;
 pub use source::{ConfigText, MAX_CONFIG_BYTES};
 
@@ -75,6 +76,17 @@ pub struct AccelerometerConfig {
     /// What each sample reports: the acceleration at the sample time, or its mean over the
     /// sample interval.
     pub output: AccelerometerOutput,
+    /// How the bias moves between samples (left out of a written configuration when constant).
+    #[serde(skip_serializing_if = "BiasModelKind::is_constant")]
+    pub bias_model: BiasModelKind,
+    /// K of a random-walk bias, b(t + Δt) − b(t) ~ N(0, K²·Δt), m/s² per √s; only with
+    /// `bias_model = "random_walk"`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bias_random_walk_m_s2_per_sqrt_s: Option<f64>,
+    /// τ_b of a Gauss–Markov bias, ḃ = −b/τ_b + w_b with stationary variance `bias_var_m2_s4`, s;
+    /// only with `bias_model = "gauss_markov"`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bias_correlation_time_s: Option<f64>,
 }
 
 impl Default for AccelerometerConfig {
@@ -84,6 +96,9 @@ impl Default for AccelerometerConfig {
             noise_var_m2_s4: 0.0004,
             bias_var_m2_s4: 0.01,
             output: AccelerometerOutput::Sample,
+            bias_model: BiasModelKind::Constant,
+            bias_random_walk_m_s2_per_sqrt_s: None,
+            bias_correlation_time_s: None,
         }
     }
 }
@@ -161,6 +176,15 @@ pub struct FilterConfig {
     /// Assumed initial velocity standard deviation, m/s.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub initial_velocity_sigma_m_s: Option<f64>,
+    /// Assumed bias model.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bias_model: Option<BiasModelKind>,
+    /// Assumed K of a random-walk bias, m/s² per √s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bias_random_walk_m_s2_per_sqrt_s: Option<f64>,
+    /// Assumed τ_b of a Gauss–Markov bias, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bias_correlation_time_s: Option<f64>,
 }
 
 /// The Monte Carlo ensemble.
@@ -311,6 +335,7 @@ impl Config {
             && self.filter_gps_velocity_sigma_m_s() == self.gps.velocity_sigma_m_s
             && self.filter_initial_position_sigma_m() == self.initial.position_sigma_m
             && self.filter_initial_velocity_sigma_m_s() == self.initial.velocity_sigma_m_s
+            && self.filter_bias_matches_truth()
     }
 }
 

@@ -16,6 +16,11 @@
 //! and N the accumulated noise, N(t_i) = Φ(τ)·N(t_{i−1}) + ν_i. The GPS noise is drawn as in the
 //! per-sample engine, so every error, estimate and residual at the fixes has the same joint
 //! distribution with about a tenth of the random numbers.
+//!
+//! A drifting bias is drawn with the rest of the error state: the random part x = δx − D moves
+//! from fix to fix as x(t_i) = Φ_i·x(t_{i−1}) + ν_i, ν_i ~ N(0, Q_i), with Φ_i the product of the
+//! interval's steps and Q_i = Σ_k Φ^k·Q(Δt)·Φ^kᵀ its accumulated noise, both of the truth's model
+//! (bias included); one 3-D draw per interval through the Cholesky factor of Q_i.
 
 use super::kernel::{LaneGroup, lane_mask};
 use super::lane_sums::LaneFix;
@@ -24,7 +29,7 @@ use crate::lanes::{Lanes, Real};
 use crate::model::Model;
 use crate::random::LaneStreams;
 use crate::simulation::{FixState, Observer, run_noise_free};
-use crate::state::ErrorState;
+use crate::state::{ErrorState, StateMatrix, StateModel};
 
 // The interval draw below is the error state written out component by component.
 const _: () = assert!(ErrorState::DIM == 3 && ErrorState::MEAS == 2);
@@ -42,6 +47,31 @@ pub struct EpochPlan {
     tau_s: Vec<f64>,
     /// The Cholesky factor (l₁₁, l₂₁, l₂₂) of the interval's noise covariance W·G(n).
     chol: Vec<[f64; 3]>,
+    /// With a drifting bias, the interval's transition Φ_i and the lower factor L_i of its
+    /// accumulated noise Q_i, L_i·L_iᵀ = Q_i, of the whole error state (`None`: a constant bias).
+    drift: Option<Vec<(StateMatrix, StateMatrix)>>,
+}
+
+/// The transition and the accumulated noise's lower factor of an interval of `n` steps of the
+/// truth `truth`: Φ_n = Φⁿ, Q_n = Σ_{k<n} Φᵏ·Q·Φᵏᵀ (the filter's own recursion).
+fn drift_interval(truth: &ErrorState, n: usize, dt_s: f64) -> (StateMatrix, StateMatrix) {
+    let (phi, q) = (truth.transition(0.0, dt_s), truth.process_noise(0.0, dt_s));
+    let (mut phi_n, mut q_n) = (StateMatrix::identity(), StateMatrix::zeros());
+    for _ in 0..n {
+        phi_n = phi * phi_n;
+        q_n = phi * q_n * phi.transpose() + q;
+    }
+    (phi_n, scaled_root(&((q_n + q_n.transpose()) * 0.5)))
+}
+
+/// A lower factor L, L·Lᵀ = Q, of a covariance whose states have very different scales: the
+/// factor of the correlation matrix, scaled back, so that no state's variance is taken for
+/// rounding of another's. A state of zero variance gets a zero row.
+fn scaled_root(q: &StateMatrix) -> StateMatrix {
+    let d = q.diagonal().map(|v| if v > 0.0 { v.sqrt() } else { 0.0 });
+    let inv = d.map(|v| if v > 0.0 { 1.0 / v } else { 0.0 });
+    let c = StateMatrix::from_diagonal(&inv) * q * StateMatrix::from_diagonal(&inv);
+    StateMatrix::from_diagonal(&d) * super::linear::psd_root(&c)
 }
 
 /// The interval noise covariance (G_pp, G_pv, G_vv) of n steps of `dt_s` per unit W.
@@ -100,8 +130,35 @@ impl EpochPlan {
             half_t2,
             tau_s,
             chol,
+            drift: drift_plan(model),
         }
     }
+}
+
+/// Every interval's (Φ_i, L_i) of `model`'s drifting bias, `None` for a constant bias. Intervals
+/// of the same length share one computation.
+fn drift_plan(model: &Model) -> Option<Vec<(StateMatrix, StateMatrix)>> {
+    let truth = ErrorState {
+        stats: model.truth_stats,
+    };
+    if !truth.stats.bias_model.drifts() {
+        return None;
+    }
+    let tl = &model.timeline;
+    let mut prev = 0;
+    let mut last: Option<(usize, (StateMatrix, StateMatrix))> = None;
+    let mut out = Vec::with_capacity(tl.fixes());
+    for &jf in &tl.fix_steps {
+        let n = jf - prev;
+        let interval = match last {
+            Some((m, v)) if m == n => v,
+            _ => drift_interval(&truth, n, tl.dt_s),
+        };
+        last = Some((n, interval));
+        out.push(interval);
+        prev = jf;
+    }
+    Some(out)
 }
 
 impl EpochPlan {
@@ -112,6 +169,9 @@ impl EpochPlan {
         let mut p = self.clone();
         for l in &mut p.chol {
             *l = l.map(|v| v * factor.sqrt());
+        }
+        for (_, l) in p.drift.iter_mut().flatten() {
+            *l *= factor.sqrt();
         }
         p
     }
@@ -136,6 +196,8 @@ pub struct EpochGroup<'a> {
     eta_sigma: [f64; ErrorState::MEAS],
     /// The accumulated accelerometer noise (N_p, N_v).
     noise: [Lanes; 2],
+    /// With a drifting bias, the random part x = δx − D of the error state.
+    drifting: [Lanes; ErrorState::DIM],
     estimate: [Lanes; ErrorState::DIM],
 }
 
@@ -158,8 +220,26 @@ impl<'a> EpochGroup<'a> {
             b,
             eta_sigma: [ts.gps_position_sigma_m, ts.gps_velocity_sigma_m_s],
             noise: [Lanes::default(); 2],
+            drifting: [dp0, dv0, b],
             estimate: [Lanes::default(); ErrorState::DIM],
         }
+    }
+}
+
+impl EpochGroup<'_> {
+    /// The random part of the error state moved through one interval with a drifting bias:
+    /// x ← Φ_i·x + L_i·u, u three standard normals.
+    #[inline(always)]
+    fn next_drifting(&mut self, (phi, l): &(StateMatrix, StateMatrix)) -> [Lanes; ErrorState::DIM] {
+        let s = Lanes::splat;
+        let u = [self.rng.normal(), self.rng.normal(), self.rng.normal()];
+        let x = self.drifting;
+        let row = |r: usize| {
+            (s(phi[(r, 0)]) * x[0] + s(phi[(r, 1)]) * x[1] + s(phi[(r, 2)]) * x[2])
+                + (s(l[(r, 0)]) * u[0] + s(l[(r, 1)]) * u[1] + s(l[(r, 2)]) * u[2])
+        };
+        self.drifting = [row(0), row(1), row(2)];
+        self.drifting
     }
 }
 
@@ -168,16 +248,26 @@ impl LaneGroup for EpochGroup<'_> {
     fn next_fix(&mut self, i: usize, fix: &FixCovariance) -> LaneFix {
         let plan = self.plan;
         let s = Lanes::splat;
-        let [l11, l21, l22] = plan.chol[i];
-        let (u1, u2) = (self.rng.normal(), self.rng.normal());
-        let [mut np, mut nv] = self.noise;
-        np += s(plan.tau_s[i]) * nv + s(l11) * u1;
-        nv += s(l21) * u1 + s(l22) * u2;
-        self.noise = [np, nv];
         let [op, ov] = plan.offsets[i];
-        let b = self.b;
-        let dp = s(op) + self.dp0 + self.dv0 * s(plan.t_s[i]) - b * s(plan.half_t2[i]) - np;
-        let dv = s(ov) + self.dv0 - b * s(plan.t_s[i]) - nv;
+        let (dp, dv, b) = if let Some(drift) = &plan.drift {
+            let x = self.next_drifting(&drift[i]);
+            (
+                s(op) + x[ErrorState::POSITION],
+                s(ov) + x[ErrorState::VELOCITY],
+                x[ErrorState::BIAS],
+            )
+        } else {
+            let [l11, l21, l22] = plan.chol[i];
+            let (u1, u2) = (self.rng.normal(), self.rng.normal());
+            let [mut np, mut nv] = self.noise;
+            np += s(plan.tau_s[i]) * nv + s(l11) * u1;
+            nv += s(l21) * u1 + s(l22) * u2;
+            self.noise = [np, nv];
+            let b = self.b;
+            let dp = s(op) + self.dp0 + self.dv0 * s(plan.t_s[i]) - b * s(plan.half_t2[i]) - np;
+            let dv = s(ov) + self.dv0 - b * s(plan.t_s[i]) - nv;
+            (dp, dv, b)
+        };
         let mask = self.mask;
         let delta_x = [dp * mask, dv * mask, b * mask];
         let eta = [

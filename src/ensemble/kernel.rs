@@ -9,6 +9,7 @@ use crate::filter::{FilterSchedule, FixCovariance};
 use crate::lanes::{Lanes, Real};
 use crate::model::Model;
 use crate::random::LaneStreams;
+use crate::simulation::BiasDrift;
 use crate::state::ErrorState;
 
 // The truth below is the error state written out component by component.
@@ -34,7 +35,10 @@ pub struct SampleGroup<'a, const EULER: bool> {
     mask: Lanes,
     p0: Lanes,
     v0: Lanes,
+    /// The bias b(t_j) at the next sample to integrate.
     b: Lanes,
+    /// The truth's bias step, when it drifts.
+    drift: Option<BiasDrift>,
     /// (p_c, v_c, p_E, v_E), eqs. (3) and (4).
     state: [Lanes; 4],
     estimate: [Lanes; ErrorState::DIM],
@@ -61,6 +65,7 @@ impl<'a, const EULER: bool> SampleGroup<'a, EULER> {
             p0,
             v0,
             b,
+            drift: BiasDrift::of(model),
             state: [
                 s(cfg.initial.position_mean_m),
                 s(cfg.initial.velocity_mean_m_s),
@@ -83,10 +88,26 @@ impl<const EULER: bool> LaneGroup for SampleGroup<'_, EULER> {
         let dt = tl.dt_s;
         let half_dt2 = 0.5 * dt * dt;
         let w_sigma = s(ts.accel_noise_var_m2_s4.sqrt());
-        let b = self.b;
+        let mut b = self.b;
         let jf = tl.fix_steps[i];
         let [mut pc, mut vc, mut pe, mut ve] = self.state;
         let mut j = self.j;
+        if let Some(drift) = self.drift {
+            // As simulation::Run::integrate_drifting: w, then the bias's increment, per sample.
+            let (phi, sigma) = (s(drift.phi), s(drift.sigma_m_s2));
+            for &a in &model.accel_m_s2[j..jf] {
+                let ac = (s(a) + b) + w_sigma * self.rng.normal();
+                pc += vc * s(dt) + ac * s(half_dt2);
+                vc += ac * s(dt);
+                if EULER {
+                    pe += ve * s(dt) + s(a * half_dt2);
+                    ve += s(a * dt);
+                }
+                b = phi * b + sigma * self.rng.normal();
+            }
+            self.b = b;
+            j = jf;
+        }
         while j < jf {
             // The interval's noises in runs of the generator's buffer: the same numbers, in the
             // same order, as one `normal()` per sample.

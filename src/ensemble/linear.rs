@@ -171,7 +171,7 @@ fn add_products<const N: usize, const M: usize>(acc: &mut Accumulator<N, M>, rho
 
 /// A square root L·Lᵀ = A of a symmetric positive semi-definite matrix: Cholesky, with a column
 /// of zeros where a pivot vanishes (a state without noise of its own, e.g. a constant bias in Q).
-fn psd_root<const N: usize>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+pub(super) fn psd_root<const N: usize>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
     let scale = a.diagonal().amax();
     let mut l = SMatrix::<f64, N, N>::zeros();
     for c in 0..N {

@@ -343,6 +343,60 @@ struct ReportData<'a> {
     /// The sensitivity to the assumed statistics, when the study ran it.
     #[serde(skip_serializing_if = "Option::is_none")]
     sensitivity: Option<sensitivity::SensitivityRecord>,
+    /// The drifting-bias study, when the study ran it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    drifting_bias: Option<DriftRecord<'a>>,
+}
+
+/// One filter of the drifting-bias study.
+#[derive(Serialize)]
+struct DriftFilterRecord<'a> {
+    /// The bias model the filter assumes.
+    bias_model: &'static str,
+    /// Fix times of the series, s.
+    time_s: &'a [f64],
+    /// The filter's a posteriori σ at those fixes: [position m, velocity m/s, bias m/s²].
+    claimed_sigma: &'a [[f64; ErrorState::DIM]],
+    /// The actual RMS error there (exact), same order and units.
+    achieved_rms: &'a [[f64; ErrorState::DIM]],
+    /// Each check's verdict on the filter's ensemble.
+    verdicts: std::collections::BTreeMap<&'static str, &'static str>,
+}
+
+/// The drifting-bias study: a constant-bias and a random-walk filter on one random-walk truth.
+#[derive(Serialize)]
+struct DriftRecord<'a> {
+    /// K of the truth's random walk, m/s²/√s.
+    bias_random_walk_m_s2_per_sqrt_s: f64,
+    /// Length of the run, s.
+    duration_s: f64,
+    /// Realizations of each ensemble.
+    realizations: u64,
+    /// The constant-bias filter, then the random-walk filter.
+    filters: [DriftFilterRecord<'a>; 2],
+}
+
+fn drift_record(d: &crate::study::drift::DriftStudy) -> DriftRecord<'_> {
+    fn filter(f: &crate::study::drift::DriftFilter) -> DriftFilterRecord<'_> {
+        DriftFilterRecord {
+            bias_model: f.bias_model.name(),
+            time_s: &f.time_s,
+            claimed_sigma: &f.claimed_sigma,
+            achieved_rms: &f.achieved_rms,
+            verdicts: f
+                .verdicts
+                .checks
+                .iter()
+                .map(|c| (c.id.name(), c.verdict.name()))
+                .collect(),
+        }
+    }
+    DriftRecord {
+        bias_random_walk_m_s2_per_sqrt_s: d.k_m_s2_per_sqrt_s,
+        duration_s: d.duration_s,
+        realizations: d.realizations,
+        filters: [filter(&d.constant), filter(&d.random_walk)],
+    }
 }
 
 /// Serializes the report's data file.
@@ -363,6 +417,7 @@ pub fn report_data_json(study: &Study) -> String {
         realization: &study.realization,
         ensembles,
         sensitivity: study.sensitivity.as_ref().map(sensitivity::record),
+        drifting_bias: study.drift.as_ref().map(drift_record),
     };
     // Indented for the default run, compact for long ones (a third of the size).
     if study.model.timeline.fixes() <= crate::model::ALL_PAIRS_MAX_FIXES {

@@ -4,13 +4,13 @@
 mod memory;
 mod validate;
 
-use crate::config::{AccelerometerOutput, Case, Config, TruthModel};
+use crate::config::{AccelerometerOutput, BiasModelKind, Case, Config, TruthModel};
 use crate::error::ConfigError;
 pub use memory::{MemoryEstimate, Work};
 use validate::{validate, whole};
 
 use crate::state::ErrorState;
-pub use crate::state::NoiseStats;
+pub use crate::state::{BiasModel, NoiseStats};
 
 /// Largest number of accelerometer samples in a run.
 pub const MAX_STEPS: usize = 10_000_000;
@@ -142,6 +142,11 @@ impl Model {
             gps_velocity_sigma_m_s: g.velocity_sigma_m_s,
             initial_position_sigma_m: config.initial.position_sigma_m,
             initial_velocity_sigma_m_s: config.initial.velocity_sigma_m_s,
+            bias_model: bias_model(
+                a.bias_model,
+                a.bias_random_walk_m_s2_per_sqrt_s,
+                a.bias_correlation_time_s,
+            ),
         };
         let filter_stats = NoiseStats {
             accel_noise_var_m2_s4: config.filter_accel_noise_var_m2_s4(),
@@ -150,6 +155,11 @@ impl Model {
             gps_velocity_sigma_m_s: config.filter_gps_velocity_sigma_m_s(),
             initial_position_sigma_m: config.filter_initial_position_sigma_m(),
             initial_velocity_sigma_m_s: config.filter_initial_velocity_sigma_m_s(),
+            bias_model: bias_model(
+                config.filter_bias_model_kind(),
+                config.filter_bias_random_walk_m_s2_per_sqrt_s(),
+                config.filter_bias_correlation_time_s(),
+            ),
         };
         let residual_pair = match config.checks.residual_pair_s {
             Some(times) => times.map(|t| timeline.fix_index_at(t).expect("validated fix time")),
@@ -237,6 +247,19 @@ impl Model {
     pub fn analytic_truth_at_fix(&self, i: usize, t_s: f64, p0_m: f64, v0_m_s: f64) -> (f64, f64) {
         let [dp, dv] = self.analytic_offsets_at_fix[i];
         (p0_m + v0_m_s * t_s + dp, v0_m_s + dv)
+    }
+}
+
+/// The bias model of `kind` with its parameter (validated: the one `kind` uses is set).
+fn bias_model(kind: BiasModelKind, k: Option<f64>, tau_b: Option<f64>) -> BiasModel {
+    match kind {
+        BiasModelKind::Constant => BiasModel::Constant,
+        BiasModelKind::RandomWalk => BiasModel::RandomWalk {
+            k_m_s2_per_sqrt_s: k.expect("validated"),
+        },
+        BiasModelKind::GaussMarkov => BiasModel::GaussMarkov {
+            correlation_time_s: tau_b.expect("validated"),
+        },
     }
 }
 

@@ -10,6 +10,8 @@ use crate::config::{Config, show};
 use crate::error::ConfigError;
 use crate::stats::MIN_ACCURATE_RATE;
 
+mod bias;
+
 /// The smallest accepted `checks.false_alarm_rate` (see [`validate_false_alarm_rate`]).
 const MIN_FALSE_ALARM_RATE: f64 = 1e-6;
 
@@ -56,6 +58,7 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
     let grid = validate_grid(c)?;
     validate_initial(c)?;
     validate_filter(c)?;
+    bias::validate_bias(c)?;
     let e = &c.ensemble;
     if !(2..=MAX_REALIZATIONS).contains(&e.realizations) {
         return Err(ConfigError::invalid(

@@ -78,6 +78,12 @@ struct StaticNoiseHtml<'a> {
 }
 
 #[derive(Template)]
+#[template(path = "sections/drift.html")]
+struct DriftHtml<'a> {
+    d: &'a super::drift::DriftView,
+}
+
+#[derive(Template)]
 #[template(path = "sections/conclusions.html")]
 struct ConclusionsHtml<'a> {
     v: &'a ConclusionsView,
@@ -110,6 +116,7 @@ pub fn section(node: &SectionNode, eq: &Equations) -> Result<String, askama::Err
         SectionView::Performance(v) => PerformanceHtml { v }.render(),
         SectionView::Sensitivity(s) => SensitivityHtml { s }.render(),
         SectionView::StaticNoise(a) => StaticNoiseHtml { a }.render(),
+        SectionView::Drift(d) => DriftHtml { d }.render(),
         SectionView::Conclusions(v) => ConclusionsHtml { v }.render(),
         SectionView::Appendix(v) => AppendixHtml { v }.render(),
     }?;

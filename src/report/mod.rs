@@ -10,6 +10,7 @@
 
 pub mod calibration;
 pub mod cases;
+pub mod drift;
 pub mod equations;
 pub mod figures;
 pub mod html;
@@ -138,13 +139,19 @@ pub fn build(
 }
 
 /// The outline of the report of `input`: every case, the sensitivity section when the study ran
-/// it, the static-noise section when its coverage is given.
+/// it, the static-noise section when its coverage is given, the drifting-bias section when the
+/// study ran it.
 pub fn outline_of(input: &ReportInput) -> Outline {
-    Outline::standard(
+    let outline = Outline::standard(
         input.study.cases.len(),
         input.study.sensitivity.is_some(),
         input.static_noise.is_some(),
-    )
+    );
+    if input.study.drift.is_some() {
+        outline.with_drift()
+    } else {
+        outline
+    }
 }
 
 /// Renders the report of `input` as HTML, with its view as JSON.

@@ -32,6 +32,8 @@ pub enum Section {
     Sensitivity,
     /// Noise statistics from a static log: the Allan deviation and its validation.
     StaticNoise,
+    /// A drifting bias seen by a constant-bias and a random-walk filter.
+    Drift,
     /// Conclusions.
     Conclusions,
     /// Configuration and reproduction.
@@ -62,6 +64,8 @@ pub enum Table {
     StaticNoise,
     /// The coverage of the noise terms' intervals.
     StaticNoiseCoverage,
+    /// Two filters on a drifting bias: claims, errors and verdicts.
+    Drift,
 }
 
 /// A numbered figure.
@@ -81,6 +85,8 @@ pub enum Figure {
     Sensitivity,
     /// The Allan deviation of a static log.
     AllanDeviation,
+    /// Claimed against achieved σ of two filters on a drifting bias.
+    Drift,
 }
 
 /// A numbered display equation.
@@ -168,6 +174,7 @@ impl Section {
                 T(Table::StaticNoise),
                 T(Table::StaticNoiseCoverage),
             ],
+            Section::Drift => vec![F(Figure::Drift), T(Table::Drift)],
         }
     }
 }
@@ -225,6 +232,17 @@ impl Outline {
         nodes.push(Node::leaf(Section::Conclusions));
         nodes.push(Node::leaf(Section::Appendix));
         Outline { nodes }
+    }
+
+    /// The same outline with the drifting-bias section before the conclusions.
+    pub fn with_drift(mut self) -> Self {
+        let at = self
+            .nodes
+            .iter()
+            .position(|n| n.section == Section::Conclusions)
+            .unwrap_or(self.nodes.len());
+        self.nodes.insert(at, Node::leaf(Section::Drift));
+        self
     }
 
     /// Every section in reading order, subsections after their section.

@@ -186,6 +186,8 @@ pub enum SectionView {
     Sensitivity(Box<SensitivityView>),
     /// Noise statistics from a static log.
     StaticNoise(Box<crate::allan::section::AllanSection>),
+    /// A drifting bias.
+    Drift(Box<super::drift::DriftView>),
     /// Conclusions.
     Conclusions(ConclusionsView),
     /// Configuration and reproduction.
@@ -205,6 +207,7 @@ impl SectionView {
             SectionView::Performance(_) => "performance".to_string(),
             SectionView::Sensitivity(_) => "sensitivity".to_string(),
             SectionView::StaticNoise(_) => "allan".to_string(),
+            SectionView::Drift(_) => "drifting-bias".to_string(),
             SectionView::Conclusions(_) => "conclusions".to_string(),
             SectionView::Appendix(_) => "appendix".to_string(),
         }
@@ -222,6 +225,7 @@ impl SectionView {
             SectionView::Performance(_) => "Performance".to_string(),
             SectionView::Sensitivity(_) => "Sensitivity to the assumed statistics".to_string(),
             SectionView::StaticNoise(_) => "Noise statistics from a static log".to_string(),
+            SectionView::Drift(_) => "A drifting bias".to_string(),
             SectionView::Conclusions(_) => "Conclusions".to_string(),
             SectionView::Appendix(_) => "Appendix: configuration and reproduction".to_string(),
         }

@@ -90,6 +90,13 @@ impl Context<'_> {
                 self.numbers,
             )?)),
             Section::StaticNoise => SectionView::StaticNoise(Box::new(self.static_noise()?)),
+            Section::Drift => SectionView::Drift(Box::new(super::drift::view(
+                study
+                    .drift
+                    .as_ref()
+                    .expect("the outline shows the drifting bias only when the study ran it"),
+                self.numbers,
+            )?)),
             Section::Conclusions => SectionView::Conclusions(self.conclusions()),
             Section::Appendix => SectionView::Appendix(AppendixView {
                 command: self.input.command.to_string(),

@@ -14,6 +14,7 @@ pub mod detection;
 mod prediction;
 pub mod sampler;
 mod scaled;
+mod statistic;
 
 use crate::checks::{self, Budget, CheckId, Verdict};
 use crate::config::{Case, Config};
@@ -25,94 +26,7 @@ use crate::progress::Progress;
 use crate::state::ErrorState;
 pub use covariance::{ActualFix, SampleCovariance, actual_covariance, covariance_at_samples};
 pub use detection::Detection;
-
-/// A statistic the filter assumes (a key of the configuration's `[filter]` section).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum AssumedStatistic {
-    /// Accelerometer noise variance W.
-    AccelNoise,
-    /// Bias prior variance.
-    BiasPrior,
-    /// GPS position noise σ.
-    GpsPosition,
-    /// GPS velocity noise σ.
-    GpsVelocity,
-    /// Initial position σ.
-    InitialPosition,
-    /// Initial velocity σ.
-    InitialVelocity,
-}
-
-impl AssumedStatistic {
-    /// Every assumed statistic, in the configuration's order.
-    pub const ALL: [AssumedStatistic; 6] = [
-        AssumedStatistic::AccelNoise,
-        AssumedStatistic::BiasPrior,
-        AssumedStatistic::GpsPosition,
-        AssumedStatistic::GpsVelocity,
-        AssumedStatistic::InitialPosition,
-        AssumedStatistic::InitialVelocity,
-    ];
-
-    /// The `[filter]` key.
-    pub fn name(self) -> &'static str {
-        match self {
-            AssumedStatistic::AccelNoise => "accel_noise_var_m2_s4",
-            AssumedStatistic::BiasPrior => "bias_var_m2_s4",
-            AssumedStatistic::GpsPosition => "gps_position_sigma_m",
-            AssumedStatistic::GpsVelocity => "gps_velocity_sigma_m_s",
-            AssumedStatistic::InitialPosition => "initial_position_sigma_m",
-            AssumedStatistic::InitialVelocity => "initial_velocity_sigma_m_s",
-        }
-    }
-
-    /// The statistic in words, as a standard deviation (the factor scales it).
-    pub fn title(self) -> &'static str {
-        match self {
-            AssumedStatistic::AccelNoise => "accelerometer noise σ",
-            AssumedStatistic::BiasPrior => "bias prior σ",
-            AssumedStatistic::GpsPosition => "GPS position σ",
-            AssumedStatistic::GpsVelocity => "GPS velocity σ",
-            AssumedStatistic::InitialPosition => "initial position σ",
-            AssumedStatistic::InitialVelocity => "initial velocity σ",
-        }
-    }
-
-    /// The statistic named `name`, if any.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|s| s.name() == name)
-    }
-
-    /// `config` with the filter assuming this statistic's standard deviation times `factor` (a
-    /// variance times `factor²`), starting from the value the filter assumes in `config`.
-    pub fn scaled(self, config: &Config, factor: f64) -> Config {
-        let mut c = config.clone();
-        let f = &mut c.filter;
-        match self {
-            AssumedStatistic::AccelNoise => {
-                f.accel_noise_var_m2_s4 =
-                    Some(config.filter_accel_noise_var_m2_s4() * factor * factor)
-            }
-            AssumedStatistic::BiasPrior => {
-                f.bias_var_m2_s4 = Some(config.filter_bias_var_m2_s4() * factor * factor)
-            }
-            AssumedStatistic::GpsPosition => {
-                f.gps_position_sigma_m = Some(config.filter_gps_position_sigma_m() * factor)
-            }
-            AssumedStatistic::GpsVelocity => {
-                f.gps_velocity_sigma_m_s = Some(config.filter_gps_velocity_sigma_m_s() * factor)
-            }
-            AssumedStatistic::InitialPosition => {
-                f.initial_position_sigma_m = Some(config.filter_initial_position_sigma_m() * factor)
-            }
-            AssumedStatistic::InitialVelocity => {
-                f.initial_velocity_sigma_m_s =
-                    Some(config.filter_initial_velocity_sigma_m_s() * factor)
-            }
-        }
-        c
-    }
-}
+pub use statistic::AssumedStatistic;
 
 /// What the sensitivity study runs.
 #[derive(Clone, Debug, PartialEq)]
@@ -138,7 +52,7 @@ impl Plan {
     /// `sensitivity.draws` draws.
     pub fn of(config: &Config) -> Self {
         Self {
-            parameters: AssumedStatistic::ALL.to_vec(),
+            parameters: AssumedStatistic::of(config),
             factors: config.sensitivity.factors.clone(),
             realizations: config.ensemble.realizations,
             ensembles: config.sensitivity.ensembles,

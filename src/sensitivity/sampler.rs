@@ -97,6 +97,15 @@ impl Sampler {
         );
         let world = ErrorStateModel::new(timeline.dt_s, truth);
         let h = schedule.model.h;
+        // With the filter's Φ_f not the truth's Φ_t, e ← Φ_t·e + (Φ_t − Φ_f)·δx̂ + w: the joint
+        // step A = [[Φ_t, Φ_t − Φ_f], [0, Φ_f]], composed over the interval.
+        let same_phi = world.phi == schedule.model.phi;
+        let mut step = JointMatrix::zeros();
+        step.fixed_view_mut::<N, N>(0, 0).copy_from(&world.phi);
+        step.fixed_view_mut::<N, N>(0, N)
+            .copy_from(&(world.phi - schedule.model.phi));
+        step.fixed_view_mut::<N, N>(N, N)
+            .copy_from(&schedule.model.phi);
         let mut j = 0;
         let steps = timeline
             .fix_steps
@@ -105,15 +114,23 @@ impl Sampler {
             .map(|(&jf, fix)| {
                 let mut q = StateMatrix::zeros();
                 let mut phi = StateMatrix::identity();
+                let mut joint = JointMatrix::identity();
                 while j < jf {
                     q = world.propagate(&q);
                     phi = world.phi * phi;
+                    if !same_phi {
+                        joint = step * joint;
+                    }
                     j += 1;
                 }
                 // Rows and columns: e in 0..N, δx̂ in N..2N, η in 2N..2N + M.
                 let mut f = JointMatrix::zeros();
-                f.fixed_view_mut::<N, N>(0, 0).copy_from(&phi);
-                f.fixed_view_mut::<N, N>(N, N).copy_from(&phi);
+                if same_phi {
+                    f.fixed_view_mut::<N, N>(0, 0).copy_from(&phi);
+                    f.fixed_view_mut::<N, N>(N, N).copy_from(&phi);
+                } else {
+                    f = joint;
+                }
                 let mut g = SMatrix::<f64, JOINT, N>::zeros();
                 g.fixed_view_mut::<N, N>(0, 0).copy_from(&psd_cholesky(&q));
                 let k = fix.gain;

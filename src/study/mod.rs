@@ -6,6 +6,7 @@
 //! it is handed, and knows nothing of terminals or pages.
 
 pub mod analysis;
+pub mod drift;
 
 use crate::checks::{self, Budget, Verdicts};
 use crate::config::Case;
@@ -91,6 +92,8 @@ pub struct Study {
     pub realization_case: Case,
     /// The sensitivity to the assumed statistics, when it was run ([`Study::with_sensitivity`]).
     pub sensitivity: Option<Sensitivity>,
+    /// The drifting-bias study, when it was run ([`Study::with_drift`]).
+    pub drift: Option<drift::DriftStudy>,
 }
 
 impl Study {
@@ -134,6 +137,7 @@ impl Study {
             realization,
             realization_case,
             sensitivity: None,
+            drift: None,
         })
     }
 
@@ -147,6 +151,16 @@ impl Study {
     ) -> Result<Self, SensitivityError> {
         let config = &self.model.config;
         self.sensitivity = Some(sensitivity::run(config, &Plan::of(config), progress)?);
+        Ok(self)
+    }
+
+    /// The study with its drifting-bias study ([`drift::run`]), when the configuration can run
+    /// [`drift::DRIFT_DURATION_S`] seconds (it keeps its rates and statistics).
+    ///
+    /// # Errors
+    /// [`FilterError`] when a filter's covariance stops being positive definite.
+    pub fn with_drift(mut self, progress: &mut dyn Progress) -> Result<Self, FilterError> {
+        self.drift = drift::run(&self.model.config, progress)?;
         Ok(self)
     }
 
