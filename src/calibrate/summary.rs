@@ -7,7 +7,9 @@ use crate::logs::write::push_row;
 use crate::state::{ErrorState, StateMatrix, StateVector};
 
 use super::StepMode;
+use super::forward::FilteredFix;
 use super::nis::NisTest;
+use super::smoother::SmoothedFix;
 
 // The columns and records below name the three states of the error state one by one.
 const _: () = assert!(ErrorState::DIM == 3);
@@ -37,6 +39,94 @@ pub const ESTIMATES_COLUMNS: [&str; 20] = [
     "p_smoothed_m",
     "v_smoothed_m_s",
 ];
+
+/// Columns of `estimates.csv` by default: one row per GPS fix, at the accelerometer sample it
+/// is applied at (`t_s`). The columns it shares with [`ESTIMATES_COLUMNS`] hold the same
+/// numbers as that file's row of the fix; "prior" is the a priori estimate δx̂⁻ and its σ, the
+/// innovation r = δz − H·δx̂⁻ with σ = √diag S, and `nis` = rᵀ·S⁻¹·r.
+pub const FIX_ESTIMATES_COLUMNS: [&str; 33] = [
+    "t_s",
+    "gps_t_s",
+    "gps_position_m",
+    "gps_velocity_m_s",
+    "p_integrated_m",
+    "v_integrated_m_s",
+    "dp_prior_m",
+    "dv_prior_m_s",
+    "bias_prior_m_s2",
+    "sigma_dp_prior_m",
+    "sigma_dv_prior_m_s",
+    "sigma_bias_prior_m_s2",
+    "dp_filtered_m",
+    "dv_filtered_m_s",
+    "bias_filtered_m_s2",
+    "sigma_dp_filtered_m",
+    "sigma_dv_filtered_m_s",
+    "sigma_bias_filtered_m_s2",
+    "dp_smoothed_m",
+    "dv_smoothed_m_s",
+    "bias_smoothed_m_s2",
+    "sigma_dp_smoothed_m",
+    "sigma_dv_smoothed_m_s",
+    "sigma_bias_smoothed_m_s2",
+    "innovation_p_m",
+    "innovation_v_m_s",
+    "sigma_innovation_p_m",
+    "sigma_innovation_v_m_s",
+    "nis",
+    "p_filtered_m",
+    "v_filtered_m_s",
+    "p_smoothed_m",
+    "v_smoothed_m_s",
+];
+
+/// Appends the row of fix `f` (taken at `gps_t_s`), smoothed as `sm`, in the order of
+/// [`FIX_ESTIMATES_COLUMNS`].
+pub(super) fn push_fix_row(out: &mut String, f: &FilteredFix, gps_t_s: f64, sm: &SmoothedFix) {
+    let (gp, gv) = (ErrorState::GPS_POSITION, ErrorState::GPS_VELOCITY);
+    let (dp, dv, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
+    let (pc, vc) = (f.integrated[gp], f.integrated[gv]);
+    let (s0, s1, s2) = (sigma(&f.p_prior), sigma(&f.p_post), sigma(&sm.p));
+    let (x0, x1, x2) = (&f.prior, &f.post, &sm.x);
+    push_row(
+        out,
+        &[
+            f.t_s,
+            gps_t_s,
+            f.z[gp],
+            f.z[gv],
+            pc,
+            vc,
+            x0[dp],
+            x0[dv],
+            x0[b],
+            s0[dp],
+            s0[dv],
+            s0[b],
+            x1[dp],
+            x1[dv],
+            x1[b],
+            s1[dp],
+            s1[dv],
+            s1[b],
+            x2[dp],
+            x2[dv],
+            x2[b],
+            s2[dp],
+            s2[dv],
+            s2[b],
+            f.residual[gp],
+            f.residual[gv],
+            f.s[(gp, gp)].sqrt(),
+            f.s[(gv, gv)].sqrt(),
+            f.nis,
+            pc + x1[dp],
+            vc + x1[dv],
+            pc + x2[dp],
+            vc + x2[dv],
+        ],
+    );
+}
 
 /// σ = √diag P.
 pub fn sigma(p: &StateMatrix) -> [f64; ErrorState::DIM] {

@@ -8,12 +8,14 @@ use std::io::Write as _;
 
 use super::{load_model, write};
 use crate::cli::{CalibrateArgs, CaseArgs, ModelArgs, SimulateArgs};
+use accelcal::calibrate::CalibrateError;
 use accelcal::calibrate::{self, Settings};
 use accelcal::filter::FilterSchedule;
 use accelcal::format::{count, sig};
-use accelcal::logs::read::LogFile;
+use accelcal::logs::read::{LogFile, LogSource};
 use accelcal::logs::write::LogWriter;
 use accelcal::logs::{ACCEL_FILE, GPS_FILE, TRUTH_FILE};
+use accelcal::logs::{LogError, LogProblem};
 use accelcal::model::Model;
 use accelcal::output::StagedFiles;
 use accelcal::{export, realization, report, simulation};
@@ -100,16 +102,35 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         }
     };
     let (accel, gps) = (LogFile::new(&args.accel), LogFile::new(&args.gps));
+    if args.every_sample && !accel.rereadable() {
+        return Err(CalibrateError::Log(LogError::of_file(
+            accel.name(),
+            LogProblem::Unreadable {
+                message: "--every-sample reads the accelerometer log twice, and this is a pipe \
+                          or a device that reads once: give it as a file, or leave out \
+                          --every-sample for one row per GPS fix"
+                    .to_string(),
+            },
+        ))
+        .into());
+    }
     note("checking the logs and running the filter and the smoother…");
-    let prepared = calibrate::prepare(&accel, &gps, &settings)?;
+    let mut prepared = calibrate::prepare(&accel, &gps, &settings)?;
+    if args.every_sample {
+        prepared.per_sample()?;
+    }
     let cal = prepared.calibration();
     let page = report::calibration::render(&cal, &calibrate_command(args))?;
     note("writing the estimates…");
     let mut staged = StagedFiles::create(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE, PAGE_FILE])?;
     let into = |name: &str| format!("cannot write {}", args.out.join(name).display());
-    prepared
-        .write_estimates(staged.writer(ESTIMATES_FILE))
-        .with_context(|| into(ESTIMATES_FILE))?;
+    let estimates = staged.writer(ESTIMATES_FILE);
+    if args.every_sample {
+        prepared.write_estimates(estimates)
+    } else {
+        prepared.write_fix_estimates(estimates)
+    }
+    .with_context(|| into(ESTIMATES_FILE))?;
     staged
         .writer(SUMMARY_FILE)
         .write_all(cal.summary.to_json().as_bytes())
@@ -149,5 +170,8 @@ fn calibrate_command(args: &CalibrateArgs) -> String {
         s.push_str(&format!(" --config {}", c.display()));
     }
     s.push_str(&format!(" --out {}", args.out.display()));
+    if args.every_sample {
+        s.push_str(" --every-sample");
+    }
     s
 }
