@@ -7,6 +7,7 @@
 mod common;
 
 mod bad_logs;
+mod fast;
 mod reference;
 mod round_trip;
 mod smoother;
