@@ -259,45 +259,72 @@ impl Stitch<'_> {
 /// What the reading thread hands over: a block, or the problem that ended the reading.
 type Message = Result<Block, LogError>;
 
-/// Parses and stitches the blocks arriving on `blocks`, in order; stops at the first problem.
+/// A block's rows, and the problem that ended them.
+type Parsed = (Rows<2>, Option<LogError>);
+
+/// Parses `group` on all threads, into the row buffers of `spare` (used before).
+fn parse_group(layout: &Layout<2>, group: &[Message], mut spare: Vec<Parsed>) -> Vec<Parsed> {
+    let mut out: Vec<Parsed> = group
+        .iter()
+        .map(|_| spare.pop().unwrap_or_default())
+        .collect();
+    out.par_iter_mut()
+        .zip(group)
+        .for_each(|((rows, error), m)| {
+            rows.clear();
+            *error = match m {
+                Ok(block) => parse_block(layout, block, rows).err(),
+                Err(e) => Some(e.clone()),
+            };
+        });
+    out
+}
+
+/// Stitches parsed blocks in order; stops at the first problem.
+fn stitch_group(parsed: &[Parsed], stitch: &mut Stitch<'_>) -> Result<(), LogError> {
+    for (rows, error) in parsed {
+        stitch.rows(rows)?;
+        if let Some(e) = error {
+            return Err(e.clone());
+        }
+    }
+    Ok(())
+}
+
+/// Parses and stitches the blocks arriving on `blocks`, in order, handing their buffers back on
+/// `used`; stops at the first problem. A group of blocks is parsed while the group before it is
+/// stitched.
 fn stitch_all(
     layout: &Layout<2>,
-    blocks: &mpsc::Receiver<Message>,
+    (blocks, used): (&mpsc::Receiver<Message>, &mpsc::Sender<Vec<u8>>),
     stitch: &mut Stitch<'_>,
 ) -> Result<(), LogError> {
-    let mut group: Vec<Message> = Vec::with_capacity(PARSE_GROUP);
-    let mut parsed: Vec<(Rows<2>, Option<LogError>)> = Vec::new();
-    while let Ok(first) = blocks.recv() {
-        group.clear();
-        group.push(first);
+    let mut parsed: Vec<Parsed> = Vec::new();
+    let mut spare: Vec<Parsed> = Vec::new();
+    loop {
+        let mut group: Vec<Message> = Vec::with_capacity(PARSE_GROUP);
+        if let Ok(first) = blocks.recv() {
+            group.push(first);
+        }
         while group.len() < PARSE_GROUP
             && let Ok(more) = blocks.try_recv()
         {
             group.push(more);
         }
-        group
-            .par_iter()
-            .map(|m| {
-                let mut rows = Rows::default();
-                match m {
-                    Ok(block) => {
-                        rows.values.reserve(block.bytes.len() / 24);
-                        rows.lines.reserve(block.bytes.len() / 24);
-                        let e = parse_block(layout, block, &mut rows).err();
-                        (rows, e)
-                    }
-                    Err(e) => (rows, Some(e.clone())),
-                }
-            })
-            .collect_into_vec(&mut parsed);
-        for (rows, error) in &parsed {
-            stitch.rows(rows)?;
-            if let Some(e) = error {
-                return Err(e.clone());
-            }
+        let (next, stitched) = rayon::join(
+            || parse_group(layout, &group, std::mem::take(&mut spare)),
+            || stitch_group(&parsed, stitch),
+        );
+        stitched?;
+        for block in group.drain(..).flatten() {
+            // The reader may have stopped; a buffer it does not take is dropped.
+            let _ = used.send(block.bytes);
         }
+        if next.is_empty() {
+            return Ok(());
+        }
+        spare = std::mem::replace(&mut parsed, next);
     }
-    Ok(())
 }
 
 /// Streams the accelerometer log `source` once: every row checked (format, increasing time
@@ -342,13 +369,15 @@ pub fn reduce(
         file: source.name().to_string(),
     };
     let (tx, rx) = mpsc::sync_channel::<Message>(2 * PARSE_GROUP);
+    let (used_tx, used) = mpsc::channel::<Vec<u8>>();
     std::thread::scope(|scope| {
         let (layout, stitch) = (&layout, &mut stitch);
-        let worker = scope.spawn(move || stitch_all(layout, &rx, stitch));
+        let worker = scope.spawn(move || stitch_all(layout, (&rx, &used_tx), stitch));
         // The reading stays on this thread (a source need not be sendable); it stops when the
         // text ends, fails, or the stitching stopped at a problem.
         loop {
-            let message = feed.next_block(BLOCK_BYTES, MAX_LINE_BYTES);
+            let buffer = used.try_recv().unwrap_or_default();
+            let message = feed.next_block_in(buffer, BLOCK_BYTES, MAX_LINE_BYTES);
             let stop = !matches!(message, Ok(Some(_)));
             if tx
                 .send(message.transpose().unwrap_or(Ok(Block::default())))

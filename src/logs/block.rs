@@ -219,24 +219,21 @@ impl<'a> Feed<'a> {
 
     /// Reads into `bytes` until it holds `target` bytes or the text ends.
     fn fill(&mut self, bytes: &mut Vec<u8>, target: usize) -> Result<(), LogError> {
-        while bytes.len() < target && !self.eof {
-            let len = bytes.len();
-            bytes.resize(target, 0);
-            let read = loop {
-                match self.reader.read(&mut bytes[len..]) {
-                    Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-                    other => break other,
-                }
-            };
-            let n = read.map_err(|e| {
-                bytes.truncate(len);
-                let line = self.lines_before + count_lines(bytes) + 1;
-                let message = e.to_string();
-                LogError::at(&self.file, line, LogProblem::Unreadable { message })
-            })?;
-            bytes.truncate(len + n);
-            self.eof = n == 0;
+        if bytes.len() >= target || self.eof {
+            return Ok(());
         }
+        let len = bytes.len();
+        // `read_to_end` of a `Take` reads into the spare capacity without zeroing it first, and
+        // stops at `target` bytes or the end of the text.
+        let wanted = (target - len) as u64;
+        let read = (&mut self.reader).take(wanted).read_to_end(bytes);
+        let n = read.map_err(|e| {
+            bytes.truncate(len);
+            let line = self.lines_before + count_lines(bytes) + 1;
+            let message = e.to_string();
+            LogError::at(&self.file, line, LogProblem::Unreadable { message })
+        })?;
+        self.eof = (n as u64) < wanted;
         Ok(())
     }
 
@@ -247,7 +244,24 @@ impl<'a> Feed<'a> {
     /// [`LogProblem::Unreadable`] when a read fails; [`LogProblem::LineTooLong`] when a line
     /// exceeds `limit` bytes.
     pub fn next_block(&mut self, target: usize, limit: usize) -> Result<Option<Block>, LogError> {
-        let mut bytes = std::mem::take(&mut self.carry);
+        self.next_block_in(Vec::new(), target, limit)
+    }
+
+    /// As [`Feed::next_block`], the block's text in `bytes` (a buffer used before: its
+    /// allocation is kept, its content dropped).
+    ///
+    /// # Errors
+    /// As [`Feed::next_block`].
+    pub fn next_block_in(
+        &mut self,
+        mut bytes: Vec<u8>,
+        target: usize,
+        limit: usize,
+    ) -> Result<Option<Block>, LogError> {
+        bytes.clear();
+        bytes.reserve(target.max(self.carry.len() + 1));
+        bytes.extend_from_slice(&self.carry);
+        self.carry.clear();
         let mut want = target.max(bytes.len() + 1);
         loop {
             self.fill(&mut bytes, want)?;
@@ -255,7 +269,7 @@ impl<'a> Feed<'a> {
                 break;
             }
             if let Some(i) = memchr::memrchr(b'\n', &bytes) {
-                self.carry = bytes[i + 1..].to_vec();
+                self.carry.extend_from_slice(&bytes[i + 1..]);
                 bytes.truncate(i + 1);
                 break;
             }
