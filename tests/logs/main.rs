@@ -8,6 +8,7 @@ mod common;
 
 mod bad_logs;
 mod fast;
+mod reader;
 mod reference;
 mod round_trip;
 mod smoother;
