@@ -325,7 +325,7 @@ impl Prepared<'_> {
     pub fn write_estimates(&self, out: &mut dyn Write) -> Result<(), CalibrateError> {
         let header = format!("{}\n", summary::ESTIMATES_COLUMNS.join(","));
         out.write_all(header.as_bytes())?;
-        let mut row = String::with_capacity(512);
+        let mut rows = summary::EstimateChunks::new(out);
         let mut next = 0usize;
         let changed = || LogError::of_file(self.accel.name(), LogProblem::Changed);
         self.forward_pass(&mut |fw, fix| {
@@ -342,19 +342,17 @@ impl Prepared<'_> {
                 (Some(f), Some(sm)) => sm.smooth(&fw.x, &fw.p, &fw.transition_to(f.sample, f.t_s)),
                 _ => (fw.x, fw.p),
             };
-            row.clear();
-            EstimateRow {
+            let row = EstimateRow {
                 t_s: fw.t_s,
                 fix: fix.is_some(),
                 integrated: [fw.pc_m, fw.vc_m_s],
                 filtered: (&fw.x, &fw.p),
                 smoothed: (&xs, &ps),
-            }
-            .push(&mut row);
-            out.write_all(row.as_bytes())?;
+            };
+            rows.push(row.values())?;
             Ok(())
         })?;
-        out.flush()?;
+        rows.flush()?;
         Ok(())
     }
 

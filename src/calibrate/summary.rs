@@ -144,8 +144,8 @@ pub(super) struct EstimateRow<'a> {
 }
 
 impl EstimateRow<'_> {
-    /// Appends the row in the order of [`ESTIMATES_COLUMNS`].
-    pub fn push(&self, out: &mut String) {
+    /// The row's numbers in the order of [`ESTIMATES_COLUMNS`].
+    pub fn values(&self) -> [f64; ESTIMATES_COLUMNS.len()] {
         let (pc, vc) = (
             self.integrated[ErrorState::GPS_POSITION],
             self.integrated[ErrorState::GPS_VELOCITY],
@@ -154,31 +154,84 @@ impl EstimateRow<'_> {
         let (xs, ps) = self.smoothed;
         let (sf, ss) = (sigma(p), sigma(ps));
         let (dp, dv, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
-        push_row(
+        [
+            self.t_s,
+            if self.fix { 1.0 } else { 0.0 },
+            pc,
+            vc,
+            x[dp],
+            x[dv],
+            x[b],
+            sf[dp],
+            sf[dv],
+            sf[b],
+            xs[dp],
+            xs[dv],
+            xs[b],
+            ss[dp],
+            ss[dv],
+            ss[b],
+            pc + x[dp],
+            vc + x[dv],
+            pc + xs[dp],
+            vc + xs[dv],
+        ]
+    }
+}
+
+/// Rows of [`ESTIMATES_COLUMNS`] formatted at once.
+const ROWS_PER_CHUNK: usize = 1 << 16;
+
+/// Rows of `estimates.csv` gathered, then formatted on all threads and written in order: the
+/// shortest round-trip form of 20 numbers a row is most of the work of writing the file.
+pub(super) struct EstimateChunks<'w> {
+    out: &'w mut dyn std::io::Write,
+    rows: Vec<[f64; ESTIMATES_COLUMNS.len()]>,
+}
+
+impl<'w> EstimateChunks<'w> {
+    /// Rows to be written to `out`.
+    pub fn new(out: &'w mut dyn std::io::Write) -> Self {
+        Self {
             out,
-            &[
-                self.t_s,
-                if self.fix { 1.0 } else { 0.0 },
-                pc,
-                vc,
-                x[dp],
-                x[dv],
-                x[b],
-                sf[dp],
-                sf[dv],
-                sf[b],
-                xs[dp],
-                xs[dv],
-                xs[b],
-                ss[dp],
-                ss[dv],
-                ss[b],
-                pc + x[dp],
-                vc + x[dv],
-                pc + xs[dp],
-                vc + xs[dv],
-            ],
-        );
+            rows: Vec::with_capacity(ROWS_PER_CHUNK),
+        }
+    }
+
+    /// Adds one row, writing the chunk when it is full.
+    ///
+    /// # Errors
+    /// When writing fails.
+    pub fn push(&mut self, row: [f64; ESTIMATES_COLUMNS.len()]) -> std::io::Result<()> {
+        self.rows.push(row);
+        if self.rows.len() == ROWS_PER_CHUNK {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    /// Writes the rows gathered.
+    ///
+    /// # Errors
+    /// When writing fails.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        use rayon::prelude::*;
+        let texts: Vec<String> = self
+            .rows
+            .par_chunks(ROWS_PER_CHUNK / 16)
+            .map(|rows| {
+                let mut text = String::with_capacity(rows.len() * 400);
+                for row in rows {
+                    push_row(&mut text, row);
+                }
+                text
+            })
+            .collect();
+        for text in texts {
+            self.out.write_all(text.as_bytes())?;
+        }
+        self.rows.clear();
+        self.out.flush()
     }
 }
 
