@@ -39,7 +39,7 @@ use crate::model::{Model, NoiseStats};
 use crate::state::{ErrorState, StateMatrix, StateVector};
 use forward::FilteredFix;
 pub use nis::{NisTest, nis_test};
-pub use scan::NOMINAL_TOLERANCE;
+pub use pass::NOMINAL_TOLERANCE;
 use scan::{FixMatcher, Scan};
 use smoother::SmoothedFix;
 use summary::{Calibration, EstimateRow, FilterRecord, FixReport, StateRecord, Summary, sigma};

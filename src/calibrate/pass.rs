@@ -17,7 +17,9 @@ use crate::logs::steps::{StepAt, StepMedian};
 use crate::logs::{ACCEL_COLUMNS, GpsFix, LogError, LogProblem};
 use crate::state::{ErrorState, StateMatrix};
 
-use super::scan::NOMINAL_TOLERANCE;
+/// Relative tolerance within which every step of a log must equal the configured Δt for the
+/// nominal recursion to run: time stamps written as j·Δt differ from j·Δt by a rounding error.
+pub const NOMINAL_TOLERANCE: f64 = 1e-9;
 
 // The unit contributions below are written out for the error state's (δp, δv, b).
 const _: () = assert!(ErrorState::DIM == 3);

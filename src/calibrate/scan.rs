@@ -8,10 +8,6 @@ use crate::logs::{AccelSample, GpsFix, LogError, LogProblem};
 use super::StepMode;
 use super::pass::Reduced;
 
-/// Relative tolerance within which every step of a log must equal the configured Δt for the
-/// nominal recursion to run: time stamps written as j·Δt differ from j·Δt by a rounding error.
-pub const NOMINAL_TOLERANCE: f64 = 1e-9;
-
 /// What the first pass learned.
 #[derive(Clone, Debug)]
 pub struct Scan {

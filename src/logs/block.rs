@@ -266,21 +266,26 @@ impl<'a> Feed<'a> {
         bytes.extend_from_slice(&self.carry);
         self.carry.clear();
         let mut want = target.max(bytes.len() + 1);
+        // Bytes already searched for a line end.
+        let mut searched = 0;
         loop {
             self.fill(&mut bytes, want)?;
             if self.eof {
                 break;
             }
-            if let Some(i) = memchr::memrchr(b'\n', &bytes) {
-                self.carry.extend_from_slice(&bytes[i + 1..]);
-                bytes.truncate(i + 1);
+            if let Some(i) = memchr::memrchr(b'\n', &bytes[searched..]) {
+                let end = searched + i + 1;
+                self.carry.extend_from_slice(&bytes[end..]);
+                bytes.truncate(end);
                 break;
             }
             if bytes.len() > limit {
                 let problem = LogProblem::LineTooLong { limit_bytes: limit };
                 return Err(LogError::at(&self.file, self.lines_before + 1, problem));
             }
-            want = bytes.len() + target;
+            // A long line: read on in steps that double, so that it is searched once.
+            searched = bytes.len();
+            want = bytes.len() + target.max(bytes.len());
         }
         if bytes.is_empty() {
             return Ok(None);
