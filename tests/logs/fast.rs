@@ -231,3 +231,70 @@ fn results_do_not_depend_on_the_thread_count() {
         assert!(outputs.windows(2).all(|w| w[0] == w[1]), "{mode}");
     }
 }
+
+/// The numbers of two summaries, flattened with their paths.
+fn numbers(v: &serde_json::Value, path: &str, out: &mut Vec<(String, f64)>) {
+    match v {
+        serde_json::Value::Object(m) => m
+            .iter()
+            .for_each(|(k, v)| numbers(v, &format!("{path}.{k}"), out)),
+        serde_json::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .for_each(|(i, v)| numbers(v, &format!("{path}[{i}]"), out)),
+        serde_json::Value::Number(n) => out.push((path.to_string(), n.as_f64().unwrap())),
+        _ => {}
+    }
+}
+
+#[test]
+fn per_step_fix_to_fix_filter_matches_the_per_sample_recursion() {
+    // The per-step mode's interval noise Q = W·U must hold every process-noise term of the
+    // state model: a term left out of the units moves the numbers far beyond rounding.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    long_logs(d);
+    let args = |out: &'static str| {
+        [
+            "calibrate",
+            "--config",
+            "long.toml",
+            "--accel",
+            "logs/jittered.csv",
+            "--gps",
+            "logs/gps.csv",
+            "--out",
+            out,
+            "-q",
+        ]
+    };
+    for (out, extra) in [("fix", None), ("all", Some("--every-sample"))] {
+        let args: Vec<&str> = args(out).into_iter().chain(extra).collect();
+        let o = run(&args, d);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let (mut fast, mut exact) = (Vec::new(), Vec::new());
+    numbers(&summary(d, "fix"), "", &mut fast);
+    numbers(&summary(d, "all"), "", &mut exact);
+    assert_eq!(fast.len(), exact.len());
+    // The smoothed σ at the start is P(0) less almost all of itself: the rounding at P(0)'s size
+    // comes out multiplied by (σ(0)/σ^s)², 10⁴ to 10⁸ here, whichever recursion computes it.
+    let tolerance = |path: &str| {
+        if path.starts_with(".start_smoothed.sigma") {
+            1e-6
+        } else {
+            1e-9
+        }
+    };
+    let mut worst = (0.0f64, String::new());
+    for ((path, a), (_, b)) in fast.iter().zip(&exact) {
+        let relative = (a - b).abs() / b.abs().max(f64::MIN_POSITIVE) / tolerance(path);
+        if relative > worst.0 {
+            worst = (relative, path.clone());
+        }
+    }
+    eprintln!(
+        "per-step, fix to fix against sample by sample: worst relative / tolerance {worst:?}"
+    );
+    assert!(worst.0 < 1.0, "{worst:?}");
+}
