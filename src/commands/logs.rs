@@ -120,7 +120,7 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         prepared.per_sample()?;
     }
     let cal = prepared.calibration();
-    let page = report::calibration::render(&cal, &calibrate_command(args))?;
+    let page = report::calibration::render(&cal, &calibrate_command(args), args.every_sample)?;
     note("writing the estimates…");
     let mut staged = StagedFiles::create(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE, PAGE_FILE])?;
     let into = |name: &str| format!("cannot write {}", args.out.join(name).display());
