@@ -201,6 +201,10 @@ pub struct CalibrateArgs {
     /// Directory that receives estimates.csv, summary.json and index.html.
     #[arg(long, value_name = "DIR", default_value = "calibration")]
     pub out: PathBuf,
+    /// Write estimates.csv with one row per accelerometer sample instead of one per GPS fix
+    /// (reads the accelerometer log a second time: it must be a file, not a pipe).
+    #[arg(long)]
+    pub every_sample: bool,
     /// Print nothing but the result.
     #[arg(long, short)]
     pub quiet: bool,

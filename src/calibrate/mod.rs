@@ -1,22 +1,27 @@
 //! Calibration from recorded logs: an accelerometer log and a GPS log in, the bias with its σ,
 //! filtered and smoothed estimates at every sample, and the NIS test out.
 //!
-//! The logs are streamed, never held: memory grows with the number of GPS fixes, not samples.
+//! The accelerometer log is streamed once, never held: memory grows with the number of GPS
+//! fixes, not samples.
 //!
-//! 1. `scan` reads the GPS log and streams the accelerometer log once: format, increasing time
-//!    stamps, the median step, whether every step equals the configured Δt (the nominal mode),
-//!    and every fix inside the log's span.
-//! 2. The forward pass streams it again: eq. (3) from the prior means and the error-state filter
-//!    (`forward`), every step checked against the median, every fix applied at its sample;
-//!    what the smoother needs is kept at the fixes. Then `smoother::backward` runs the
-//!    Rauch–Tung–Striebel pass over the fixes.
-//! 3. [`Prepared::write_estimates`] streams it a third time, repeating the forward pass
-//!    operation for operation, and writes each sample's filtered and smoothed estimates.
+//! 1. `pass` reads the GPS log and streams the accelerometer log once (blocks parsed on all
+//!    threads, stitched in order): format, increasing time stamps, the steps' histogram, whether
+//!    every step equals the configured Δt (the nominal mode), each fix at its nearest sample,
+//!    and between fixes what the filter needs: the integrated (p_c, v_c) at each fix and, per
+//!    step, the interval's process noise as unit contributions.
+//! 2. `intervals` checks what needed the median step (gaps, fixes between samples) and runs the
+//!    filter fix to fix: in nominal mode the in-memory filter's recursion, operation for
+//!    operation; then `smoother::backward` runs the Rauch–Tung–Striebel pass over the fixes.
+//! 3. [`Prepared::write_fix_estimates`] writes one row per fix; with `--every-sample`,
+//!    [`Prepared::write_estimates`] streams the log again, repeating the filter sample by
+//!    sample (`forward`), and writes each sample's filtered and smoothed estimates.
 //!
-//! Nothing is written before the logs have passed every check of the first two passes.
+//! Nothing is written before the logs have passed every check.
 
 mod forward;
+mod intervals;
 mod nis;
+pub mod pass;
 mod scan;
 mod smoother;
 pub mod summary;
@@ -28,13 +33,13 @@ use thiserror::Error;
 
 use crate::error::FilterError;
 use crate::filter::ErrorStateModel;
-use crate::logs::read::{AccelReader, LogSource};
+use crate::logs::read::{AccelReader, LogSource, read_gps};
 use crate::logs::{LogError, LogProblem};
 use crate::model::{Model, NoiseStats};
 use crate::state::{ErrorState, StateMatrix, StateVector};
 use forward::FilteredFix;
 pub use nis::{NisTest, nis_test};
-pub use scan::NOMINAL_TOLERANCE;
+pub use pass::NOMINAL_TOLERANCE;
 use scan::{FixMatcher, Scan};
 use smoother::SmoothedFix;
 use summary::{Calibration, EstimateRow, FilterRecord, FixReport, StateRecord, Summary, sigma};
@@ -127,7 +132,8 @@ pub struct Prepared<'a> {
 type Visit<'v> =
     dyn FnMut(&forward::Forward<'_>, Option<&FilteredFix>) -> Result<(), CalibrateError> + 'v;
 
-/// Checks the logs, runs the filter over them and the smoother's backward pass (passes 1 and 2).
+/// Checks the logs and reduces the accelerometer log in one streamed pass, then runs the
+/// filter fix to fix and the smoother's backward pass: O(fixes) after the pass.
 ///
 /// # Errors
 /// [`CalibrateError::Log`] naming the file and line of the first problem of either log;
@@ -137,29 +143,30 @@ pub fn prepare<'a>(
     gps: &dyn LogSource,
     settings: &Settings,
 ) -> Result<Prepared<'a>, CalibrateError> {
-    let scan = scan::scan(accel, gps, settings.nominal_dt_s)?;
-    let mut prepared = Prepared {
-        settings: settings.clone(),
-        model: ErrorStateModel::new(settings.nominal_dt_s, &settings.filter_stats),
-        accel,
-        fixes: Vec::new(),
-        scan,
-        smoothed: Vec::new(),
-        end: (StateVector::zeros(), StateMatrix::zeros()),
+    let fixes = read_gps(gps)?;
+    let start = pass::Integrated {
+        pc_m: settings.position_mean_m,
+        vc_m_s: settings.velocity_mean_m_s,
     };
-    let mut fixes = Vec::with_capacity(prepared.scan.gps.len());
-    let mut end = prepared.end;
-    prepared.forward_pass(&mut |fw, fix| {
-        if let Some(f) = fix {
-            fixes.push(f.clone());
-        }
-        end = (fw.x, fw.p);
-        Ok(())
-    })?;
-    prepared.smoothed = smoother::backward(&fixes);
-    prepared.fixes = fixes;
-    prepared.end = end;
-    Ok(prepared)
+    let reduced = pass::reduce(accel, &fixes, settings.nominal_dt_s, start)?;
+    let scan = Scan::of(&reduced, fixes, gps.name())?;
+    let model = ErrorStateModel::new(settings.nominal_dt_s, &settings.filter_stats);
+    let (fixes, end) = intervals::filter(
+        &scan,
+        &reduced,
+        &model,
+        &settings.filter_stats,
+        accel.name(),
+    )?;
+    Ok(Prepared {
+        settings: settings.clone(),
+        model,
+        accel,
+        smoothed: smoother::backward(&fixes),
+        fixes,
+        scan,
+        end,
+    })
 }
 
 impl Prepared<'_> {
@@ -261,7 +268,56 @@ impl Prepared<'_> {
         Err(error.into())
     }
 
-    /// Pass 3: writes `estimates.csv` to `out`, one row per sample in time order.
+    /// Runs the filter sample by sample over the log once more, as `--every-sample` writes
+    /// it, and takes its fixes: in per-step mode their numbers then are those of the
+    /// per-sample recursion (the reduced pass agrees to rounding); in nominal mode they are
+    /// the same bits already, and nothing is read.
+    ///
+    /// # Errors
+    /// As [`Prepared::write_estimates`].
+    pub fn per_sample(&mut self) -> Result<(), CalibrateError> {
+        if self.scan.mode == StepMode::Nominal {
+            return Ok(());
+        }
+        let mut fixes = Vec::with_capacity(self.fixes.len());
+        let mut end = self.end;
+        self.forward_pass(&mut |fw, fix| {
+            if let Some(f) = fix {
+                fixes.push(f.clone());
+            }
+            end = (fw.x, fw.p);
+            Ok(())
+        })?;
+        if fixes.len() != self.fixes.len() {
+            return Err(LogError::of_file(self.accel.name(), LogProblem::Changed).into());
+        }
+        self.smoothed = smoother::backward(&fixes);
+        self.fixes = fixes;
+        self.end = end;
+        Ok(())
+    }
+
+    /// Writes `estimates.csv` to `out`, one row per GPS fix: the a priori, a posteriori and
+    /// smoothed estimates with their σ, the innovation with its σ, and the NIS.
+    ///
+    /// # Errors
+    /// [`CalibrateError::Write`] when `out` fails.
+    pub fn write_fix_estimates(&self, out: &mut dyn Write) -> Result<(), CalibrateError> {
+        let header = format!("{}\n", summary::FIX_ESTIMATES_COLUMNS.join(","));
+        out.write_all(header.as_bytes())?;
+        let mut row = String::with_capacity(1024);
+        // Every fix of the GPS log was applied, in order.
+        for ((f, sm), gps) in self.fixes.iter().zip(&self.smoothed).zip(&self.scan.gps) {
+            row.clear();
+            summary::push_fix_row(&mut row, f, gps.t_s, sm);
+            out.write_all(row.as_bytes())?;
+        }
+        out.flush()?;
+        Ok(())
+    }
+
+    /// Writes `estimates.csv` to `out`, one row per sample in time order (`--every-sample`):
+    /// the log read again.
     ///
     /// # Errors
     /// [`CalibrateError::Write`] when `out` fails; [`LogProblem::Changed`] when the log no longer
@@ -269,7 +325,7 @@ impl Prepared<'_> {
     pub fn write_estimates(&self, out: &mut dyn Write) -> Result<(), CalibrateError> {
         let header = format!("{}\n", summary::ESTIMATES_COLUMNS.join(","));
         out.write_all(header.as_bytes())?;
-        let mut row = String::with_capacity(512);
+        let mut rows = summary::EstimateChunks::new(out);
         let mut next = 0usize;
         let changed = || LogError::of_file(self.accel.name(), LogProblem::Changed);
         self.forward_pass(&mut |fw, fix| {
@@ -286,19 +342,17 @@ impl Prepared<'_> {
                 (Some(f), Some(sm)) => sm.smooth(&fw.x, &fw.p, &fw.transition_to(f.sample, f.t_s)),
                 _ => (fw.x, fw.p),
             };
-            row.clear();
-            EstimateRow {
+            let row = EstimateRow {
                 t_s: fw.t_s,
                 fix: fix.is_some(),
                 integrated: [fw.pc_m, fw.vc_m_s],
                 filtered: (&fw.x, &fw.p),
                 smoothed: (&xs, &ps),
-            }
-            .push(&mut row);
-            out.write_all(row.as_bytes())?;
+            };
+            rows.push(row.values())?;
             Ok(())
         })?;
-        out.flush()?;
+        rows.flush()?;
         Ok(())
     }
 

@@ -1,16 +1,12 @@
-//! The first pass over the logs, and the rules it sets for the second: the median step and the
+//! What the pass over the logs learned, and the rules it sets: the median step and the
 //! steps accepted around it, whether the nominal recursion applies, and which sample each GPS
 //! fix belongs to.
 
-use crate::logs::read::{AccelReader, LogSource, read_gps};
-use crate::logs::steps::{ACCEPTED_STEP_RATIO, StepMedian};
+use crate::logs::steps::ACCEPTED_STEP_RATIO;
 use crate::logs::{AccelSample, GpsFix, LogError, LogProblem};
 
 use super::StepMode;
-
-/// Relative tolerance within which every step of a log must equal the configured Δt for the
-/// nominal recursion to run: time stamps written as j·Δt differ from j·Δt by a rounding error.
-pub const NOMINAL_TOLERANCE: f64 = 1e-9;
+use super::pass::Reduced;
 
 /// What the first pass learned.
 #[derive(Clone, Debug)]
@@ -74,71 +70,45 @@ impl Scan {
     }
 }
 
-/// Reads the GPS log and streams the accelerometer log once: headers, numbers, increasing time
-/// stamps, the median step, the Δt mode against `nominal_dt_s`, and every fix inside the span.
-///
-/// # Errors
-/// [`LogError`] naming the file and line of the first problem.
-pub fn scan(
-    accel: &dyn LogSource,
-    gps: &dyn LogSource,
-    nominal_dt_s: f64,
-) -> Result<Scan, LogError> {
-    let fixes = read_gps(gps)?;
-    let mut reader = AccelReader::open(accel)?;
-    let mut median = StepMedian::new();
-    let (mut first, mut last) = (None, None);
-    let mut range = (f64::INFINITY, 0.0f64);
-    let mut nominal = true;
-    let mut samples = 0u64;
-    while let Some(s) = reader.next_sample()? {
-        if let Some(p) = last {
-            let step = s.t_s - p;
-            median.add(step);
-            range = (range.0.min(step), range.1.max(step));
-            nominal &= (step - nominal_dt_s).abs() <= NOMINAL_TOLERANCE * nominal_dt_s;
+impl Scan {
+    /// What the pass learned, with the GPS log's `fixes` (named `gps_name`), checked to lie in
+    /// the span of the accelerometer log.
+    ///
+    /// # Errors
+    /// [`LogProblem::FixOutsideSpan`] for the first fix beyond half the median step of the
+    /// first or the last sample.
+    pub fn of(reduced: &Reduced, fixes: Vec<GpsFix>, gps_name: &str) -> Result<Self, LogError> {
+        let median_step_s = reduced.median.median().unwrap_or(f64::NAN);
+        let (first, last) = reduced.span_s;
+        let tolerance_s = 0.5 * median_step_s;
+        for f in &fixes {
+            if f.t_s < first - tolerance_s || f.t_s > last + tolerance_s {
+                return Err(LogError::at(
+                    gps_name,
+                    f.line,
+                    LogProblem::FixOutsideSpan {
+                        t_s: f.t_s,
+                        first_s: first,
+                        last_s: last,
+                        tolerance_s,
+                    },
+                ));
+            }
         }
-        first.get_or_insert(s.t_s);
-        last = Some(s.t_s);
-        samples += 1;
-    }
-    let (Some(first), Some(last), Some(median_step_s)) = (first, last, median.median()) else {
-        return Err(LogError::of_file(
-            reader.file(),
-            LogProblem::TooFewRows {
-                found: samples,
-                needed: 2,
+        Ok(Scan {
+            samples: reduced.samples,
+            span_s: reduced.span_s,
+            median_step_s,
+            step_range_s: (reduced.step_range.0.step_s(), reduced.step_range.1.step_s()),
+            mode: if reduced.nominal {
+                StepMode::Nominal
+            } else {
+                StepMode::PerStep
             },
-        ));
-    };
-    let tolerance_s = 0.5 * median_step_s;
-    for f in &fixes {
-        if f.t_s < first - tolerance_s || f.t_s > last + tolerance_s {
-            return Err(LogError::at(
-                gps.name(),
-                f.line,
-                LogProblem::FixOutsideSpan {
-                    t_s: f.t_s,
-                    first_s: first,
-                    last_s: last,
-                    tolerance_s,
-                },
-            ));
-        }
+            gps: fixes,
+            gps_name: gps_name.to_string(),
+        })
     }
-    Ok(Scan {
-        samples,
-        span_s: (first, last),
-        median_step_s,
-        step_range_s: range,
-        mode: if nominal {
-            StepMode::Nominal
-        } else {
-            StepMode::PerStep
-        },
-        gps: fixes,
-        gps_name: gps.name().to_string(),
-    })
 }
 
 /// Assigns each fix to the accelerometer sample nearest to it, as the samples stream past.

@@ -7,7 +7,9 @@ use crate::logs::write::push_row;
 use crate::state::{ErrorState, StateMatrix, StateVector};
 
 use super::StepMode;
+use super::forward::FilteredFix;
 use super::nis::NisTest;
+use super::smoother::SmoothedFix;
 
 // The columns and records below name the three states of the error state one by one.
 const _: () = assert!(ErrorState::DIM == 3);
@@ -38,6 +40,94 @@ pub const ESTIMATES_COLUMNS: [&str; 20] = [
     "v_smoothed_m_s",
 ];
 
+/// Columns of `estimates.csv` by default: one row per GPS fix, at the accelerometer sample it
+/// is applied at (`t_s`). The columns it shares with [`ESTIMATES_COLUMNS`] hold the same
+/// numbers as that file's row of the fix; "prior" is the a priori estimate δx̂⁻ and its σ, the
+/// innovation r = δz − H·δx̂⁻ with σ = √diag S, and `nis` = rᵀ·S⁻¹·r.
+pub const FIX_ESTIMATES_COLUMNS: [&str; 33] = [
+    "t_s",
+    "gps_t_s",
+    "gps_position_m",
+    "gps_velocity_m_s",
+    "p_integrated_m",
+    "v_integrated_m_s",
+    "dp_prior_m",
+    "dv_prior_m_s",
+    "bias_prior_m_s2",
+    "sigma_dp_prior_m",
+    "sigma_dv_prior_m_s",
+    "sigma_bias_prior_m_s2",
+    "dp_filtered_m",
+    "dv_filtered_m_s",
+    "bias_filtered_m_s2",
+    "sigma_dp_filtered_m",
+    "sigma_dv_filtered_m_s",
+    "sigma_bias_filtered_m_s2",
+    "dp_smoothed_m",
+    "dv_smoothed_m_s",
+    "bias_smoothed_m_s2",
+    "sigma_dp_smoothed_m",
+    "sigma_dv_smoothed_m_s",
+    "sigma_bias_smoothed_m_s2",
+    "innovation_p_m",
+    "innovation_v_m_s",
+    "sigma_innovation_p_m",
+    "sigma_innovation_v_m_s",
+    "nis",
+    "p_filtered_m",
+    "v_filtered_m_s",
+    "p_smoothed_m",
+    "v_smoothed_m_s",
+];
+
+/// Appends the row of fix `f` (taken at `gps_t_s`), smoothed as `sm`, in the order of
+/// [`FIX_ESTIMATES_COLUMNS`].
+pub(super) fn push_fix_row(out: &mut String, f: &FilteredFix, gps_t_s: f64, sm: &SmoothedFix) {
+    let (gp, gv) = (ErrorState::GPS_POSITION, ErrorState::GPS_VELOCITY);
+    let (dp, dv, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
+    let (pc, vc) = (f.integrated[gp], f.integrated[gv]);
+    let (s0, s1, s2) = (sigma(&f.p_prior), sigma(&f.p_post), sigma(&sm.p));
+    let (x0, x1, x2) = (&f.prior, &f.post, &sm.x);
+    push_row(
+        out,
+        &[
+            f.t_s,
+            gps_t_s,
+            f.z[gp],
+            f.z[gv],
+            pc,
+            vc,
+            x0[dp],
+            x0[dv],
+            x0[b],
+            s0[dp],
+            s0[dv],
+            s0[b],
+            x1[dp],
+            x1[dv],
+            x1[b],
+            s1[dp],
+            s1[dv],
+            s1[b],
+            x2[dp],
+            x2[dv],
+            x2[b],
+            s2[dp],
+            s2[dv],
+            s2[b],
+            f.residual[gp],
+            f.residual[gv],
+            f.s[(gp, gp)].sqrt(),
+            f.s[(gv, gv)].sqrt(),
+            f.nis,
+            pc + x1[dp],
+            vc + x1[dv],
+            pc + x2[dp],
+            vc + x2[dv],
+        ],
+    );
+}
+
 /// σ = √diag P.
 pub fn sigma(p: &StateMatrix) -> [f64; ErrorState::DIM] {
     std::array::from_fn(|k| p[(k, k)].sqrt())
@@ -54,8 +144,8 @@ pub(super) struct EstimateRow<'a> {
 }
 
 impl EstimateRow<'_> {
-    /// Appends the row in the order of [`ESTIMATES_COLUMNS`].
-    pub fn push(&self, out: &mut String) {
+    /// The row's numbers in the order of [`ESTIMATES_COLUMNS`].
+    pub fn values(&self) -> [f64; ESTIMATES_COLUMNS.len()] {
         let (pc, vc) = (
             self.integrated[ErrorState::GPS_POSITION],
             self.integrated[ErrorState::GPS_VELOCITY],
@@ -64,31 +154,84 @@ impl EstimateRow<'_> {
         let (xs, ps) = self.smoothed;
         let (sf, ss) = (sigma(p), sigma(ps));
         let (dp, dv, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
-        push_row(
+        [
+            self.t_s,
+            if self.fix { 1.0 } else { 0.0 },
+            pc,
+            vc,
+            x[dp],
+            x[dv],
+            x[b],
+            sf[dp],
+            sf[dv],
+            sf[b],
+            xs[dp],
+            xs[dv],
+            xs[b],
+            ss[dp],
+            ss[dv],
+            ss[b],
+            pc + x[dp],
+            vc + x[dv],
+            pc + xs[dp],
+            vc + xs[dv],
+        ]
+    }
+}
+
+/// Rows of [`ESTIMATES_COLUMNS`] formatted at once.
+const ROWS_PER_CHUNK: usize = 1 << 16;
+
+/// Rows of `estimates.csv` gathered, then formatted on all threads and written in order: the
+/// shortest round-trip form of 20 numbers a row is most of the work of writing the file.
+pub(super) struct EstimateChunks<'w> {
+    out: &'w mut dyn std::io::Write,
+    rows: Vec<[f64; ESTIMATES_COLUMNS.len()]>,
+}
+
+impl<'w> EstimateChunks<'w> {
+    /// Rows to be written to `out`.
+    pub fn new(out: &'w mut dyn std::io::Write) -> Self {
+        Self {
             out,
-            &[
-                self.t_s,
-                if self.fix { 1.0 } else { 0.0 },
-                pc,
-                vc,
-                x[dp],
-                x[dv],
-                x[b],
-                sf[dp],
-                sf[dv],
-                sf[b],
-                xs[dp],
-                xs[dv],
-                xs[b],
-                ss[dp],
-                ss[dv],
-                ss[b],
-                pc + x[dp],
-                vc + x[dv],
-                pc + xs[dp],
-                vc + xs[dv],
-            ],
-        );
+            rows: Vec::with_capacity(ROWS_PER_CHUNK),
+        }
+    }
+
+    /// Adds one row, writing the chunk when it is full.
+    ///
+    /// # Errors
+    /// When writing fails.
+    pub fn push(&mut self, row: [f64; ESTIMATES_COLUMNS.len()]) -> std::io::Result<()> {
+        self.rows.push(row);
+        if self.rows.len() == ROWS_PER_CHUNK {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    /// Writes the rows gathered.
+    ///
+    /// # Errors
+    /// When writing fails.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        use rayon::prelude::*;
+        let texts: Vec<String> = self
+            .rows
+            .par_chunks(ROWS_PER_CHUNK / 16)
+            .map(|rows| {
+                let mut text = String::with_capacity(rows.len() * 400);
+                for row in rows {
+                    push_row(&mut text, row);
+                }
+                text
+            })
+            .collect();
+        for text in texts {
+            self.out.write_all(text.as_bytes())?;
+        }
+        self.rows.clear();
+        self.out.flush()
     }
 }
 

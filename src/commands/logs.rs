@@ -8,12 +8,14 @@ use std::io::Write as _;
 
 use super::{load_model, write};
 use crate::cli::{CalibrateArgs, CaseArgs, ModelArgs, SimulateArgs};
+use accelcal::calibrate::CalibrateError;
 use accelcal::calibrate::{self, Settings};
 use accelcal::filter::FilterSchedule;
 use accelcal::format::{count, sig};
-use accelcal::logs::read::LogFile;
+use accelcal::logs::read::{LogFile, LogSource};
 use accelcal::logs::write::LogWriter;
 use accelcal::logs::{ACCEL_FILE, GPS_FILE, TRUTH_FILE};
+use accelcal::logs::{LogError, LogProblem};
 use accelcal::model::Model;
 use accelcal::output::StagedFiles;
 use accelcal::{export, realization, report, simulation};
@@ -34,8 +36,8 @@ pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
     let csv = export::realization_csv(&r, &model.timeline.fix_times_s());
     write(csv_path, csv.as_bytes())?;
     if let Some(last) = r.fixes.last() {
-        println!(
-            "realization {} ({}): b = {:.6} m/s², estimate at {:.1} s = {:.6} ± {:.6} m/s²; {} samples written to {}",
+        super::say(&format!(
+            "realization {} ({}): b = {:.6} m/s², estimate at {:.1} s = {:.6} ± {:.6} m/s²; {} samples written to {}\n",
             args.realization,
             model.case(),
             r.bias_m_s2,
@@ -44,7 +46,7 @@ pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
             last.sigma_post[2],
             r.samples.len(),
             csv_path.display()
-        );
+        ))?;
     }
     Ok(())
 }
@@ -72,13 +74,13 @@ fn write_logs(model: &Model, schedule: &FilterSchedule, index: u64, dir: &Path) 
         (samples, fixes, draws)
     };
     staged.commit()?;
-    println!(
+    super::say(&format!(
         "realization {index} ({}): b = {:.6} m/s²; logs of {samples} samples and {fixes} fixes \
-         written to {} ({ACCEL_FILE}, {GPS_FILE}, {TRUTH_FILE})",
+         written to {} ({ACCEL_FILE}, {GPS_FILE}, {TRUTH_FILE})\n",
         model.case(),
         draws.bias_m_s2,
         dir.display()
-    );
+    ))?;
     Ok(())
 }
 
@@ -101,16 +103,35 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         }
     };
     let (accel, gps) = (LogFile::new(&args.accel), LogFile::new(&args.gps));
+    if args.every_sample && !accel.rereadable() {
+        return Err(CalibrateError::Log(LogError::of_file(
+            accel.name(),
+            LogProblem::Unreadable {
+                message: "--every-sample reads the accelerometer log twice, and this is a pipe \
+                          or a device that reads once: give it as a file, or leave out \
+                          --every-sample for one row per GPS fix"
+                    .to_string(),
+            },
+        ))
+        .into());
+    }
     note("checking the logs and running the filter and the smoother…");
-    let prepared = calibrate::prepare(&accel, &gps, &settings)?;
+    let mut prepared = calibrate::prepare(&accel, &gps, &settings)?;
+    if args.every_sample {
+        prepared.per_sample()?;
+    }
     let cal = prepared.calibration();
-    let page = report::calibration::render(&cal, &calibrate_command(args))?;
+    let page = report::calibration::render(&cal, &calibrate_command(args), args.every_sample)?;
     note("writing the estimates…");
     let mut staged = StagedFiles::create(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE, PAGE_FILE])?;
     let into = |name: &str| format!("cannot write {}", args.out.join(name).display());
-    prepared
-        .write_estimates(staged.writer(ESTIMATES_FILE))
-        .with_context(|| into(ESTIMATES_FILE))?;
+    let estimates = staged.writer(ESTIMATES_FILE);
+    if args.every_sample {
+        prepared.write_estimates(estimates)
+    } else {
+        prepared.write_fix_estimates(estimates)
+    }
+    .with_context(|| into(ESTIMATES_FILE))?;
     staged
         .writer(SUMMARY_FILE)
         .write_all(cal.summary.to_json().as_bytes())
@@ -121,9 +142,9 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         .with_context(|| into(PAGE_FILE))?;
     staged.commit()?;
     let s = &cal.summary;
-    println!(
+    super::say(&format!(
         "bias {} ± {} m/s² at t = {} s ({} samples, {} fixes, Δt mode {}); NIS test {} \
-         (sum {} in [{}, {}]); written to {}",
+         (sum {} in [{}, {}]); written to {}\n",
         sig(s.bias_m_s2, 6),
         sig(s.bias_sigma_m_s2, 3),
         s.end_s,
@@ -135,7 +156,7 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         sig(s.nis.lower, 5),
         sig(s.nis.upper, 5),
         args.out.join(PAGE_FILE).display()
-    );
+    ))?;
     Ok(())
 }
 
@@ -150,5 +171,8 @@ fn calibrate_command(args: &CalibrateArgs) -> String {
         s.push_str(&format!(" --config {}", c.display()));
     }
     s.push_str(&format!(" --out {}", args.out.display()));
+    if args.every_sample {
+        s.push_str(" --every-sample");
+    }
     s
 }

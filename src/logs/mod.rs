@@ -11,6 +11,7 @@
 //! the line and what was expected; [`write`](mod@write) formats every number so that it reads back bit for
 //! bit; [`steps`] finds the median time step of a log in bounded memory.
 
+pub mod block;
 pub mod read;
 pub mod steps;
 pub mod write;
@@ -71,6 +72,16 @@ pub enum LogProblem {
     Unreadable {
         /// The operating system's words.
         message: String,
+    },
+    /// A line longer than the reader accepts.
+    #[error(
+        "the line is longer than {} KiB: expected rows of a few comma-separated numbers (is \
+         this a CSV log?)",
+        .limit_bytes / 1024
+    )]
+    LineTooLong {
+        /// The longest line accepted, bytes.
+        limit_bytes: usize,
     },
     /// A line is not UTF-8 text.
     #[error("not text: expected comma-separated numbers in UTF-8")]

@@ -6,13 +6,13 @@
 //! lines are skipped, a byte-order mark and `\r\n` line ends are accepted, and every field must
 //! be a finite number (`NaN` and `inf` are refused).
 
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
+use super::block::{BLOCK_BYTES, Feed, Layout, MAX_LINE_BYTES, Rows, parse_block};
 use super::{ACCEL_COLUMNS, AccelSample, GPS_COLUMNS, GpsFix, LogError, LogProblem, echo};
 
-/// A log that can be read from its start any number of times: a calibration reads the
-/// accelerometer log three times rather than hold it in memory.
+/// A log read from its start: a file can be read again, a pipe only once.
 pub trait LogSource {
     /// The name used in messages: the path as the user gave it.
     fn name(&self) -> &str;
@@ -22,6 +22,27 @@ pub trait LogSource {
     /// # Errors
     /// [`LogProblem::Unreadable`] when it cannot be opened.
     fn open(&self) -> Result<Box<dyn BufRead + '_>, LogError>;
+
+    /// Whether [`LogSource::open`] can start again after a first reading: false for a pipe or
+    /// a device.
+    fn rereadable(&self) -> bool {
+        true
+    }
+}
+
+/// The two bytes that start a gzip member.
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+
+/// `reader`, decompressed when its text starts as gzip does (whatever the file's name).
+///
+/// # Errors
+/// The operating system's when the first bytes cannot be read.
+fn decompressed<'a>(mut reader: Box<dyn BufRead + 'a>) -> std::io::Result<Box<dyn BufRead + 'a>> {
+    if reader.fill_buf()?.starts_with(&GZIP_MAGIC) {
+        let decoder = flate2::bufread::MultiGzDecoder::new(reader);
+        return Ok(Box::new(BufReader::with_capacity(1 << 16, decoder)));
+    }
+    Ok(reader)
 }
 
 /// A log in a file.
@@ -55,15 +76,21 @@ impl LogSource for LogFile {
                 },
             ));
         }
-        let file = std::fs::File::open(&self.path).map_err(|e| {
+        let unreadable = |e: std::io::Error| {
             LogError::of_file(
                 &self.name,
                 LogProblem::Unreadable {
                     message: e.to_string(),
                 },
             )
-        })?;
-        Ok(Box::new(BufReader::with_capacity(1 << 16, file)))
+        };
+        let file = std::fs::File::open(&self.path).map_err(unreadable)?;
+        decompressed(Box::new(BufReader::with_capacity(1 << 16, file))).map_err(unreadable)
+    }
+
+    fn rereadable(&self) -> bool {
+        // A missing file is reported when it is opened.
+        std::fs::metadata(&self.path).map_or(true, |m| m.is_file())
     }
 }
 
@@ -90,21 +117,78 @@ impl LogSource for LogText {
     }
 
     fn open(&self) -> Result<Box<dyn BufRead + '_>, LogError> {
-        Ok(Box::new(self.text.as_slice()))
+        decompressed(Box::new(self.text.as_slice())).map_err(|e| {
+            let message = e.to_string();
+            LogError::of_file(&self.name, LogProblem::Unreadable { message })
+        })
     }
+}
+
+/// Opens `source` (gzip-compressed text read transparently) and reads its header, which must
+/// name each of `columns` once: where the columns lie, and the text after the header.
+///
+/// # Errors
+/// [`LogError`] when the file cannot be read, is empty, or its header lacks a column or names
+/// one twice.
+pub fn open_blocks<'a, const N: usize>(
+    source: &'a dyn LogSource,
+    columns: [&'static str; N],
+) -> Result<(Layout<N>, Feed<'a>), LogError> {
+    let reader: Box<dyn Read + 'a> = source.open()?;
+    let mut feed = Feed::new(source.name(), reader);
+    let expected = columns.join(",");
+    let Some((text, line)) = feed.header()? else {
+        return Err(LogError::of_file(
+            source.name(),
+            LogProblem::Empty { header: expected },
+        ));
+    };
+    let at = |problem| LogError::at(source.name(), line, problem);
+    let found: Vec<&str> = text
+        .trim_start_matches('\u{feff}')
+        .split(',')
+        .map(str::trim)
+        .collect();
+    // One pass with a set: the first name seen before (a header of 10⁶ columns is checked
+    // in a fraction of a second, where comparing each with all before it took minutes).
+    let mut seen = std::collections::HashSet::with_capacity(found.len());
+    if let Some(name) = found.iter().find(|name| !seen.insert(**name)) {
+        return Err(at(LogProblem::DuplicateColumn { column: echo(name) }));
+    }
+    let header = echo(&found.join(","));
+    let mut positions = [0; N];
+    for (k, column) in columns.iter().enumerate() {
+        match found.iter().position(|f| f == column) {
+            Some(p) => positions[k] = p,
+            None => {
+                return Err(at(LogProblem::MissingColumn {
+                    column,
+                    found: header,
+                    header: expected,
+                }));
+            }
+        }
+    }
+    let layout = Layout {
+        file: source.name().to_string(),
+        columns,
+        positions,
+        width: found.len(),
+        header,
+    };
+    Ok((layout, feed))
 }
 
 /// A CSV stream whose rows hold the `N` columns asked for, as numbers.
 pub struct CsvReader<'a, const N: usize> {
-    file: String,
-    reader: Box<dyn BufRead + 'a>,
+    layout: Layout<N>,
+    feed: Feed<'a>,
+    rows: Rows<N>,
+    next: usize,
+    /// The problem that ended the current block, reported after its good rows.
+    pending: Option<LogError>,
+    /// Line of the last row handed out (the header's before any).
     line: u64,
-    buf: Vec<u8>,
-    columns: [&'static str; N],
-    /// Position of each wanted column in a row.
-    positions: [usize; N],
-    width: usize,
-    header: String,
 }
 
 impl<'a, const N: usize> CsvReader<'a, N> {
@@ -113,93 +197,25 @@ impl<'a, const N: usize> CsvReader<'a, N> {
     /// # Errors
     /// [`LogError`] when the file cannot be read, is empty, or its header lacks a column.
     pub fn open(source: &'a dyn LogSource, columns: [&'static str; N]) -> Result<Self, LogError> {
-        let mut reader = Self {
-            file: source.name().to_string(),
-            reader: source.open()?,
-            line: 0,
-            buf: Vec::with_capacity(128),
-            columns,
-            positions: [0; N],
-            width: 0,
-            header: columns.join(","),
-        };
-        let expected = reader.header.clone();
-        let Some(text) = reader.next_line()? else {
-            return Err(LogError::of_file(
-                &reader.file,
-                LogProblem::Empty { header: expected },
-            ));
-        };
-        let found: Vec<String> = text
-            .trim_start_matches('\u{feff}')
-            .split(',')
-            .map(|f| f.trim().to_string())
-            .collect();
-        // One pass with a set: the first name seen before (a header of 10⁶ columns is checked
-        // in a fraction of a second, where comparing each with all before it took minutes).
-        let mut seen = std::collections::HashSet::with_capacity(found.len());
-        if let Some(name) = found.iter().find(|name| !seen.insert(name.as_str())) {
-            return Err(reader.error(LogProblem::DuplicateColumn { column: echo(name) }));
-        }
-        let header = echo(&found.join(","));
-        for (k, column) in columns.iter().enumerate() {
-            match found.iter().position(|f| f == column) {
-                Some(p) => reader.positions[k] = p,
-                None => {
-                    return Err(reader.error(LogProblem::MissingColumn {
-                        column,
-                        found: header,
-                        header: expected,
-                    }));
-                }
-            }
-        }
-        reader.width = found.len();
-        reader.header = header;
-        Ok(reader)
+        let (layout, feed) = open_blocks(source, columns)?;
+        Ok(Self {
+            layout,
+            line: 1,
+            feed,
+            rows: Rows::default(),
+            next: 0,
+            pending: None,
+        })
     }
 
     /// The name of the file in messages.
     pub fn file(&self) -> &str {
-        &self.file
+        &self.layout.file
     }
 
     /// An error at the current line.
     pub fn error(&self, problem: LogProblem) -> LogError {
-        LogError::at(&self.file, self.line, problem)
-    }
-
-    /// The next line that is not blank, without its line end; `None` at the end of the file.
-    fn next_line(&mut self) -> Result<Option<&str>, LogError> {
-        loop {
-            self.buf.clear();
-            let n = self.reader.read_until(b'\n', &mut self.buf).map_err(|e| {
-                LogError::at(
-                    &self.file,
-                    self.line + 1,
-                    LogProblem::Unreadable {
-                        message: e.to_string(),
-                    },
-                )
-            })?;
-            if n == 0 {
-                return Ok(None);
-            }
-            self.line += 1;
-            let end = self
-                .buf
-                .iter()
-                .rposition(|&b| b != b'\n' && b != b'\r')
-                .map_or(0, |i| i + 1);
-            if self.buf[..end].iter().all(u8::is_ascii_whitespace) {
-                continue;
-            }
-            let line = self.line;
-            let file = &self.file;
-            return std::str::from_utf8(&self.buf[..end])
-                .map(Some)
-                .map_err(|_| LogError::at(file, line, LogProblem::NotText));
-        }
+        LogError::at(&self.layout.file, self.line, problem)
     }
 
     /// The next data row: its line and the wanted columns' values; `None` at the end.
@@ -208,43 +224,21 @@ impl<'a, const N: usize> CsvReader<'a, N> {
     /// [`LogError`] naming the line when the row has another number of fields than the header,
     /// or a wanted field is not a finite number.
     pub fn next_row(&mut self) -> Result<Option<(u64, [f64; N])>, LogError> {
-        let (width, positions, columns) = (self.width, self.positions, self.columns);
-        let Some(text) = self.next_line()? else {
-            return Ok(None);
-        };
-        let mut wanted: [&str; N] = [""; N];
-        let mut found = 0;
-        for (i, field) in text.split(',').enumerate() {
-            for (k, &p) in positions.iter().enumerate() {
-                if p == i {
-                    wanted[k] = field.trim();
-                }
+        while self.next == self.rows.values.len() {
+            if let Some(e) = self.pending.take() {
+                return Err(e);
             }
-            found += 1;
-        }
-        if found != width {
-            return Err(self.error(LogProblem::FieldCount {
-                expected: width,
-                found,
-                header: self.header.clone(),
-            }));
-        }
-        let mut values = [0.0; N];
-        for (k, text) in wanted.iter().enumerate() {
-            let column = columns[k];
-            values[k] = match text.parse::<f64>() {
-                Ok(x) if x.is_finite() => x,
-                Ok(_) => {
-                    let text = echo(text);
-                    return Err(self.error(LogProblem::NotFinite { column, text }));
-                }
-                Err(_) => {
-                    let text = echo(text);
-                    return Err(self.error(LogProblem::NotANumber { column, text }));
-                }
+            let Some(block) = self.feed.next_block(BLOCK_BYTES, MAX_LINE_BYTES)? else {
+                return Ok(None);
             };
+            self.rows.clear();
+            self.next = 0;
+            self.pending = parse_block(&self.layout, &block, &mut self.rows).err();
         }
-        Ok(Some((self.line, values)))
+        let k = self.next;
+        self.next += 1;
+        self.line = self.rows.lines[k];
+        Ok(Some((self.line, self.rows.values[k])))
     }
 }
 

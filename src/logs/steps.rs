@@ -21,31 +21,115 @@ pub const MAX_BUCKETS: usize = 4096;
 #[derive(Clone, Debug, Default)]
 pub struct StepMedian {
     shift: u32,
-    counts: BTreeMap<u64, u64>,
+    /// Count of each key, and the first step counted under it.
+    counts: BTreeMap<u64, (u64, StepAt)>,
     n: u64,
+    /// The keys counted last, with counts not yet in `counts`: a log at a fixed rate has a few
+    /// distinct steps, so most steps are counted here without a search of the map.
+    hot: [(u64, u64); HOT_KEYS],
+    /// The entry of `hot` replaced next.
+    evict: usize,
+}
+
+/// Keys counted without a search of the map.
+const HOT_KEYS: usize = 8;
+
+/// A key no step has (the bits of a NaN).
+const NO_KEY: u64 = u64::MAX;
+
+/// Where a step was taken: the line and time stamp of the sample it ends at, and the time
+/// stamp before.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepAt {
+    /// Index of the sample the step ends at (0 = the log's first).
+    pub sample: u64,
+    /// Its line in the file.
+    pub line: u64,
+    /// The time stamp before, s.
+    pub previous_s: f64,
+    /// The time stamp the step ends at, s.
+    pub t_s: f64,
+}
+
+impl StepAt {
+    /// The step, s.
+    pub fn step_s(&self) -> f64 {
+        self.t_s - self.previous_s
+    }
 }
 
 impl StepMedian {
     /// An empty histogram.
     pub fn new() -> Self {
-        Self::default()
+        Self {
+            hot: [(NO_KEY, 0); HOT_KEYS],
+            ..Self::default()
+        }
     }
 
     /// Counts one step, s (positive and finite: time stamps are strictly increasing).
     pub fn add(&mut self, step_s: f64) {
-        *self
-            .counts
-            .entry(step_s.to_bits() >> self.shift)
-            .or_insert(0) += 1;
+        self.add_at(step_s, StepAt::default());
+    }
+
+    /// Counts one step taken `at` (its step is `step_s`), keeping the first step of each key.
+    #[inline]
+    pub fn add_at(&mut self, step_s: f64, at: StepAt) {
+        let key = step_s.to_bits() >> self.shift;
         self.n += 1;
-        while self.counts.len() > MAX_BUCKETS {
-            self.shift += 1;
-            let mut coarser = BTreeMap::new();
-            for (k, c) in std::mem::take(&mut self.counts) {
-                *coarser.entry(k >> 1).or_insert(0) += c;
-            }
-            self.counts = coarser;
+        if let Some(hot) = self.hot.iter_mut().find(|(k, _)| *k == key) {
+            hot.1 += 1;
+            return;
         }
+        self.counts.entry(key).or_insert((0, at)).0 += 1;
+        let (old, count) = std::mem::replace(&mut self.hot[self.evict], (key, 0));
+        self.evict = (self.evict + 1) % HOT_KEYS;
+        if old != NO_KEY {
+            self.counts
+                .get_mut(&old)
+                .expect("a hot key is in the map")
+                .0 += count;
+        }
+        while self.counts.len() > MAX_BUCKETS {
+            self.coarsen();
+        }
+    }
+
+    /// Moves the hot counts into the map.
+    fn settle(&mut self) {
+        for (key, count) in std::mem::replace(&mut self.hot, [(NO_KEY, 0); HOT_KEYS]) {
+            if key != NO_KEY {
+                self.counts
+                    .get_mut(&key)
+                    .expect("a hot key is in the map")
+                    .0 += count;
+            }
+        }
+    }
+
+    /// Halves the resolution: keys drop their lowest bit; a bucket keeps its earliest step.
+    fn coarsen(&mut self) {
+        self.settle();
+        self.shift += 1;
+        let mut coarser: BTreeMap<u64, (u64, StepAt)> = BTreeMap::new();
+        for (k, (c, at)) in std::mem::take(&mut self.counts) {
+            let e = coarser.entry(k >> 1).or_insert((0, at));
+            e.0 += c;
+            if at.sample < e.1.sample {
+                e.1 = at;
+            }
+        }
+        self.counts = coarser;
+    }
+
+    /// The earliest step outside `[lo_s, hi_s]` among the first steps of the keys: exact while
+    /// the histogram is ([`StepMedian::relative_resolution`] 0), else among steps that are.
+    pub fn first_outside(&self, lo_s: f64, hi_s: f64) -> Option<StepAt> {
+        self.counts
+            .values()
+            .map(|(_, at)| *at)
+            .filter(|at| !(lo_s..=hi_s).contains(&at.step_s()))
+            .min_by_key(|at| at.sample)
     }
 
     /// Number of steps counted.
@@ -79,8 +163,14 @@ impl StepMedian {
         }
         // 0-based ranks of the middle steps.
         let (lo, hi) = ((self.n - 1) / 2, self.n / 2);
+        let mut counts = self.counts.clone();
+        for &(key, count) in &self.hot {
+            if key != NO_KEY {
+                counts.get_mut(&key).expect("a hot key is in the map").0 += count;
+            }
+        }
         let (mut below, mut at_lo, mut at_hi) = (0u64, None, None);
-        for (&k, &c) in &self.counts {
+        for (&k, &(c, _)) in &counts {
             if at_lo.is_none() && lo < below + c {
                 at_lo = Some(self.value(k));
             }

@@ -47,6 +47,8 @@ pub struct CalibrationView {
     pub figures: Vec<FigureView>,
     /// The command that wrote the page.
     pub command: String,
+    /// What `estimates.csv` holds, in words.
+    pub estimates_words: &'static str,
 }
 
 /// The calibration page.
@@ -128,11 +130,16 @@ fn method(s: &Summary) -> Vec<String> {
     ]
 }
 
-/// Builds the view of `cal`; `command` wrote it.
+/// Builds the view of `cal`; `command` wrote it, `estimates.csv` with a row per sample when
+/// `every_sample`, else per fix.
 ///
 /// # Errors
 /// [`RenderError::Figure`] when a figure cannot be drawn.
-pub fn build(cal: &Calibration, command: &str) -> Result<CalibrationView, RenderError> {
+pub fn build(
+    cal: &Calibration,
+    command: &str,
+    every_sample: bool,
+) -> Result<CalibrationView, RenderError> {
     let s = &cal.summary;
     Ok(CalibrationView {
         version: s.accelcal_version.to_string(),
@@ -151,6 +158,11 @@ pub fn build(cal: &Calibration, command: &str) -> Result<CalibrationView, Render
         settings: settings(s),
         figures: figures(cal)?,
         command: command.to_string(),
+        estimates_words: if every_sample {
+            "filtered and smoothed estimates at every sample"
+        } else {
+            "a priori, filtered and smoothed estimates, innovation and NIS at every GPS fix"
+        },
     })
 }
 
@@ -342,12 +354,12 @@ fn settings(s: &Summary) -> Vec<Row> {
     ]
 }
 
-/// Renders the page of `cal` as HTML; `command` wrote it.
+/// Renders the page of `cal` as HTML; `command` wrote it, `every_sample` as in [`build`].
 ///
 /// # Errors
 /// [`RenderError`] when a figure cannot be drawn or the template cannot be filled.
-pub fn render(cal: &Calibration, command: &str) -> Result<String, RenderError> {
-    let view = build(cal, command)?;
+pub fn render(cal: &Calibration, command: &str, every_sample: bool) -> Result<String, RenderError> {
+    let view = build(cal, command, every_sample)?;
     let style = include_str!("../../assets/report.css");
     Ok(CalibrationPage { v: &view, style }.render()?)
 }

@@ -7,6 +7,8 @@
 mod common;
 
 mod bad_logs;
+mod fast;
+mod reader;
 mod reference;
 mod round_trip;
 mod smoother;
@@ -51,7 +53,8 @@ pub fn simulate_logs(dir: &Path) {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
-/// Calibrates `accel` and `gps` into `dir/out`; returns the summary.
+/// Calibrates `accel` and `gps` into `dir/out`, the estimates at every sample; returns the
+/// summary.
 pub fn calibrate(dir: &Path, accel: &str, gps: &str, out: &str) -> serde_json::Value {
     let o = run(
         &[
@@ -63,6 +66,7 @@ pub fn calibrate(dir: &Path, accel: &str, gps: &str, out: &str) -> serde_json::V
             "--out",
             out,
             "--quiet",
+            "--every-sample",
         ],
         dir,
     );

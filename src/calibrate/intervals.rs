@@ -1,0 +1,358 @@
+//! The filter over the reduced log, fix to fix, and the checks that needed the whole log first
+//! (the median step): gaps, fixes far from every sample, two fixes on one sample. The first
+//! problem in the order of the samples is reported, as a sample-by-sample pass meets it.
+
+use crate::error::FilterError;
+use crate::filter::ErrorStateModel;
+use crate::logs::{GpsFix, LogError, LogProblem};
+use crate::model::NoiseStats;
+use crate::simulation::measurement;
+use crate::state::{ErrorState, StateMatrix, StateVector, transition};
+
+use super::forward::FilteredFix;
+use super::pass::{FixAt, Reduced};
+use super::scan::Scan;
+use super::{CalibrateError, StepMode};
+
+/// A problem found after the pass, at the sample where a sample-by-sample pass meets it, and
+/// in the order it meets them there (a step, the fix, the integration).
+struct Found {
+    sample: u64,
+    phase: u8,
+    error: LogError,
+}
+
+impl Found {
+    fn key(&self) -> (u64, u8) {
+        (self.sample, self.phase)
+    }
+}
+
+/// The first step outside the accepted band, as the first problem found at the sample before it.
+fn first_gap(scan: &Scan, reduced: &Reduced, accel: &str) -> Option<Found> {
+    let (lo, hi) = scan.accepted_step_s();
+    let (short, long) = reduced.step_range;
+    let at = [
+        reduced.median.first_outside(lo, hi),
+        Some(short),
+        Some(long),
+    ]
+    .into_iter()
+    .flatten()
+    .filter(|at| !(lo..=hi).contains(&at.step_s()))
+    .min_by_key(|at| at.sample)?;
+    let step_s = at.step_s();
+    let problem = LogProblem::Gap {
+        previous_s: at.previous_s,
+        t_s: at.t_s,
+        step_s,
+        ratio: step_s / scan.median_step_s,
+        median_s: scan.median_step_s,
+    };
+    Some(Found {
+        sample: at.sample - 1,
+        phase: 0,
+        error: LogError::at(accel, at.line, problem),
+    })
+}
+
+/// The first fix that no sample takes or that falls on a sample already taken, and its index.
+fn first_misplaced_fix(scan: &Scan, fixes: &[FixAt]) -> Option<(usize, Found)> {
+    let tol = scan.tolerance_s();
+    let gps = |i: usize| &scan.gps[fixes[i].fix];
+    for (i, f) in fixes.iter().enumerate() {
+        let at = |problem| LogError::at(&scan.gps_name, gps(i).line, problem);
+        if f.distance_s > tol {
+            let (sample, after_s) = f.after.unwrap_or((f.sample, f.t_s));
+            let problem = LogProblem::FixBetweenSamples {
+                t_s: gps(i).t_s,
+                before_s: f.before_s,
+                after_s,
+                tolerance_s: tol,
+            };
+            let error = at(problem);
+            return Some((
+                i,
+                Found {
+                    sample,
+                    phase: 1,
+                    error,
+                },
+            ));
+        }
+        if i > 0 && fixes[i - 1].sample == f.sample {
+            let problem = LogProblem::FixOnTakenSample {
+                t_s: gps(i).t_s,
+                sample_s: f.t_s,
+                other_line: gps(i - 1).line,
+            };
+            let error = at(problem);
+            return Some((
+                i,
+                Found {
+                    sample: f.sample,
+                    phase: 1,
+                    error,
+                },
+            ));
+        }
+    }
+    None
+}
+
+/// The first sample whose step overflows the integration in `mode`.
+fn overflow(reduced: &Reduced, mode: StepMode, accel: &str) -> Option<Found> {
+    let (sample, line) = reduced.overflow[mode_index(mode)]?;
+    let what = "the step to the next row, the integrated velocity and position or their \
+                covariance is no longer a finite number: a time stamp or acceleration here is \
+                too large"
+        .to_string();
+    let error = LogError::at(accel, line, LogProblem::Overflow { what });
+    Some(Found {
+        sample,
+        phase: 3,
+        error,
+    })
+}
+
+/// Which of the pass's two integrations `mode` takes.
+pub fn mode_index(mode: StepMode) -> usize {
+    match mode {
+        StepMode::Nominal => 0,
+        StepMode::PerStep => 1,
+    }
+}
+
+/// The filter at the last fix (the log's first sample before any).
+struct FixFilter<'m> {
+    model: &'m ErrorStateModel,
+    stats: NoiseStats,
+    mode: StepMode,
+    /// Sample and time stamp of the last fix.
+    last: (u64, f64),
+    x: StateVector,
+    p: StateMatrix,
+}
+
+impl FixFilter<'_> {
+    /// The transition from the last fix to `sample` at `t_s` and P propagated there, with the
+    /// per-step noise `units` of the interval: the nominal step's recursion sample by sample
+    /// (the in-memory filter's operations), or Φ and Q of the interval from the units.
+    fn propagate(
+        &self,
+        sample: u64,
+        t_s: f64,
+        units: &super::pass::NoiseUnits,
+    ) -> (StateMatrix, StateMatrix) {
+        match self.mode {
+            StepMode::Nominal => {
+                let n = sample - self.last.0;
+                (
+                    transition(n as f64 * self.model.dt_s),
+                    propagate_steps(self.model, &self.p, n),
+                )
+            }
+            StepMode::PerStep => {
+                let phi = transition(t_s - self.last.1);
+                let q = units.process_noise(self.stats.accel_noise_var_m2_s4);
+                let p = phi * self.p * phi.transpose() + q;
+                (phi, (p + p.transpose()) * 0.5)
+            }
+        }
+    }
+
+    /// The measurement update with `gps` at `fix`, as `forward::Forward::update`.
+    fn update(&mut self, fix: &FixAt, gps: &GpsFix) -> Result<FilteredFix, FilterError> {
+        let (phi, p) = self.propagate(fix.sample, fix.t_s, &fix.units);
+        let prior = phi * self.x;
+        let cov = self.model.update_covariance(&p, fix.t_s, phi)?;
+        let z = measurement(gps.position_m, gps.velocity_m_s);
+        let integrated = fix.integrated[mode_index(self.mode)];
+        // eq. (6): δz = z − (p_c, v_c).
+        let dz = measurement(
+            z[ErrorState::GPS_POSITION] - integrated.pc_m,
+            z[ErrorState::GPS_VELOCITY] - integrated.vc_m_s,
+        );
+        let (post, residual) = self.model.update_estimate(&cov, &prior, &dz);
+        (self.x, self.p, self.last) = (post, cov.p_post, (fix.sample, fix.t_s));
+        Ok(FilteredFix {
+            line: gps.line,
+            sample: fix.sample,
+            t_s: fix.t_s,
+            z,
+            integrated: measurement(integrated.pc_m, integrated.vc_m_s),
+            prior,
+            post,
+            residual,
+            s: cov.s,
+            nis: (residual.transpose() * cov.s_inv * residual)[0],
+            p_prior: cov.p_prior,
+            p_prior_inv: cov.p_prior_inv,
+            p_post: cov.p_post,
+            phi_from_previous: phi,
+        })
+    }
+
+    /// The estimate and covariance at the log's last sample.
+    fn end(&self, reduced: &Reduced) -> (StateVector, StateMatrix) {
+        let (samples, last_s) = (reduced.samples - 1, reduced.span_s.1);
+        match self.mode {
+            StepMode::Nominal => {
+                // Sample by sample, as the per-sample estimate runs after the last fix.
+                let mut x = self.x;
+                for _ in self.last.0..samples {
+                    x = self.model.phi * x;
+                }
+                (
+                    x,
+                    propagate_steps(self.model, &self.p, samples - self.last.0),
+                )
+            }
+            StepMode::PerStep => {
+                let (phi, p) = self.propagate(samples, last_s, &reduced.end.1);
+                (phi * self.x, p)
+            }
+        }
+    }
+}
+
+/// `p` after `n` steps of [`ErrorStateModel::propagate`], P ← (Φ·P·Φᵀ + Q + (Φ·P·Φᵀ + Q)ᵀ)/2,
+/// with the same operations in the same order on plain arrays (the same bits, a few times
+/// faster: it runs once per sample of a nominal log).
+pub fn propagate_steps(model: &ErrorStateModel, p: &StateMatrix, n: u64) -> StateMatrix {
+    type M = [[f64; 3]; 3];
+    let get =
+        |m: &StateMatrix| -> M { std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)])) };
+    let (phi, q) = (get(&model.phi), get(&model.q));
+    // c_ij = (a_i0·b_0j + a_i1·b_1j) + a_i2·b_2j, nalgebra's order for a product of 3×3.
+    let product = |a: &M, b: &M| -> M {
+        std::array::from_fn(|i| {
+            std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j])
+        })
+    };
+    let phi_t: M = std::array::from_fn(|i| std::array::from_fn(|j| phi[j][i]));
+    let mut m = get(p);
+    for _ in 0..n {
+        let mut a = product(&product(&phi, &m), &phi_t);
+        for (row, q) in a.iter_mut().zip(&q) {
+            for (v, q) in row.iter_mut().zip(q) {
+                *v += q;
+            }
+        }
+        m = std::array::from_fn(|i| std::array::from_fn(|j| (a[i][j] + a[j][i]) * 0.5));
+    }
+    StateMatrix::from_fn(|i, j| m[i][j])
+}
+
+/// The fixes filtered and the estimate at the last sample.
+pub type Filtered = (Vec<FilteredFix>, (StateVector, StateMatrix));
+
+/// Checks the reduced log against the median step and runs the filter over its fixes.
+///
+/// # Errors
+/// The first problem in sample order: a gap, a fix between samples or on a taken sample, a
+/// covariance not positive definite, a non-finite residual, or an overflowing integration.
+pub fn filter(
+    scan: &Scan,
+    reduced: &Reduced,
+    model: &ErrorStateModel,
+    stats: &NoiseStats,
+    accel: &str,
+) -> Result<Filtered, CalibrateError> {
+    let misplaced = first_misplaced_fix(scan, &reduced.fixes);
+    let stop_fix = misplaced.as_ref().map_or(reduced.fixes.len(), |(i, _)| *i);
+    let found = [
+        first_gap(scan, reduced, accel),
+        misplaced.map(|(_, f)| f),
+        overflow(reduced, scan.mode, accel),
+    ]
+    .into_iter()
+    .flatten()
+    .min_by_key(Found::key);
+    let mut f = FixFilter {
+        model,
+        stats: *stats,
+        mode: scan.mode,
+        last: (0, scan.span_s.0),
+        x: StateVector::zeros(),
+        p: model.p0,
+    };
+    let mut fixes = Vec::with_capacity(stop_fix);
+    let mut since_line = reduced.first_line;
+    for fix in &reduced.fixes[..stop_fix] {
+        if found.as_ref().is_some_and(|e| e.key() < (fix.sample, 2)) {
+            break;
+        }
+        let gps = &scan.gps[fix.fix];
+        let filtered = f.update(fix, gps)?;
+        if !filtered.is_finite() {
+            return Err(not_finite(&filtered, scan, gps, (accel, since_line)).into());
+        }
+        since_line = fix.line;
+        fixes.push(filtered);
+    }
+    if let Some(e) = found {
+        return Err(e.error.into());
+    }
+    let end = f.end(reduced);
+    Ok((fixes, end))
+}
+
+/// The overflow at a fix whose residual, NIS or estimate is not finite: naming the fix's line
+/// when the fix is the larger of the fix and the integrated (p_c, v_c) it is compared with, else
+/// the accelerometer rows integrated since the previous fix (from `since_line` of `accel`).
+fn not_finite(
+    fix: &FilteredFix,
+    scan: &Scan,
+    gps: &GpsFix,
+    (accel, since_line): (&str, u64),
+) -> LogError {
+    let largest = |v: &[f64]| v.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
+    if largest(fix.z.as_slice()) >= largest(fix.integrated.as_slice()) {
+        let what = "the filter's residual, NIS or estimate at this fix is no longer a finite \
+                    number: its position or velocity is too large"
+            .to_string();
+        LogError::at(&scan.gps_name, gps.line, LogProblem::Overflow { what })
+    } else {
+        let what = format!(
+            "the residual of the fix at {} line {} is no longer a finite number: the velocity \
+             and position integrated from this row to that fix's sample are too large (an \
+             acceleration of those rows is)",
+            scan.gps_name, gps.line
+        );
+        LogError::at(accel, since_line.max(1), LogProblem::Overflow { what })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_written_out_propagation_is_the_model_s_bit_for_bit() {
+        let stats = crate::model::Model::new(&crate::config::Config::default())
+            .unwrap()
+            .filter_stats;
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for dt in [0.005, 0.001, 0.0123] {
+            let model = ErrorStateModel::new(dt, &stats);
+            for _ in 0..200 {
+                let a = StateMatrix::from_fn(|_, _| uniform());
+                let p0 = a * a.transpose() + StateMatrix::identity() * 1e-3;
+                let mut p = p0;
+                for _ in 0..7 {
+                    p = model.propagate(&p);
+                }
+                let fast = propagate_steps(&model, &p0, 7);
+                let bits = |m: &StateMatrix| m.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&fast), bits(&p), "Δt {dt}");
+            }
+        }
+    }
+}
