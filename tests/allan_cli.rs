@@ -121,6 +121,51 @@ fn recovers_n_and_k_of_a_random_walk_log() {
     }
     let toml = std::fs::read_to_string(out.join("noise.toml")).unwrap();
     assert!(toml.contains("bias_model = \"random_walk\""), "{toml}");
+    noise_toml_drives_simulate_and_calibrate(&out.join("noise.toml"), dir.path());
+}
+
+/// The README's path: `noise.toml` given as it is to `--config` of `simulate --logs` and of
+/// `calibrate` on those logs; the calibration's filter takes the measured white noise.
+fn noise_toml_drives_simulate_and_calibrate(noise: &Path, dir: &Path) {
+    let run = |args: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_accelcal"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    let (logs, cal) = (dir.join("drive"), dir.join("cal"));
+    let config = noise.to_str().unwrap();
+    run(&[
+        "simulate",
+        "--config",
+        config,
+        "--logs",
+        logs.to_str().unwrap(),
+    ]);
+    run(&[
+        "calibrate",
+        "--config",
+        config,
+        "--accel",
+        logs.join("accelerometer.csv").to_str().unwrap(),
+        "--gps",
+        logs.join("gps.csv").to_str().unwrap(),
+        "--out",
+        cal.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let parsed: toml::Value = toml::from_str(&std::fs::read_to_string(noise).unwrap()).unwrap();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(cal.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(
+        summary["filter"]["accel_noise_var_m2_s4"].as_f64(),
+        parsed["filter"]["accel_noise_var_m2_s4"].as_float()
+    );
 }
 
 #[test]
