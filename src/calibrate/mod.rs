@@ -148,7 +148,8 @@ pub fn prepare<'a>(
         pc_m: settings.position_mean_m,
         vc_m_s: settings.velocity_mean_m_s,
     };
-    let reduced = pass::reduce(accel, &fixes, settings.nominal_dt_s, start)?;
+    let steps = (settings.nominal_dt_s, settings.filter_stats.bias_model);
+    let reduced = pass::reduce(accel, &fixes, steps, start)?;
     let scan = Scan::of(&reduced, fixes, gps.name())?;
     let model = ErrorStateModel::new(settings.nominal_dt_s, &settings.filter_stats);
     let (fixes, end) = intervals::filter(
@@ -339,7 +340,7 @@ impl Prepared<'_> {
                 next += 1;
             }
             let (xs, ps) = match (self.fixes.get(next), self.smoothed.get(next)) {
-                (Some(f), Some(sm)) => sm.smooth(&fw.x, &fw.p, &fw.transition_to(f.sample, f.t_s)),
+                (Some(f), Some(sm)) => sm.smooth(&fw.x, &fw.p, &fw.transition_to(f)),
                 _ => (fw.x, fw.p),
             };
             let row = EstimateRow {
