@@ -372,6 +372,8 @@ impl Prepared<'_> {
             _ => (StateVector::zeros(), self.model.p0),
         };
         let nis: Vec<f64> = self.fixes.iter().map(|f| f.nis).collect();
+        let (bias_model, bias_random_walk_m_s2_per_sqrt_s, bias_correlation_time_s) =
+            FilterRecord::bias_fields(f.bias_model);
         let (lo, hi) = sc.accepted_step_s();
         let summary = Summary {
             accelcal_version: env!("CARGO_PKG_VERSION"),
@@ -393,6 +395,7 @@ impl Prepared<'_> {
             fix_tolerance_s: sc.tolerance_s(),
             start_smoothed: StateRecord::new(&start_smoothed.0, &start_smoothed.1),
             end_estimate: StateRecord::new(x_end, p_end),
+            end_smoothed: StateRecord::new(x_end, p_end),
             nis: nis_test(&nis, s.false_alarm_rate),
             filter: FilterRecord {
                 initial_position_mean_m: s.position_mean_m,
@@ -403,6 +406,9 @@ impl Prepared<'_> {
                 accel_noise_var_m2_s4: f.accel_noise_var_m2_s4,
                 gps_position_sigma_m: f.gps_position_sigma_m,
                 gps_velocity_sigma_m_s: f.gps_velocity_sigma_m_s,
+                bias_model,
+                bias_random_walk_m_s2_per_sqrt_s,
+                bias_correlation_time_s,
             },
         };
         let fixes = self
