@@ -81,10 +81,12 @@ impl NoiseUnits {
     /// constant one).
     #[inline]
     pub fn add_bias_step(&mut self, tau_s: f64, bias: BiasModel) {
-        // (φ, q_b/s_b): the step at unit scale s_b = 1 (q_b is linear in K² and in σ_b²).
+        // (φ, q_b/s_b): q_b = K²·Δt is linear in K², q_b = σ_b²·(1 − φ²) in σ_b² (the
+        // Gauss–Markov step at σ_b² = 1).
         let (phi, unit) = match bias {
             BiasModel::Constant => return,
-            drifting => drifting.step(tau_s, 1.0),
+            BiasModel::RandomWalk { .. } => (1.0, tau_s),
+            gauss_markov => gauss_markov.step(tau_s, 1.0),
         };
         let mut step = transition(tau_s);
         step[(ErrorState::BIAS, ErrorState::BIAS)] = phi;
