@@ -361,9 +361,27 @@ mod tests {
 
     #[test]
     fn the_written_out_propagation_is_the_model_s_bit_for_bit() {
-        let stats = crate::model::Model::new(&crate::config::Config::default())
+        let constant = crate::model::Model::new(&crate::config::Config::default())
             .unwrap()
             .filter_stats;
+        for bias_model in [
+            crate::state::BiasModel::Constant,
+            crate::state::BiasModel::RandomWalk {
+                k_m_s2_per_sqrt_s: 0.02,
+            },
+            crate::state::BiasModel::GaussMarkov {
+                correlation_time_s: 20.0,
+            },
+        ] {
+            let stats = NoiseStats {
+                bias_model,
+                ..constant
+            };
+            written_out_equals_the_model(&stats);
+        }
+    }
+
+    fn written_out_equals_the_model(stats: &NoiseStats) {
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
         let mut uniform = || {
             seed ^= seed << 13;
@@ -372,7 +390,7 @@ mod tests {
             (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         };
         for dt in [0.005, 0.001, 0.0123] {
-            let model = ErrorStateModel::new(dt, &stats);
+            let model = ErrorStateModel::new(dt, stats);
             for _ in 0..200 {
                 let a = StateMatrix::from_fn(|_, _| uniform());
                 let p0 = a * a.transpose() + StateMatrix::identity() * 1e-3;
