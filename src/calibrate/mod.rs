@@ -25,6 +25,7 @@ pub mod pass;
 mod scan;
 mod smoother;
 pub mod summary;
+mod units;
 
 use std::io::Write;
 
