@@ -12,6 +12,7 @@ use std::time::Instant;
 
 use accelcal::calibrate::pass::{Integrated, reduce};
 use accelcal::logs::read::{LogFile, LogSource, read_gps};
+use accelcal::model::BiasModel;
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -84,7 +85,8 @@ fn main() {
         vc_m_s: 100.0,
     };
     measure("one pass (parse, check, reduce)", repeats, bytes, || {
-        let reduced = reduce(&accel, &fixes, 0.001, start).expect("a good log");
+        let reduced =
+            reduce(&accel, &fixes, (0.001, BiasModel::Constant), start).expect("a good log");
         std::hint::black_box(reduced);
     });
 }

@@ -5,9 +5,7 @@ use crate::error::FilterError;
 use crate::filter::{ErrorStateModel, propagate_over};
 use crate::logs::GpsFix;
 use crate::simulation::measurement;
-use crate::state::{
-    ErrorState, MeasMatrix, MeasVector, StateMatrix, StateModel, StateVector, transition,
-};
+use crate::state::{ErrorState, MeasMatrix, MeasVector, StateMatrix, StateModel, StateVector};
 
 use super::StepMode;
 
@@ -82,6 +80,10 @@ pub(super) struct Forward<'m> {
     pub p: StateMatrix,
     /// Sample, time and a posteriori estimate of the last fix (the start before any).
     last_fix: (u64, f64, StateVector),
+    /// Whether the filter's Φ composes over an interval ([`StateModel::transition_composes`]).
+    composes: bool,
+    /// Π Φ(Δt_j) over the steps since the last fix, when Φ does not compose (I otherwise).
+    phi_since_fix: StateMatrix,
 }
 
 impl<'m> Forward<'m> {
@@ -107,6 +109,8 @@ impl<'m> Forward<'m> {
             x: StateVector::zeros(),
             p: model.p0,
             last_fix: (0, t0_s, StateVector::zeros()),
+            composes: state.transition_composes(),
+            phi_since_fix: StateMatrix::identity(),
         }
     }
 
@@ -122,6 +126,10 @@ impl<'m> Forward<'m> {
                 self.vc_m_s += a * dt;
                 self.x = self.model.phi * self.x;
                 self.p = self.model.propagate(&self.p);
+                if !self.composes {
+                    // The in-memory filter's product of the steps (`FilterSchedule::of`).
+                    self.phi_since_fix = self.model.phi * self.phi_since_fix;
+                }
             }
             StepMode::PerStep => {
                 let dt = t_next_s - self.t_s;
@@ -129,8 +137,12 @@ impl<'m> Forward<'m> {
                 // eq. (3) with this step's Δt_j; Φ(Δt_j) and Q(Δt_j) for eq. (5).
                 self.pc_m += self.vc_m_s * dt + a * half_dt2;
                 self.vc_m_s += a * dt;
-                self.x = self.state.transition(self.t_s, dt) * self.x;
+                let phi = self.state.transition(self.t_s, dt);
+                self.x = phi * self.x;
                 self.p = propagate_over(&self.state, &self.p, self.t_s, dt);
+                if !self.composes {
+                    self.phi_since_fix = phi * self.phi_since_fix;
+                }
             }
         }
         self.k += 1;
@@ -146,12 +158,34 @@ impl<'m> Forward<'m> {
             .all(|v| v.is_finite())
     }
 
-    /// Transition Φ from the current sample to sample `k_to` at `t_to_s`.
-    pub fn transition_to(&self, k_to: u64, t_to_s: f64) -> StateMatrix {
-        match self.mode {
-            StepMode::Nominal => transition((k_to - self.k) as f64 * self.model.dt_s),
-            StepMode::PerStep => transition(t_to_s - self.t_s),
+    /// Transition Φ from the current sample to the sample of the next fix `next`.
+    ///
+    /// # Formula
+    /// When Φ composes, Φ(t_b − t_k) (n·Δt in nominal mode). Otherwise (a Gauss–Markov bias)
+    /// Φ(b←k) = Φ(b←a)·Φ(k←a)⁻¹ from the fix's transition since the previous fix a and the
+    /// product of the steps from a to k, with the closed-form inverse of
+    /// M = [[1, T, c_p], [0, 1, c_v], [0, 0, φ]]:
+    /// M⁻¹ = [[1, −T, (T·c_v − c_p)/φ], [0, 1, −c_v/φ], [0, 0, 1/φ]]. Its bias column is a
+    /// difference of terms of size |c|/φ(k←a): relative rounding ε·e^((t_k − t_a)/τ_b), small
+    /// while the GPS interval is not many τ_b.
+    pub fn transition_to(&self, next: &FilteredFix) -> StateMatrix {
+        if self.composes {
+            return match self.mode {
+                StepMode::Nominal => self
+                    .state
+                    .transition(0.0, (next.sample - self.k) as f64 * self.model.dt_s),
+                StepMode::PerStep => self.state.transition(self.t_s, next.t_s - self.t_s),
+            };
         }
+        let (p, v, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
+        let m = &self.phi_since_fix;
+        let (t, c_p, c_v, phi) = (m[(p, v)], m[(p, b)], m[(v, b)], m[(b, b)]);
+        let mut inverse = StateMatrix::identity();
+        inverse[(p, v)] = -t;
+        inverse[(p, b)] = (t * c_v - c_p) / phi;
+        inverse[(v, b)] = -c_v / phi;
+        inverse[(b, b)] = 1.0 / phi;
+        next.phi_from_previous * inverse
     }
 
     /// The measurement update with `fix` at the current sample.
@@ -161,13 +195,23 @@ impl<'m> Forward<'m> {
     pub fn update(&mut self, fix: &GpsFix) -> Result<FilteredFix, FilterError> {
         let (k0, t0, post0) = self.last_fix;
         let (phi, prior) = match self.mode {
-            // As the in-memory filter: one transition over the whole interval since the last fix.
+            // As the in-memory filter: one transition over the whole interval since the last fix
+            // (the product of the steps when Φ does not compose).
             StepMode::Nominal => {
-                let phi = transition((self.k - k0) as f64 * self.model.dt_s);
+                let phi = if self.composes {
+                    self.state
+                        .transition(0.0, (self.k - k0) as f64 * self.model.dt_s)
+                } else {
+                    self.phi_since_fix
+                };
                 (phi, phi * post0)
             }
-            StepMode::PerStep => (transition(self.t_s - t0), self.x),
+            StepMode::PerStep if self.composes => {
+                (self.state.transition(t0, self.t_s - t0), self.x)
+            }
+            StepMode::PerStep => (self.phi_since_fix, self.x),
         };
+        self.phi_since_fix = StateMatrix::identity();
         let cov = self.model.update_covariance(&self.p, self.t_s, phi)?;
         let z = measurement(fix.position_m, fix.velocity_m_s);
         // eq. (6): δz = z − (p_c, v_c).

@@ -7,7 +7,7 @@ use crate::filter::ErrorStateModel;
 use crate::logs::{GpsFix, LogError, LogProblem};
 use crate::model::NoiseStats;
 use crate::simulation::measurement;
-use crate::state::{ErrorState, StateMatrix, StateVector, transition};
+use crate::state::{ErrorState, StateMatrix, StateModel, StateVector};
 
 use super::forward::FilteredFix;
 use super::pass::{FixAt, Reduced};
@@ -127,6 +127,9 @@ pub fn mode_index(mode: StepMode) -> usize {
 struct FixFilter<'m> {
     model: &'m ErrorStateModel,
     stats: NoiseStats,
+    /// Φ over n nominal steps, by n: the product of the steps for a bias whose Φ does not
+    /// compose (a nominal log's intervals take few lengths).
+    powers: Vec<(u64, StateMatrix)>,
     mode: StepMode,
     /// Sample and time stamp of the last fix.
     last: (u64, f64),
@@ -139,7 +142,7 @@ impl FixFilter<'_> {
     /// per-step noise `units` of the interval: the nominal step's recursion sample by sample
     /// (the in-memory filter's operations), or Φ and Q of the interval from the units.
     fn propagate(
-        &self,
+        &mut self,
         sample: u64,
         t_s: f64,
         units: &super::pass::NoiseUnits,
@@ -148,17 +151,34 @@ impl FixFilter<'_> {
             StepMode::Nominal => {
                 let n = sample - self.last.0;
                 (
-                    transition(n as f64 * self.model.dt_s),
+                    self.nominal_transition(n),
                     propagate_steps(self.model, &self.p, n),
                 )
             }
             StepMode::PerStep => {
-                let phi = transition(t_s - self.last.1);
-                let q = units.process_noise(self.stats.accel_noise_var_m2_s4);
+                let phi = units.interval_transition(t_s - self.last.1, self.stats.bias_model);
+                let q = units.interval_noise(&self.stats);
                 let p = phi * self.p * phi.transpose() + q;
                 (phi, (p + p.transpose()) * 0.5)
             }
         }
+    }
+
+    /// Φ over `n` nominal steps as `FilterSchedule` computes it: in one piece when the model's
+    /// Φ composes, else the product of the steps, Φ(Δt)·(…·(Φ(Δt)·I)).
+    fn nominal_transition(&mut self, n: u64) -> StateMatrix {
+        let state = ErrorState { stats: self.stats };
+        if state.transition_composes() {
+            return state.transition(0.0, n as f64 * self.model.dt_s);
+        }
+        if let Some((_, phi)) = self.powers.iter().find(|(m, _)| *m == n) {
+            return *phi;
+        }
+        let phi = step_product(self.model, n);
+        if self.powers.len() < 16 {
+            self.powers.push((n, phi));
+        }
+        phi
     }
 
     /// The measurement update with `gps` at `fix`, as `forward::Forward::update`.
@@ -194,7 +214,7 @@ impl FixFilter<'_> {
     }
 
     /// The estimate and covariance at the log's last sample.
-    fn end(&self, reduced: &Reduced) -> (StateVector, StateMatrix) {
+    fn end(&mut self, reduced: &Reduced) -> (StateVector, StateMatrix) {
         let (samples, last_s) = (reduced.samples - 1, reduced.span_s.1);
         match self.mode {
             StepMode::Nominal => {
@@ -214,6 +234,16 @@ impl FixFilter<'_> {
             }
         }
     }
+}
+
+/// Φ(Δt)ⁿ as the product of the steps, I multiplied by Φ(Δt) n times from the left: the
+/// in-memory filter's transition over an interval of a model whose Φ does not compose.
+pub fn step_product(model: &ErrorStateModel, n: u64) -> StateMatrix {
+    let mut phi = StateMatrix::identity();
+    for _ in 0..n {
+        phi = model.phi * phi;
+    }
+    phi
 }
 
 /// `p` after `n` steps of [`ErrorStateModel::propagate`], P ← (Φ·P·Φᵀ + Q + (Φ·P·Φᵀ + Q)ᵀ)/2,
@@ -272,6 +302,7 @@ pub fn filter(
     let mut f = FixFilter {
         model,
         stats: *stats,
+        powers: Vec::new(),
         mode: scan.mode,
         last: (0, scan.span_s.0),
         x: StateVector::zeros(),
@@ -330,9 +361,27 @@ mod tests {
 
     #[test]
     fn the_written_out_propagation_is_the_model_s_bit_for_bit() {
-        let stats = crate::model::Model::new(&crate::config::Config::default())
+        let constant = crate::model::Model::new(&crate::config::Config::default())
             .unwrap()
             .filter_stats;
+        for bias_model in [
+            crate::state::BiasModel::Constant,
+            crate::state::BiasModel::RandomWalk {
+                k_m_s2_per_sqrt_s: 0.02,
+            },
+            crate::state::BiasModel::GaussMarkov {
+                correlation_time_s: 20.0,
+            },
+        ] {
+            let stats = NoiseStats {
+                bias_model,
+                ..constant
+            };
+            written_out_equals_the_model(&stats);
+        }
+    }
+
+    fn written_out_equals_the_model(stats: &NoiseStats) {
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
         let mut uniform = || {
             seed ^= seed << 13;
@@ -341,7 +390,7 @@ mod tests {
             (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         };
         for dt in [0.005, 0.001, 0.0123] {
-            let model = ErrorStateModel::new(dt, &stats);
+            let model = ErrorStateModel::new(dt, stats);
             for _ in 0..200 {
                 let a = StateMatrix::from_fn(|_, _| uniform());
                 let p0 = a * a.transpose() + StateMatrix::identity() * 1e-3;

@@ -25,6 +25,7 @@ pub mod pass;
 mod scan;
 mod smoother;
 pub mod summary;
+mod units;
 
 use std::io::Write;
 
@@ -148,7 +149,8 @@ pub fn prepare<'a>(
         pc_m: settings.position_mean_m,
         vc_m_s: settings.velocity_mean_m_s,
     };
-    let reduced = pass::reduce(accel, &fixes, settings.nominal_dt_s, start)?;
+    let steps = (settings.nominal_dt_s, settings.filter_stats.bias_model);
+    let reduced = pass::reduce(accel, &fixes, steps, start)?;
     let scan = Scan::of(&reduced, fixes, gps.name())?;
     let model = ErrorStateModel::new(settings.nominal_dt_s, &settings.filter_stats);
     let (fixes, end) = intervals::filter(
@@ -339,7 +341,7 @@ impl Prepared<'_> {
                 next += 1;
             }
             let (xs, ps) = match (self.fixes.get(next), self.smoothed.get(next)) {
-                (Some(f), Some(sm)) => sm.smooth(&fw.x, &fw.p, &fw.transition_to(f.sample, f.t_s)),
+                (Some(f), Some(sm)) => sm.smooth(&fw.x, &fw.p, &fw.transition_to(f)),
                 _ => (fw.x, fw.p),
             };
             let row = EstimateRow {
@@ -371,6 +373,8 @@ impl Prepared<'_> {
             _ => (StateVector::zeros(), self.model.p0),
         };
         let nis: Vec<f64> = self.fixes.iter().map(|f| f.nis).collect();
+        let (bias_model, bias_random_walk_m_s2_per_sqrt_s, bias_correlation_time_s) =
+            FilterRecord::bias_fields(f.bias_model);
         let (lo, hi) = sc.accepted_step_s();
         let summary = Summary {
             accelcal_version: env!("CARGO_PKG_VERSION"),
@@ -392,6 +396,7 @@ impl Prepared<'_> {
             fix_tolerance_s: sc.tolerance_s(),
             start_smoothed: StateRecord::new(&start_smoothed.0, &start_smoothed.1),
             end_estimate: StateRecord::new(x_end, p_end),
+            end_smoothed: StateRecord::new(x_end, p_end),
             nis: nis_test(&nis, s.false_alarm_rate),
             filter: FilterRecord {
                 initial_position_mean_m: s.position_mean_m,
@@ -402,6 +407,9 @@ impl Prepared<'_> {
                 accel_noise_var_m2_s4: f.accel_noise_var_m2_s4,
                 gps_position_sigma_m: f.gps_position_sigma_m,
                 gps_velocity_sigma_m_s: f.gps_velocity_sigma_m_s,
+                bias_model,
+                bias_random_walk_m_s2_per_sqrt_s,
+                bias_correlation_time_s,
             },
         };
         let fixes = self

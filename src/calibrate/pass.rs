@@ -15,63 +15,16 @@ use crate::logs::block::{BLOCK_BYTES, Block, Layout, MAX_LINE_BYTES, Rows, parse
 use crate::logs::read::{LogSource, open_blocks};
 use crate::logs::steps::{StepAt, StepMedian};
 use crate::logs::{ACCEL_COLUMNS, GpsFix, LogError, LogProblem};
-use crate::state::{ErrorState, StateMatrix};
+use crate::state::BiasModel;
+
+pub use super::units::NoiseUnits;
 
 /// Relative tolerance within which every step of a log must equal the configured Δt for the
 /// nominal recursion to run: time stamps written as j·Δt differ from j·Δt by a rounding error.
 pub const NOMINAL_TOLERANCE: f64 = 1e-9;
 
-// The unit contributions below are written out for the error state's (δp, δv, b).
-const _: () = assert!(ErrorState::DIM == 3);
-
 /// Blocks parsed together, one per thread or more: a bound on the text held at once.
 const PARSE_GROUP: usize = 4;
-
-/// The process noise of an interval per unit of each noise statistic: Q = W·U_W for the
-/// accelerometer's white-noise variance W. A further statistic (a bias random walk K²·U_K) is a
-/// further unit, and a search over the statistics rescales the units without reading the log.
-///
-/// # Formula
-/// Over steps Δt_1 … Δt_n from the fix at t_a to the one at t_b,
-/// U_W = Σ_j Φ(t_b − t_{j+1})·γ_j·γ_jᵀ·Φ(t_b − t_{j+1})ᵀ with γ_j = −(Δt_j²/2, Δt_j, 0)ᵀ,
-/// accumulated step by step as U ← Φ(Δt)·U·Φ(Δt)ᵀ + γγᵀ. γ has no bias part, so U has none and
-/// only Φ's (δp, δv) block [[1, Δt], [0, 1]] acts on it: three numbers per step.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct NoiseUnits {
-    /// U_W's (δp δp, δp δv, δv δv) entries, (m², m²/s, m²/s²) per (m/s²)².
-    white: [f64; 3],
-}
-
-impl NoiseUnits {
-    /// Adds one step of `tau_s`.
-    #[inline]
-    pub fn add_step(&mut self, tau_s: f64) {
-        let [pp, pv, vv] = self.white;
-        let tau2 = tau_s * tau_s;
-        self.white = [
-            pp + 2.0 * tau_s * pv + tau2 * vv + 0.25 * tau2 * tau2,
-            pv + tau_s * vv + 0.5 * tau2 * tau_s,
-            vv + tau2,
-        ];
-    }
-
-    /// Q = W·U_W for the white-noise variance `accel_noise_var_m2_s4`.
-    pub fn process_noise(&self, accel_noise_var_m2_s4: f64) -> StateMatrix {
-        let (p, v) = (ErrorState::POSITION, ErrorState::VELOCITY);
-        let [pp, pv, vv] = self.white.map(|u| u * accel_noise_var_m2_s4);
-        let mut q = StateMatrix::zeros();
-        q[(p, p)] = pp;
-        q[(p, v)] = pv;
-        q[(v, p)] = pv;
-        q[(v, v)] = vv;
-        q
-    }
-
-    /// Whether every unit is finite.
-    pub fn is_finite(&self) -> bool {
-        self.white.iter().all(|u| u.is_finite())
-    }
-}
 
 /// Integrated accelerometer (p_c, v_c), (m, m/s).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -154,6 +107,8 @@ struct Current {
 /// The pass's state between rows.
 struct Stitch<'g> {
     dt_s: f64,
+    /// The filter's bias model: the per-step units' bias part.
+    bias: BiasModel,
     half_dt2_s2: f64,
     gps: &'g [GpsFix],
     k: u64,
@@ -237,6 +192,9 @@ impl Stitch<'_> {
         self.integrated[0].advance(a, self.dt_s, self.half_dt2_s2);
         self.integrated[1].advance(a, step, 0.5 * step * step);
         self.units.add_step(step);
+        if self.bias.drifts() {
+            self.units.add_bias_step(step, self.bias);
+        }
         let finite = [
             self.integrated[0].is_finite(),
             self.integrated[1].is_finite() && self.units.is_finite(),
@@ -331,7 +289,8 @@ fn stitch_all(
 
 /// Streams the accelerometer log `source` once: every row checked (format, increasing time
 /// stamps), the steps counted, and the log reduced between the `gps` fixes for either Δt mode
-/// (`nominal_dt_s` the configured step). Starts eq. (3) from `start` = (p_c(0), v_c(0)).
+/// (`nominal_dt_s` the configured step, `bias` the filter's bias model for the per-step units).
+/// Starts eq. (3) from `start` = (p_c(0), v_c(0)).
 ///
 /// # Errors
 /// [`LogError`] naming the line of the first malformed row or time stamp not after the
@@ -339,7 +298,7 @@ fn stitch_all(
 pub fn reduce(
     source: &dyn LogSource,
     gps: &[GpsFix],
-    nominal_dt_s: f64,
+    (nominal_dt_s, bias): (f64, BiasModel),
     start: Integrated,
 ) -> Result<Reduced, LogError> {
     let (layout, mut feed) = open_blocks(source, ACCEL_COLUMNS)?;
@@ -350,6 +309,7 @@ pub fn reduce(
     };
     let mut stitch = Stitch {
         dt_s: nominal_dt_s,
+        bias,
         half_dt2_s2: 0.5 * nominal_dt_s * nominal_dt_s,
         gps,
         k: 0,
@@ -407,29 +367,4 @@ pub fn reduce(
 
 fn too_few(file: &str, found: u64) -> LogError {
     LogError::of_file(file, LogProblem::TooFewRows { found, needed: 2 })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::state::{process_noise, transition};
-
-    #[test]
-    fn unit_noise_is_the_step_by_step_propagation_of_the_process_noise() {
-        let steps = [0.005, 0.0049, 0.0052, 0.005, 0.0048];
-        let w = 3e-4;
-        let mut units = NoiseUnits::default();
-        let mut q = StateMatrix::zeros();
-        for &tau in &steps {
-            units.add_step(tau);
-            let phi = transition(tau);
-            q = phi * q * phi.transpose() + process_noise(tau, w);
-        }
-        let d = units.process_noise(w) - q;
-        assert!(d.norm() <= 1e-14 * q.norm(), "{d}");
-        // A wrong unit (the noise entering velocity alone) is told apart.
-        let mut wrong = NoiseUnits::default();
-        wrong.white[2] = units.white[2];
-        assert!((wrong.process_noise(w) - q).norm() > 1e-3 * q.norm());
-    }
 }

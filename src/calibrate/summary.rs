@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use crate::logs::write::push_row;
-use crate::state::{ErrorState, StateMatrix, StateVector};
+use crate::state::{BiasModel, ErrorState, StateMatrix, StateVector};
 
 use super::StepMode;
 use super::forward::FilteredFix;
@@ -287,6 +287,30 @@ pub struct FilterRecord {
     pub gps_position_sigma_m: f64,
     /// GPS velocity noise σ, m/s.
     pub gps_velocity_sigma_m_s: f64,
+    /// The bias model the filter assumes: "constant", "random_walk" or "gauss_markov".
+    pub bias_model: &'static str,
+    /// K of a random-walk bias, m/s² per √s (only with `random_walk`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bias_random_walk_m_s2_per_sqrt_s: Option<f64>,
+    /// τ_b of a Gauss–Markov bias, s (only with `gauss_markov`; its stationary variance is
+    /// `bias_var_m2_s4`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bias_correlation_time_s: Option<f64>,
+}
+
+impl FilterRecord {
+    /// The bias model's fields of the record: its name and its parameter.
+    pub fn bias_fields(model: BiasModel) -> (&'static str, Option<f64>, Option<f64>) {
+        match model {
+            BiasModel::Constant => (model.name(), None, None),
+            BiasModel::RandomWalk { k_m_s2_per_sqrt_s } => {
+                (model.name(), Some(k_m_s2_per_sqrt_s), None)
+            }
+            BiasModel::GaussMarkov { correlation_time_s } => {
+                (model.name(), None, Some(correlation_time_s))
+            }
+        }
+    }
 }
 
 /// `summary.json`.
@@ -298,7 +322,7 @@ pub struct Summary {
     pub accelerometer_log: String,
     /// The GPS log as named on the command line.
     pub gps_log: String,
-    /// The bias estimate at the end of the log, m/s² (filtered and smoothed agree there).
+    /// The bias estimate at the last sample, m/s² (filtered and smoothed agree there).
     pub bias_m_s2: f64,
     /// Its σ, m/s².
     pub bias_sigma_m_s2: f64,
@@ -327,10 +351,14 @@ pub struct Summary {
     pub accepted_step_s: [f64; 2],
     /// How far from its sample a fix may lie: half the median step, s.
     pub fix_tolerance_s: f64,
-    /// The smoothed estimate at the first sample: the initial position and velocity errors.
+    /// The smoothed estimate at the first sample: the initial position and velocity errors, and
+    /// the bias at the start (which differs from the end's when the bias drifts).
     pub start_smoothed: StateRecord,
-    /// The estimate at the last sample.
+    /// The filtered estimate at the last sample.
     pub end_estimate: StateRecord,
+    /// The smoothed estimate at the last sample: no measurement follows it, so it equals the
+    /// filtered one, `end_estimate` (the smoother starts there).
+    pub end_smoothed: StateRecord,
     /// The NIS test of the whole log.
     pub nis: NisTest,
     /// The filter's assumptions.

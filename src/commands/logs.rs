@@ -142,8 +142,13 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         .with_context(|| into(PAGE_FILE))?;
     staged.commit()?;
     let s = &cal.summary;
+    // A drifting bias is named: its estimate holds at the end of the log only.
+    let model = match s.filter.bias_model {
+        "constant" => String::new(),
+        name => format!(", bias model {name}"),
+    };
     super::say(&format!(
-        "bias {} ± {} m/s² at t = {} s ({} samples, {} fixes, Δt mode {}); NIS test {} \
+        "bias {} ± {} m/s² at t = {} s ({} samples, {} fixes, Δt mode {}{model}); NIS test {} \
          (sum {} in [{}, {}]); written to {}\n",
         sig(s.bias_m_s2, 6),
         sig(s.bias_sigma_m_s2, 3),

@@ -9,7 +9,7 @@ use super::RenderError;
 use super::rich::rich;
 use super::view::{FigureView, VerdictView};
 use crate::calibrate::StepMode;
-use crate::calibrate::summary::{Calibration, Summary};
+use crate::calibrate::summary::{Calibration, FilterRecord, Summary};
 use crate::format::{count, percent, short, sig};
 use crate::plot;
 
@@ -86,6 +86,55 @@ fn seconds(x: f64) -> String {
     }
 }
 
+/// `text` with the HTML special characters escaped.
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// The filter's bias model in words with its parameter (plain text), when the bias drifts.
+fn drift_words(f: &FilterRecord) -> Option<String> {
+    match (
+        f.bias_random_walk_m_s2_per_sqrt_s,
+        f.bias_correlation_time_s,
+    ) {
+        (Some(k), _) => Some(format!(
+            "random walk (random_walk), K = {} m/s² per √s",
+            short(k)
+        )),
+        (_, Some(tau_b)) => Some(format!(
+            "Gauss–Markov (gauss_markov), correlation time {}, stationary σ {} m/s²",
+            seconds(tau_b),
+            short(f.bias_var_m2_s4.sqrt())
+        )),
+        _ => None,
+    }
+}
+
+/// How the smoother's bias reads: constant, or following the filter's bias model.
+fn smoother_words(s: &Summary) -> String {
+    match drift_words(&s.filter) {
+        None => rich(
+            "A fixed-interval Rauch–Tung–Striebel smoother runs backward over the fixes and gives \
+             the smoothed δp, δv, b and their σ at every sample; the bias is constant, so its \
+             smoothed estimate is the same at every time, and at the end of the log filtered and \
+             smoothed agree.",
+        ),
+        Some(model) => format!(
+            "The filter assumes a drifting bias, {}: Φ and Q of every step carry the bias's own \
+             decay and process noise. {}",
+            escape(&model),
+            rich(
+                "A fixed-interval Rauch–Tung–Striebel smoother runs backward over the fixes and \
+                 gives the smoothed δp, δv, b and their σ at every sample; the smoothed bias \
+                 follows its path through the log, and at the end of the log filtered and \
+                 smoothed agree."
+            )
+        ),
+    }
+}
+
 fn method(s: &Summary) -> Vec<String> {
     let mode = match s.dt_mode {
         StepMode::Nominal => format!(
@@ -121,12 +170,7 @@ fn method(s: &Summary) -> Vec<String> {
             seconds(s.accepted_step_s[1]),
             seconds(s.fix_tolerance_s)
         )),
-        rich(
-            "A fixed-interval Rauch–Tung–Striebel smoother runs backward over the fixes and gives \
-             the smoothed δp, δv, b and their σ at every sample; the bias is constant, so its \
-             smoothed estimate is the same at every time, and at the end of the log filtered and \
-             smoothed agree.",
-        ),
+        smoother_words(s),
     ]
 }
 
@@ -180,11 +224,16 @@ fn figures(cal: &Calibration) -> Result<Vec<FigureView>, RenderError> {
             id: "fig-bias".into(),
             number: 1,
             title: "The bias estimate".into(),
-            caption_html: rich(
+            caption_html: rich(if cal.summary.filter.bias_model == "constant" {
                 "The filtered (a posteriori) bias estimate at each fix and the smoothed one, each \
              with ±1σ; below, the two σ. The smoothed estimate uses every fix, so it holds \
-             its final value from the start.",
-            ),
+             its final value from the start."
+            } else {
+                "The filtered (a posteriori) bias estimate at each fix and the smoothed one, each \
+             with ±1σ; below, the two σ. The smoothed estimate uses every fix; the bias drifts \
+             in the filter's model, so it follows the bias's path, and at the last fix it \
+             equals the filtered one."
+            }),
             svg: fig("fig-bias", plot::calibration_bias(&cal.fixes))?,
         },
         FigureView {
@@ -249,6 +298,23 @@ fn logs(s: &Summary) -> Vec<Row> {
 
 /// The estimates at the start and the end of the log.
 fn results(s: &Summary) -> Vec<Row> {
+    let start = &s.start_smoothed;
+    let mut rows = results_end_and_start(s);
+    if s.filter.bias_model != "constant" {
+        // A drifting bias has a start of its own.
+        rows.insert(
+            1,
+            row(
+                "bias b̂^{s} at the start (smoothed)",
+                with_sigma(start.bias_m_s2, start.sigma_bias_m_s2, "m/s²"),
+            ),
+        );
+    }
+    rows
+}
+
+/// The end's estimates and the initial position and velocity.
+fn results_end_and_start(s: &Summary) -> Vec<Row> {
     let start = &s.start_smoothed;
     let end = &s.end_estimate;
     let f = &s.filter;
@@ -317,7 +383,7 @@ fn nis_words(s: &Summary) -> String {
 /// The filter's assumptions.
 fn settings(s: &Summary) -> Vec<Row> {
     let f = &s.filter;
-    vec![
+    let mut rows = vec![
         row(
             "p_{c}(t_{0}), mean of p(0)",
             format!("{} m", short(f.initial_position_mean_m)),
@@ -351,7 +417,17 @@ fn settings(s: &Summary) -> Vec<Row> {
             format!("{} m/s", short(f.gps_velocity_sigma_m_s)),
         ),
         row("configured Δt", seconds(s.nominal_dt_s)),
-    ]
+    ];
+    if let Some(model) = drift_words(f) {
+        rows.insert(
+            5,
+            Row {
+                quantity_html: rich("bias model"),
+                value: model,
+            },
+        );
+    }
+    rows
 }
 
 /// Renders the page of `cal` as HTML; `command` wrote it, `every_sample` as in [`build`].

@@ -249,16 +249,40 @@ fn numbers(v: &serde_json::Value, path: &str, out: &mut Vec<(String, f64)>) {
 
 #[test]
 fn per_step_fix_to_fix_filter_matches_the_per_sample_recursion() {
-    // The per-step mode's interval noise Q = W·U must hold every process-noise term of the
-    // state model: a term left out of the units moves the numbers far beyond rounding.
+    // The per-step mode's interval noise Q = W·U_W + s_b·U_b and transition must hold every
+    // process-noise term and the bias's decay of the state model: a term left out of the units
+    // moves the numbers far beyond rounding. For each bias model the filter may assume.
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     long_logs(d);
-    let args = |out: &'static str| {
-        [
+    let long = std::fs::read_to_string(d.join("long.toml")).unwrap();
+    for (config, filter) in [
+        ("long.toml", ""),
+        (
+            "long-rw.toml",
+            "bias_model = \"random_walk\"\nbias_random_walk_m_s2_per_sqrt_s = 0.01\n",
+        ),
+        (
+            "long-gm.toml",
+            "bias_model = \"gauss_markov\"\nbias_correlation_time_s = 5.0\n",
+        ),
+    ] {
+        if !filter.is_empty() {
+            std::fs::write(d.join(config), format!("{long}\n[filter]\n{filter}")).unwrap();
+        }
+        fix_to_fix_against_per_sample(d, config);
+    }
+}
+
+/// Calibrates the jittered log with `config`, fix to fix and sample by sample, and compares
+/// every number of the summaries.
+fn fix_to_fix_against_per_sample(d: &Path, config: &str) {
+    let (fix, all) = (format!("{config}-fix"), format!("{config}-all"));
+    for (out, extra) in [(&fix, None), (&all, Some("--every-sample"))] {
+        let args = [
             "calibrate",
             "--config",
-            "long.toml",
+            config,
             "--accel",
             "logs/jittered.csv",
             "--gps",
@@ -266,16 +290,14 @@ fn per_step_fix_to_fix_filter_matches_the_per_sample_recursion() {
             "--out",
             out,
             "-q",
-        ]
-    };
-    for (out, extra) in [("fix", None), ("all", Some("--every-sample"))] {
-        let args: Vec<&str> = args(out).into_iter().chain(extra).collect();
+        ];
+        let args: Vec<&str> = args.into_iter().chain(extra).collect();
         let o = run(&args, d);
         assert!(o.status.success(), "{}", stderr(&o));
     }
     let (mut fast, mut exact) = (Vec::new(), Vec::new());
-    numbers(&summary(d, "fix"), "", &mut fast);
-    numbers(&summary(d, "all"), "", &mut exact);
+    numbers(&summary(d, &fix), "", &mut fast);
+    numbers(&summary(d, &all), "", &mut exact);
     assert_eq!(fast.len(), exact.len());
     // The smoothed σ at the start is P(0) less almost all of itself: the rounding at P(0)'s size
     // comes out multiplied by (σ(0)/σ^s)², 10⁴ to 10⁸ here, whichever recursion computes it.
@@ -294,7 +316,8 @@ fn per_step_fix_to_fix_filter_matches_the_per_sample_recursion() {
         }
     }
     eprintln!(
-        "per-step, fix to fix against sample by sample: worst relative / tolerance {worst:?}"
+        "{config}: per-step, fix to fix against sample by sample: worst relative / tolerance \
+         {worst:?}"
     );
-    assert!(worst.0 < 1.0, "{worst:?}");
+    assert!(worst.0 < 1.0, "{config}: {worst:?}");
 }

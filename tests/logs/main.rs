@@ -7,6 +7,7 @@
 mod common;
 
 mod bad_logs;
+mod drift;
 mod fast;
 mod reader;
 mod reference;

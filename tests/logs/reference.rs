@@ -1,6 +1,7 @@
 //! An independent processing of the logs, written here with plain arrays and the textbook
 //! formulas: per-step Δt_j from the time stamps, Euler integration (eq. 3), Φ(Δt_j) and
-//! Q(Δt_j) = W·g·gᵀ, the short-form update P⁺ = P⁻ − K·S·Kᵀ with an explicit 2×2 inverse, and a
+//! Q(Δt_j) = W·g·gᵀ (with the bias's own φ(Δt_j) and q_b(Δt_j) when it drifts), the short-form
+//! update P⁺ = P⁻ − K·S·Kᵀ with an explicit 2×2 inverse, and a
 //! Rauch–Tung–Striebel smoother over every sample with explicit 3×3 inverses. It shares no code
 //! with the library's filter.
 // Matrix formulas read best with explicit indices.
@@ -13,6 +14,18 @@ pub type AccelLog = Vec<(f64, f64)>;
 /// A GPS log: (t, z_p, z_v).
 pub type GpsLog = Vec<(f64, f64, f64)>;
 
+/// How the filter's bias moves between samples.
+#[derive(Clone, Copy, Debug)]
+pub enum Drift {
+    /// A constant bias: φ = 1, q_b = 0.
+    None,
+    /// A random walk with K (m/s² per √s): φ = 1, q_b = K²·Δt.
+    RandomWalk(f64),
+    /// Gauss–Markov with τ_b (s), stationary at the prior variance σ_b²: φ = e^(−Δt/τ_b),
+    /// q_b = σ_b²·(1 − φ²).
+    GaussMarkov(f64),
+}
+
 /// The filter's assumptions.
 #[derive(Clone, Copy, Debug)]
 pub struct Prior {
@@ -24,6 +37,7 @@ pub struct Prior {
     pub accel_noise_var: f64,
     pub gps_p_sigma_m: f64,
     pub gps_v_sigma_m_s: f64,
+    pub drift: Drift,
 }
 
 impl Prior {
@@ -38,6 +52,7 @@ impl Prior {
             accel_noise_var: 0.0004,
             gps_p_sigma_m: 1.0,
             gps_v_sigma_m_s: 0.04,
+            drift: Drift::None,
         }
     }
 }
@@ -127,7 +142,15 @@ pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> 
             let a = accel[k].1;
             pc += vc * dt + a * dt * dt / 2.0;
             vc += a * dt;
-            let f = [[1.0, dt, -dt * dt / 2.0], [0.0, 1.0, -dt], [0.0, 0.0, 1.0]];
+            let (phi, q_b) = match prior.drift {
+                Drift::None => (1.0, 0.0),
+                Drift::RandomWalk(k) => (1.0, k * k * dt),
+                Drift::GaussMarkov(tau_b) => {
+                    let phi = (-dt / tau_b).exp();
+                    (phi, prior.bias_var * (1.0 - phi * phi))
+                }
+            };
+            let f = [[1.0, dt, -dt * dt / 2.0], [0.0, 1.0, -dt], [0.0, 0.0, phi]];
             let g = [-dt * dt / 2.0, -dt, 0.0];
             x = mul_v(&f, &x);
             p = mul(&mul(&f, &p), &transpose(&f));
@@ -136,6 +159,7 @@ pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> 
                     p[i][j] += prior.accel_noise_var * g[i] * g[j];
                 }
             }
+            p[2][2] += q_b;
             x_prior_next.push(x);
             p_prior_next.push(p);
             f_step.push(f);
