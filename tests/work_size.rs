@@ -95,6 +95,20 @@ fn the_estimate_bounds_the_measured_peak_within_a_factor_2() {
     }
 }
 
+/// The estimate counts the blocks an ensemble of N realizations can hold in flight: a block holds
+/// at least one chunk ([`accelcal::ensemble::CHUNK`]), so N from 2 (the least) up to a chunk is one block, one more
+/// realization a second.
+#[test]
+fn the_estimate_counts_blocks_of_at_least_one_chunk() {
+    let chunk = accelcal::ensemble::CHUNK;
+    let with = |n: u64| estimate(&format!("[ensemble]\nrealizations = {n}\n"), Work::Ensemble);
+    assert_eq!(with(2), with(chunk));
+    assert!(with(chunk + 1) > with(chunk));
+    // Two blocks per thread at most, whatever N.
+    assert_eq!(with(4 * chunk), with(1000 * chunk));
+    assert!(with(4 * chunk) > with(3 * chunk));
+}
+
 /// The reproducer: a 2 000 s run with 200 Hz GPS and residual_max_lag = 1.
 const LONG_RUN: &str = "[profile]\nduration_s = 2000.0\n[gps]\nsample_rate_hz = 200.0\n\
                         [checks]\nresidual_max_lag = 1\n[ensemble]\nrealizations = 2\n";

@@ -46,9 +46,9 @@ impl Work {
     /// analyses 100 static logs of fixed size; the CSV text, built whole, a simulation.
     fn bytes_fixed_per_sample_and_fix(self) -> (f64, f64, f64) {
         match self {
-            Work::Ensemble => (0.0, 24.0, 1536.0),
+            Work::Ensemble => (0.0, 24.0, 2048.0),
             Work::Sensitivity => (0.0, 24.0, 6144.0),
-            Work::Report => (96.0 * 1048576.0, 24.0, 13312.0),
+            Work::Report => (128.0 * 1048576.0, 24.0, 13312.0),
             Work::Simulate => (0.0, 640.0, 1024.0),
         }
     }
@@ -68,6 +68,10 @@ pub struct MemoryEstimate {
     pub terms: String,
 }
 
+/// Realizations of the smallest block of an ensemble: one chunk, `ensemble::CHUNK` (named here,
+/// not imported: the ensemble depends on the model; tests/work_size.rs checks that they agree).
+const CHUNK_REALIZATIONS: u64 = 64;
+
 /// Resident memory of the program itself, bytes.
 const BASE_BYTES: f64 = 8.0 * 1048576.0;
 
@@ -77,16 +81,23 @@ impl super::Model {
     /// # Formula
     /// bytes = 8 MiB + c + samples·s + fixes·f + blocks·B, where c, s and f are the work's
     /// fixed bytes and bytes per sample and per fix, B the bytes of one block's running sums,
-    /// and blocks = min(2·threads, N) + 1 for the ensembles (each thread merges into its own
-    /// sums while a block runs, a block holds at least one of the N realizations, and the
-    /// total) and 0 for a simulation.
+    /// and blocks = min(2·threads, ⌈N/64⌉) + 1 for the ensembles (each thread sums a block while
+    /// another waits for its turn, a block holds at least a chunk of 64 of the N realizations,
+    /// and the total) and 0 for a simulation.
     pub fn peak_memory(&self, work: Work, threads: usize) -> MemoryEstimate {
         let (fixed, per_sample, per_fix) = work.bytes_fixed_per_sample_and_fix();
         let samples = self.timeline.steps as f64 + 1.0;
         let fixes = self.timeline.fixes() as f64;
         let blocks = match work {
             Work::Simulate => 0.0,
-            _ => (2 * threads.max(1) as u64).min(self.config.ensemble.realizations) as f64 + 1.0,
+            _ => {
+                let least = self
+                    .config
+                    .ensemble
+                    .realizations
+                    .div_ceil(CHUNK_REALIZATIONS);
+                (2 * threads.max(1) as u64).min(least) as f64 + 1.0
+            }
         };
         let sums = blocks * sums_bytes(&self.config, self.timeline.fixes() as u64);
         let terms = [
