@@ -79,27 +79,33 @@ impl super::Model {
     /// The predicted peak memory of `work` on `threads` threads.
     ///
     /// # Formula
-    /// bytes = 8 MiB + c + samples·s + fixes·f + blocks·B, where c, s and f are the work's
-    /// fixed bytes and bytes per sample and per fix, B the bytes of one block's running sums,
-    /// and blocks = min(2·threads, ⌈N/64⌉) + 1 for the ensembles (each thread sums a block while
-    /// another waits for its turn, a block holds at least a chunk of 64 of the N realizations,
-    /// and the total) and 0 for a simulation.
+    /// bytes = 8 MiB + c + samples·s + fixes·f + blocks·B + workers·P, where c, s and f are the
+    /// work's fixed bytes and bytes per sample and per fix, B the bytes of one block's running
+    /// sums and P those of its residual products alone; blocks = min(2·threads, ⌈N/64⌉) + 1 for
+    /// the ensembles (each thread sums a block while another waits for its turn, a block holds
+    /// at least a chunk of 64 of the N realizations, and the total) and 0 for a simulation;
+    /// workers = threads for the ensembles (each keeps the tiles it sums the products in, about
+    /// as large as the products: every pair of a run of 1 000 fixes makes them 16 MB) and 0 for
+    /// a simulation.
     pub fn peak_memory(&self, work: Work, threads: usize) -> MemoryEstimate {
         let (fixed, per_sample, per_fix) = work.bytes_fixed_per_sample_and_fix();
         let samples = self.timeline.steps as f64 + 1.0;
         let fixes = self.timeline.fixes() as f64;
-        let blocks = match work {
-            Work::Simulate => 0.0,
+        let (blocks, workers) = match work {
+            Work::Simulate => (0.0, 0.0),
             _ => {
                 let least = self
                     .config
                     .ensemble
                     .realizations
                     .div_ceil(CHUNK_REALIZATIONS);
-                (2 * threads.max(1) as u64).min(least) as f64 + 1.0
+                let threads = threads.max(1) as u64;
+                ((2 * threads).min(least) as f64 + 1.0, threads as f64)
             }
         };
-        let sums = blocks * sums_bytes(&self.config, self.timeline.fixes() as u64);
+        let block = sums_bytes(&self.config, self.timeline.fixes() as u64);
+        let fix_sum = fixes * (std::mem::size_of::<f64>() * SUM_FLOATS_PER_FIX) as f64;
+        let sums = blocks * block + workers * (block - fix_sum);
         let terms = [
             (samples * per_sample, "profile.duration_s"),
             (fixes * per_fix, "gps.sample_rate_hz"),
@@ -107,8 +113,11 @@ impl super::Model {
         ];
         // The fix-level part of the sums grows with the fixes alone, only the residual products
         // with the lags too: the key names what lowers the larger share.
-        let fix_sums = blocks * fixes * (std::mem::size_of::<f64>() * SUM_FLOATS_PER_FIX) as f64;
-        let shares = [terms[0].0, terms[1].0 + fix_sums, sums - fix_sums];
+        let shares = [
+            terms[0].0,
+            terms[1].0 + blocks * fix_sum,
+            sums - blocks * fix_sum,
+        ];
         let key = shares
             .iter()
             .zip(&terms)
@@ -120,7 +129,7 @@ impl super::Model {
             key,
             terms: format!(
                 "{samples} samples × {per_sample} B = {:.0} MB, {fixes} fixes × {per_fix} B = \
-                 {:.0} MB, {blocks} blocks of running sums = {:.0} MB",
+                 {:.0} MB, {blocks} blocks of running sums and {workers} workers' tiles = {:.0} MB",
                 mb(terms[0].0),
                 mb(terms[1].0),
                 mb(sums)
