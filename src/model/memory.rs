@@ -79,14 +79,15 @@ impl super::Model {
     /// The predicted peak memory of `work` on `threads` threads.
     ///
     /// # Formula
-    /// bytes = 8 MiB + c + samples·s + fixes·f + blocks·B + workers·P, where c, s and f are the
-    /// work's fixed bytes and bytes per sample and per fix, B the bytes of one block's running
-    /// sums and P those of its residual products alone; blocks = min(2·threads, ⌈N/64⌉) + 1 for
-    /// the ensembles (each thread sums a block while another waits for its turn, a block holds
-    /// at least a chunk of 64 of the N realizations, and the total) and 0 for a simulation;
-    /// workers = threads for the ensembles (each keeps the tiles it sums the products in, about
-    /// as large as the products: every pair of a run of 1 000 fixes makes them 16 MB) and 0 for
-    /// a simulation.
+    /// bytes = 8 MiB + c + samples·s + fixes·f + blocks·B + workers·(P + R), where c, s and f
+    /// are the work's fixed bytes and bytes per sample and per fix, B the bytes of one block's
+    /// running sums and P those of its residual products alone; blocks = min(2·threads, ⌈N/64⌉)
+    /// + 1 for the ensembles (each thread sums a block while another waits for its turn, a block
+    /// holds at least a chunk of 64 of the N realizations, and the total) and 0 for a
+    /// simulation; workers = threads for the ensembles and 0 for a simulation. Each worker keeps
+    /// the tiles it sums the products in, about as large as the products (P: every pair of a
+    /// run of 1 000 fixes makes them 16 MB), and the residuals of a pass of up to 128
+    /// realizations in single precision, R = 4 bytes · 2·fixes · min(N, 128).
     pub fn peak_memory(&self, work: Work, threads: usize) -> MemoryEstimate {
         let (fixed, per_sample, per_fix) = work.bytes_fixed_per_sample_and_fix();
         let samples = self.timeline.steps as f64 + 1.0;
@@ -105,19 +106,22 @@ impl super::Model {
         };
         let block = sums_bytes(&self.config, self.timeline.fixes() as u64);
         let fix_sum = fixes * (std::mem::size_of::<f64>() * SUM_FLOATS_PER_FIX) as f64;
-        let sums = blocks * block + workers * (block - fix_sum);
+        let pass = self
+            .config
+            .ensemble
+            .realizations
+            .min(2 * CHUNK_REALIZATIONS) as f64;
+        let residuals = (std::mem::size_of::<f32>() * RESIDUAL_WIDTH) as f64 * fixes * pass;
+        let sums = blocks * block + workers * (block - fix_sum + residuals);
         let terms = [
             (samples * per_sample, "profile.duration_s"),
             (fixes * per_fix, "gps.sample_rate_hz"),
             (sums, "checks.residual_max_lag"),
         ];
-        // The fix-level part of the sums grows with the fixes alone, only the residual products
-        // with the lags too: the key names what lowers the larger share.
-        let shares = [
-            terms[0].0,
-            terms[1].0 + blocks * fix_sum,
-            sums - blocks * fix_sum,
-        ];
+        // The fix-level sums and the residuals grow with the fixes alone, only the residual
+        // products with the lags too: the key names what lowers the larger share.
+        let products = (blocks + workers) * (block - fix_sum);
+        let shares = [terms[0].0, terms[1].0 + sums - products, products];
         let key = shares
             .iter()
             .zip(&terms)
@@ -129,7 +133,7 @@ impl super::Model {
             key,
             terms: format!(
                 "{samples} samples × {per_sample} B = {:.0} MB, {fixes} fixes × {per_fix} B = \
-                 {:.0} MB, {blocks} blocks of running sums and {workers} workers' tiles = {:.0} MB",
+                 {:.0} MB, {blocks} blocks of running sums, {workers} workers' tiles and residuals = {:.0} MB",
                 mb(terms[0].0),
                 mb(terms[1].0),
                 mb(sums)
