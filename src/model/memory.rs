@@ -81,13 +81,13 @@ impl super::Model {
     /// # Formula
     /// bytes = 8 MiB + c + samples·s + fixes·f + blocks·B + workers·(P + R), where c, s and f
     /// are the work's fixed bytes and bytes per sample and per fix, B the bytes of one block's
-    /// running sums and P those of its residual products alone; blocks = min(2·threads, ⌈N/64⌉)
-    /// + 1 for the ensembles (each thread sums a block while another waits for its turn, a block
-    /// holds at least a chunk of 64 of the N realizations, and the total) and 0 for a
-    /// simulation; workers = threads for the ensembles and 0 for a simulation. Each worker keeps
-    /// the tiles it sums the products in, about as large as the products (P: every pair of a
-    /// run of 1 000 fixes makes them 16 MB), and the residuals of a pass of up to 128
-    /// realizations in single precision, R = 4 bytes · 2·fixes · min(N, 128).
+    /// running sums and P those of its residual products alone; blocks =
+    /// min(2·threads, ⌈N/64⌉) + 1 for the ensembles (each thread sums a block while another
+    /// waits for its turn, a block holds at least a chunk of 64 of the N realizations, and the
+    /// total) and 0 for a simulation; workers = threads for the ensembles and 0 for a
+    /// simulation. Each worker keeps the tiles it sums the products in, about as large as the
+    /// products (P: every pair of a run of 1 000 fixes makes them 16 MB), and the residuals of
+    /// a pass of up to 128 realizations in single precision, R = 4 bytes · 2·fixes · min(N, 128).
     pub fn peak_memory(&self, work: Work, threads: usize) -> MemoryEstimate {
         let (fixed, per_sample, per_fix) = work.bytes_fixed_per_sample_and_fix();
         let samples = self.timeline.steps as f64 + 1.0;
