@@ -170,6 +170,67 @@ fn a_full_device_is_exit_2_with_the_error_once() {
     assert!(entries(&d.join("tmp")).is_empty(), "scratch files left");
 }
 
+/// The JSON of `ensemble`, `merge` and `sensitivity` is written as it is serialized, never held
+/// whole: a full device met mid-stream, given as the output or as standard output, is exit 2
+/// with the error once, and a symbolic link to the device stays one.
+#[test]
+fn a_streamed_output_that_meets_a_full_device_is_exit_2_with_the_error_once() {
+    let full = Path::new("/dev/full");
+    if !full.exists() {
+        eprintln!("no /dev/full here: skipped");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir(d.join("tmp")).unwrap();
+    let made = Command::new(common::bin())
+        .args(["ensemble", "--realizations", "200", "-q"])
+        .args(["--shard", "1/1", "--partial", "p.bin"])
+        .current_dir(d)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    std::os::unix::fs::symlink(full, d.join("full.json")).unwrap();
+    let why = "No space left on device";
+    let commands: [&[&str]; 3] = [
+        &["ensemble", "--realizations", "200", "-q"],
+        &["merge", "p.bin", "-q"],
+        &[
+            "sensitivity",
+            "--realizations",
+            "64",
+            "--draws",
+            "10",
+            "--ensembles",
+            "0",
+            "-q",
+        ],
+    ];
+    for args in commands {
+        for path in ["/dev/full", "full.json"] {
+            refused(d, &[args, &["--json", path]].concat(), path, why);
+        }
+        // Standard output a full device: the document is streamed there.
+        let out = Command::new(common::bin())
+            .args(args)
+            .current_dir(d)
+            .env("TMPDIR", d.join("tmp"))
+            .stdout(std::fs::File::create(full).unwrap())
+            .output()
+            .unwrap();
+        let msg = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {msg}");
+        assert!(
+            msg.starts_with("error: cannot write to standard output: "),
+            "{args:?}: {msg}"
+        );
+        assert_eq!(msg.matches(why).count(), 1, "{args:?}: {msg}");
+    }
+    assert_eq!(std::fs::read_link(d.join("full.json")).unwrap(), full);
+    assert_eq!(entries(d), ["full.json", "p.bin", "tmp"]);
+    assert!(entries(&d.join("tmp")).is_empty(), "scratch files left");
+}
+
 /// A shard interrupted (SIGINT) or terminated (SIGTERM, as `scancel` and a time limit do) left
 /// its hidden `.part-K.bin.PID.blocks` and `.tmp` files; it now removes them and ends by the
 /// signal.

@@ -1,5 +1,7 @@
-//! Exporters: results to bytes (JSON, CSV). They do no IO, so tests call them directly. This is
-//! an edge of the library: the typed verdicts become the stable field names of the data contract.
+//! Exporters: results to bytes (JSON, CSV). They open nothing: a document is built whole or
+//! serialized into any writer the caller gives (a file, standard output, a buffer in tests). This
+//! is an edge of the library: the typed verdicts become the stable field names of the data
+//! contract.
 
 pub mod sensitivity;
 
@@ -265,14 +267,23 @@ struct EnsembleFile<'a> {
     ensemble: &'a EnsembleDoc<'a>,
 }
 
-/// Serializes the `accelcal ensemble` output.
-pub fn ensemble_json(config: &Config, doc: &EnsembleDoc<'_>) -> String {
-    serde_json::to_string_pretty(&EnsembleFile {
+/// Serializes the `accelcal ensemble` output into `w` as it goes: the text of every fix is
+/// written and dropped, never held whole (at 4·10⁵ fixes it is 1.6 GB).
+///
+/// # Errors
+/// The writer's error, unchanged (the document itself always serializes: non-finite numbers
+/// are written as `null`).
+pub fn write_ensemble_json(
+    w: impl std::io::Write,
+    config: &Config,
+    doc: &EnsembleDoc<'_>,
+) -> std::io::Result<()> {
+    let file = EnsembleFile {
         accelcal_version: env!("CARGO_PKG_VERSION"),
         config,
         ensemble: doc,
-    })
-    .expect("finite numbers serialize")
+    };
+    serde_json::to_writer_pretty(w, &file).map_err(std::io::Error::from)
 }
 
 /// One realization at every accelerometer sample, as CSV with a header row.

@@ -117,7 +117,11 @@ pub fn record(s: &Sensitivity) -> SensitivityRecord {
     }
 }
 
-/// Serializes the `accelcal sensitivity` output.
-pub fn sensitivity_json(s: &Sensitivity) -> String {
-    serde_json::to_string_pretty(&record(s)).expect("finite numbers serialize")
+/// Serializes the `accelcal sensitivity` output into `w` as it goes.
+///
+/// # Errors
+/// The writer's error, unchanged (the record itself always serializes: non-finite numbers are
+/// written as `null`).
+pub fn write_sensitivity_json(w: impl std::io::Write, s: &Sensitivity) -> std::io::Result<()> {
+    serde_json::to_writer_pretty(w, &record(s)).map_err(std::io::Error::from)
 }

@@ -69,7 +69,7 @@ impl AtomicFile {
             path: dest.to_path_buf(),
             real,
             tmp,
-            file: Some(std::io::BufWriter::new(file)),
+            file: Some(std::io::BufWriter::with_capacity(1 << 16, file)),
         })
     }
 
