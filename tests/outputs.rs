@@ -265,3 +265,34 @@ fn a_cancelled_shard_leaves_no_hidden_files() {
         );
     }
 }
+
+/// `calibrate --out` and `simulate --csv`/`--logs` are checked before the work: a calibration
+/// into a file's place is refused before either log is opened (the missing log is not what is
+/// reported), and a `--csv` that cannot be written leaves no `--logs` directory behind.
+#[test]
+fn calibrate_and_simulate_check_their_outputs_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("file"), "").unwrap();
+    refused(
+        d,
+        &[
+            "calibrate",
+            "--accel",
+            "missing.csv",
+            "--gps",
+            "missing.csv",
+            "--out",
+            "file/cal",
+        ],
+        "file/cal/estimates.csv",
+        "is not a directory",
+    );
+    refused(
+        d,
+        &["simulate", "--logs", "logs", "--csv", "file/r.csv"],
+        "file/r.csv",
+        "is not a directory",
+    );
+    assert_eq!(entries(d), ["file"]);
+}

@@ -17,7 +17,7 @@ use accelcal::logs::write::LogWriter;
 use accelcal::logs::{ACCEL_FILE, GPS_FILE, TRUTH_FILE};
 use accelcal::logs::{LogError, LogProblem};
 use accelcal::model::Model;
-use accelcal::output::StagedFiles;
+use accelcal::output::{StagedFiles, check_directory, check_file};
 use accelcal::{export, realization, report, simulation};
 use anyhow::{Context, Result};
 
@@ -26,6 +26,13 @@ pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
     super::check_memory(&model, accelcal::model::Work::Simulate, &args.model)?;
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
     let seed = model.config.ensemble.seed;
+    // Both destinations checked before either is written: a bad --csv does not leave new logs.
+    if let Some(dir) = &args.logs {
+        check_directory(dir, &[ACCEL_FILE, GPS_FILE, TRUTH_FILE])?;
+    }
+    if let Some(path) = &args.csv {
+        check_file(path)?;
+    }
     if let Some(dir) = &args.logs {
         write_logs(&model, &schedule, args.realization, dir)?;
     }
@@ -96,6 +103,7 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         quiet: args.quiet,
     };
     let model = load_model(&model_args, &CaseArgs::default(), None)?;
+    check_directory(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE, PAGE_FILE])?;
     let settings = Settings::from_model(&model);
     let note = |text: &str| {
         if !args.quiet && std::io::stderr().is_terminal() {
