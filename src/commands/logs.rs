@@ -157,7 +157,7 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
     };
     super::say(&format!(
         "bias {} ± {} m/s² at t = {} s ({} samples, {} fixes, Δt mode {}{model}); NIS test {} \
-         (sum {} in [{}, {}]); written to {}\n",
+         (sum {} {} [{}, {}]); written to {}\n",
         sig(s.bias_m_s2, 6),
         sig(s.bias_sigma_m_s2, 3),
         s.end_s,
@@ -166,11 +166,26 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         s.dt_mode.name(),
         s.nis.verdict,
         sig(s.nis.sum, 5),
+        nis_place(s.nis.sum, s.nis.lower, s.nis.upper),
         sig(s.nis.lower, 5),
         sig(s.nis.upper, 5),
         args.out.join(PAGE_FILE).display()
     ))?;
     Ok(())
+}
+
+/// Where the NIS sum lies against its band, in the printed line's words: "in", "below" or
+/// "above" (a failing sum is never said to be in its band).
+fn nis_place(sum: f64, lower: f64, upper: f64) -> &'static str {
+    if (lower..=upper).contains(&sum) {
+        "in"
+    } else if sum < lower {
+        "below"
+    } else if sum > upper {
+        "above"
+    } else {
+        "outside"
+    }
 }
 
 /// The command line that reproduces a calibration.

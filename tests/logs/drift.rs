@@ -45,7 +45,17 @@ fn simulate(dir: &Path, l: u64) -> String {
 }
 
 /// Calibrates `accel` and `logs/gps.csv` with `config` into `out`; returns the summary.
-fn calibrate(dir: &Path, config: &str, (accel, gps): (&str, &str), out: &str) -> serde_json::Value {
+fn calibrate(dir: &Path, config: &str, logs: (&str, &str), out: &str) -> serde_json::Value {
+    calibrate_printed(dir, config, logs, out).0
+}
+
+/// [`calibrate`], with the line the command printed.
+fn calibrate_printed(
+    dir: &Path,
+    config: &str,
+    (accel, gps): (&str, &str),
+    out: &str,
+) -> (serde_json::Value, String) {
     let args = [
         "calibrate",
         "--config",
@@ -61,8 +71,30 @@ fn calibrate(dir: &Path, config: &str, (accel, gps): (&str, &str), out: &str) ->
     ];
     let o = run(&args, dir);
     assert!(o.status.success(), "{}", stderr(&o));
-    serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap())
-        .unwrap()
+    let summary =
+        serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap())
+            .unwrap();
+    (summary, String::from_utf8(o.stdout).unwrap())
+}
+
+/// The printed line places the NIS sum against its band in words that agree with the verdict:
+/// "pass (sum … in [" or "fail (sum … below [" / "above [" (it said "in" for a failing sum).
+fn assert_nis_words(summary: &serde_json::Value, printed: &str) {
+    let n = &summary["nis"];
+    let sum = n["sum"].as_f64().unwrap();
+    let place = if n["verdict"] == "pass" {
+        "in"
+    } else if sum < n["lower"].as_f64().unwrap() {
+        "below"
+    } else {
+        "above"
+    };
+    let verdict = n["verdict"].as_str().unwrap();
+    let words = format!("NIS test {verdict} (sum ");
+    let at = printed.find(&words).unwrap_or_else(|| panic!("{printed}"));
+    let rest = &printed[at + words.len()..];
+    let after_sum = &rest[rest.find(' ').unwrap() + 1..];
+    assert!(after_sum.starts_with(&format!("{place} [")), "{printed}");
 }
 
 /// The largest |library − reference| / σ_reference over every sample and state of the filtered
@@ -210,8 +242,12 @@ fn a_random_walk_log_passes_the_nis_test_with_the_matching_filter_only() {
         );
         let accel = format!("{logs}/accelerometer.csv");
         let gps = format!("{logs}/gps.csv");
-        let matching = calibrate(d, "truth.toml", (&accel, &gps), &format!("rw-{l}"));
-        let constant = calibrate(d, "constant.toml", (&accel, &gps), &format!("const-{l}"));
+        let (matching, printed) =
+            calibrate_printed(d, "truth.toml", (&accel, &gps), &format!("rw-{l}"));
+        assert_nis_words(&matching, &printed);
+        let (constant, printed) =
+            calibrate_printed(d, "constant.toml", (&accel, &gps), &format!("const-{l}"));
+        assert_nis_words(&constant, &printed);
         assert_eq!(matching["filter"]["bias_model"], "random_walk");
         assert_eq!(
             matching["filter"]["bias_random_walk_m_s2_per_sqrt_s"],
