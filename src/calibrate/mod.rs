@@ -411,8 +411,9 @@ impl Prepared<'_> {
                 bias_random_walk_m_s2_per_sqrt_s,
                 bias_correlation_time_s,
             },
+            warnings: Vec::new(),
         };
-        let fixes = self
+        let fixes: Vec<FixReport> = self
             .fixes
             .iter()
             .zip(&self.smoothed)
@@ -429,6 +430,10 @@ impl Prepared<'_> {
                 nis: f.nis,
             })
             .collect();
+        let summary = Summary {
+            warnings: summary::prior_warnings(fixes.first()),
+            ..summary
+        };
         Calibration { summary, fixes }
     }
 

@@ -150,6 +150,10 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         .with_context(|| into(PAGE_FILE))?;
     staged.commit()?;
     let s = &cal.summary;
+    // Warnings go to standard error even with --quiet: they are about the numbers, not progress.
+    for w in &s.warnings {
+        eprintln!("warning: {w}");
+    }
     // A drifting bias is named: its estimate holds at the end of the log only.
     let model = match s.filter.bias_model {
         "constant" => String::new(),

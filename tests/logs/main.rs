@@ -9,6 +9,7 @@ mod common;
 mod bad_logs;
 mod drift;
 mod fast;
+mod prior;
 mod reader;
 mod reference;
 mod round_trip;
