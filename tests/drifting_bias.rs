@@ -18,9 +18,9 @@ mod common;
 use accelcal::checks::{CheckId, Verdict, Verdicts};
 use accelcal::config::{BiasModelKind, Config, TruthModel};
 use accelcal::ensemble::{Engine, Ensemble, kernel};
-use accelcal::simulation::{FixState, Observer, run_realization, stream_key};
+use accelcal::simulation::{FixState, run_realization, stream_key};
 use accelcal::study::{Silent, run_case};
-use common::plain::{M3, mul, transpose};
+use common::plain::{M3, gps_gain, i_minus_kh, mul, transpose};
 use nalgebra::SMatrix;
 
 /// K of the random-walk truth, m/s²/√s: over the 30 s run the bias moves by K·√30 ≈ 0.11 m/s²,
@@ -93,14 +93,6 @@ fn a_constant_bias_filter_on_a_random_walk_fails_nees() {
     }
 }
 
-struct Keep(Vec<FixState>);
-
-impl Observer for Keep {
-    fn fix(&mut self, f: &FixState) {
-        self.0.push(*f);
-    }
-}
-
 #[test]
 #[allow(clippy::needless_range_loop)] // k is the lane, of the group and of `scalar`
 fn lane_groups_reproduce_the_scalar_realizations_with_a_drifting_bias() {
@@ -113,7 +105,7 @@ fn lane_groups_reproduce_the_scalar_realizations_with_a_drifting_bias() {
             let (first, active) = (37u64, 5usize);
             let scalar: Vec<Vec<FixState>> = (0..active as u64)
                 .map(|k| {
-                    let mut keep = Keep(Vec::new());
+                    let mut keep = common::Keep(Vec::new());
                     run_realization(&m, &s, 11, first + k, &mut keep);
                     keep.0
                 })
@@ -207,20 +199,7 @@ fn plain_filter(config: &Config, phi: &M3, q: &M3) -> Vec<(M3, M3, M3)> {
             phi_n = mul(phi, &phi_n);
         }
         let prior = p;
-        let s = [[p[0][0] + rp, p[0][1]], [p[1][0], p[1][1] + rv]];
-        let det = s[0][0] * s[1][1] - s[0][1] * s[1][0];
-        let s_inv = [
-            [s[1][1] / det, -s[0][1] / det],
-            [-s[1][0] / det, s[0][0] / det],
-        ];
-        let mut ikh = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        for r in 0..3 {
-            for c in 0..2 {
-                let k = p[r][0] * s_inv[0][c] + p[r][1] * s_inv[1][c];
-                ikh[r][c] -= k;
-            }
-        }
-        p = mul(&ikh, &prior);
+        p = mul(&i_minus_kh(&gps_gain(&prior, rp, rv)), &prior);
         out.push((prior, p, phi_n));
     }
     out

@@ -18,7 +18,7 @@ use accelcal::ensemble::epoch::{EpochPlan, interval_noise, interval_noise_by_ste
 use accelcal::ensemble::{Engine, Ensemble, EnsembleStats, StageStats, kernel};
 use accelcal::filter::{FilterSchedule, Stage};
 use accelcal::model::Model;
-use accelcal::simulation::{FixState, Observer, run_realization, stream_key};
+use accelcal::simulation::{FixState, run_realization, stream_key};
 use accelcal::state::{StateMatrix, StateVector};
 
 const ALL_CASES: [Case; 4] = [
@@ -50,14 +50,6 @@ fn model(config: &Config, case: Case) -> (Model, FilterSchedule) {
     (m.with_case(case), s)
 }
 
-struct Keep(Vec<FixState>);
-
-impl Observer for Keep {
-    fn fix(&mut self, f: &FixState) {
-        self.0.push(*f);
-    }
-}
-
 #[test]
 #[allow(clippy::needless_range_loop)] // k is the lane, of the group and of `scalar`
 fn lane_groups_reproduce_the_scalar_realizations_bit_for_bit() {
@@ -73,7 +65,7 @@ fn lane_groups_reproduce_the_scalar_realizations_bit_for_bit() {
             for (first, active) in [(16u64, 8usize), (37, 3)] {
                 let scalar: Vec<Vec<FixState>> = (0..active as u64)
                     .map(|k| {
-                        let mut keep = Keep(Vec::new());
+                        let mut keep = common::Keep(Vec::new());
                         run_realization(&m, &s, 11, first + k, &mut keep);
                         keep.0
                     })

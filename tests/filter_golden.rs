@@ -5,7 +5,7 @@ mod common;
 
 use accelcal::config::Config;
 use approx::assert_relative_eq;
-use common::plain::{M3, mul, transpose};
+use common::plain::{M3, gps_gain, i_minus_kh, mul, transpose};
 
 fn reference(fix_count: usize) -> Vec<(M3, M3)> {
     let dt: f64 = 0.005;
@@ -25,28 +25,8 @@ fn reference(fix_count: usize) -> Vec<(M3, M3)> {
             }
         }
         let prior = p;
-        // S = H P Hᵀ + R with H selecting position and velocity.
-        let s = [[p[0][0] + rp, p[0][1]], [p[1][0], p[1][1] + rv]];
-        let det = s[0][0] * s[1][1] - s[0][1] * s[1][0];
-        let s_inv = [
-            [s[1][1] / det, -s[0][1] / det],
-            [-s[1][0] / det, s[0][0] / det],
-        ];
-        // K = P Hᵀ S⁻¹ (3×2).
-        let mut k = [[0.0; 2]; 3];
-        for i in 0..3 {
-            for j in 0..2 {
-                k[i][j] = p[i][0] * s_inv[0][j] + p[i][1] * s_inv[1][j];
-            }
-        }
-        // P⁺ = (I − K H) P⁻.
-        let mut ikh = [[0.0; 3]; 3];
-        for i in 0..3 {
-            ikh[i][i] = 1.0;
-            ikh[i][0] -= k[i][0];
-            ikh[i][1] -= k[i][1];
-        }
-        p = mul(&ikh, &prior);
+        // P⁺ = (I − K H) P⁻, H selecting position and velocity.
+        p = mul(&i_minus_kh(&gps_gain(&prior, rp, rv)), &prior);
         out.push((prior, p));
     }
     out

@@ -19,7 +19,7 @@ struct Ended {
 
 /// Runs the binary with `args` in `dir`, killed when it has not ended within `limit_s` seconds.
 fn run_limited(dir: &Path, args: &[&str], limit_s: u64) -> Ended {
-    let mut child = Command::new(common::bin())
+    let child = Command::new(common::bin())
         .args(args)
         .current_dir(dir)
         .env("RAYON_NUM_THREADS", "2")
@@ -27,21 +27,11 @@ fn run_limited(dir: &Path, args: &[&str], limit_s: u64) -> Ended {
         .stderr(Stdio::piped())
         .spawn()
         .expect("the binary runs");
-    let start = Instant::now();
-    let code = loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            break status.code();
-        }
-        if start.elapsed() > Duration::from_secs(limit_s) {
-            child.kill().unwrap();
-            child.wait().unwrap();
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let mut stderr = String::new();
-    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
-    Ended { code, stderr }
+    let (status, stderr) = common::wait_limited(child, limit_s);
+    Ended {
+        code: status.and_then(|s| s.code()),
+        stderr,
+    }
 }
 
 /// Expects `ended` to be a refusal: exit code 2, no panic, every word of `expect` in the message.

@@ -7,7 +7,7 @@ mod common;
 
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitStatus, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// Far more work than the limits below allow: a run that starts it is seen.
@@ -25,29 +25,10 @@ fn spawn(dir: &Path, args: &[&str]) -> Child {
         .expect("the binary runs")
 }
 
-/// Waits for `child` at most `limit_s` seconds (then kills it: `None`); its status and stderr.
-fn wait(mut child: Child, limit_s: u64) -> (Option<ExitStatus>, String) {
-    let start = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            break Some(status);
-        }
-        if start.elapsed() > Duration::from_secs(limit_s) {
-            child.kill().unwrap();
-            child.wait().unwrap();
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let mut stderr = String::new();
-    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
-    (status, stderr)
-}
-
 /// Runs `args` in `dir` and expects exit code 2 within 10 s with a message that starts with
 /// `cannot write <shown>: `, holds `why` and the operating system's text at most once.
 fn refused(dir: &Path, args: &[&str], shown: &str, why: &str) {
-    let (status, msg) = wait(spawn(dir, args), 30);
+    let (status, msg) = common::wait_limited(spawn(dir, args), 30);
     let what = args.join(" ");
     assert_eq!(status.and_then(|s| s.code()), Some(2), "{what}: {msg}");
     assert!(
@@ -129,7 +110,7 @@ fn bad_output_paths_are_refused_before_the_work() {
     let out = [("file", "file/index.html"), (&ro[..], &ro[..])];
     for (path, shown) in out {
         let args = ["report", "--out", path, "--realizations", LONG];
-        let (status, msg) = wait(spawn(d, &args), 30);
+        let (status, msg) = common::wait_limited(spawn(d, &args), 30);
         assert_eq!(status.and_then(|s| s.code()), Some(2), "{path}: {msg}");
         assert!(msg.contains(&format!("cannot write {shown}")), "{msg}");
     }
@@ -255,7 +236,7 @@ fn a_cancelled_shard_leaves_no_hidden_files() {
             .args([&format!("-{name}"), &pid])
             .status();
         assert!(killed.unwrap().success());
-        let (status, msg) = wait(child, 20);
+        let (status, msg) = common::wait_limited(child, 20);
         let status = status.expect("ended after the signal");
         assert_eq!(status.signal(), Some(signal), "{status:?}: {msg}");
         assert!(

@@ -10,7 +10,7 @@ use accelcal::ensemble::{Engine, Ensemble, EnsembleStats};
 use accelcal::sensitivity::{self, AssumedStatistic, Plan, actual_covariance};
 use accelcal::stats::clopper_pearson;
 use accelcal::study::Silent;
-use common::plain::{M3, mul, transpose};
+use common::plain::{M3, gps_gain, i_minus_kh, mul, transpose};
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
 type M3x = accelcal::state::StateMatrix;
@@ -42,23 +42,9 @@ fn textbook(dt: f64, fix_every: usize, fixes: usize, assumed: [f64; 6], truth: [
             p = add(&mul(&mul(&phi, &p), &transpose(&phi)), &qf);
             pa = add(&mul(&mul(&phi, &pa), &transpose(&phi)), &qt);
         }
-        // S = H P Hᵀ + R with H = [I₂ 0]: the upper-left 2×2 block.
-        let s = [
-            [p[0][0] + assumed[2] * assumed[2], p[0][1]],
-            [p[1][0], p[1][1] + assumed[3] * assumed[3]],
-        ];
-        let det = s[0][0] * s[1][1] - s[0][1] * s[1][0];
-        let s_inv = [
-            [s[1][1] / det, -s[0][1] / det],
-            [-s[1][0] / det, s[0][0] / det],
-        ];
-        // K = P Hᵀ S⁻¹ (3×2).
-        let k: [[f64; 2]; 3] = std::array::from_fn(|i| {
-            std::array::from_fn(|j| p[i][0] * s_inv[0][j] + p[i][1] * s_inv[1][j])
-        });
-        let i_kh: M3 = std::array::from_fn(|i| {
-            std::array::from_fn(|j| f64::from(u8::from(i == j)) - if j < 2 { k[i][j] } else { 0.0 })
-        });
+        // K = P Hᵀ S⁻¹ with H = [I₂ 0], S = H P Hᵀ + R.
+        let k = gps_gain(&p, assumed[2] * assumed[2], assumed[3] * assumed[3]);
+        let i_kh = i_minus_kh(&k);
         let krk = |r: [f64; 2]| -> M3 {
             std::array::from_fn(|i| {
                 std::array::from_fn(|j| k[i][0] * r[0] * k[j][0] + k[i][1] * r[1] * k[j][1])

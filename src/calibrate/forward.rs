@@ -43,6 +43,43 @@ pub struct FilteredFix {
 }
 
 impl FilteredFix {
+    /// The measurement update of the fix `gps` applied at accelerometer sample `sample`, time
+    /// `t_s`, where the accelerometer integrates to `integrated` = (p_c, v_c): the a priori
+    /// estimate `prior` with covariance `p` (before the update) reached by `phi` from the
+    /// previous fix. The one update both the fix-to-fix filter and the per-sample recursion run.
+    ///
+    /// # Errors
+    /// [`FilterError`] when a covariance is not positive definite.
+    pub fn update(
+        model: &ErrorStateModel,
+        gps: &GpsFix,
+        (sample, t_s): (u64, f64),
+        integrated: MeasVector,
+        (prior, p, phi): (StateVector, &StateMatrix, StateMatrix),
+    ) -> Result<Self, FilterError> {
+        let cov = model.update_covariance(p, t_s, phi)?;
+        let z = measurement(gps.position_m, gps.velocity_m_s);
+        // eq. (6): δz = z − (p_c, v_c).
+        let dz = z - integrated;
+        let (post, residual) = model.update_estimate(&cov, &prior, &dz);
+        Ok(FilteredFix {
+            line: gps.line,
+            sample,
+            t_s,
+            z,
+            integrated,
+            prior,
+            post,
+            residual,
+            s: cov.s,
+            nis: (residual.transpose() * cov.s_inv * residual)[0],
+            p_prior: cov.p_prior,
+            p_prior_inv: cov.p_prior_inv,
+            p_post: cov.p_post,
+            phi_from_previous: phi,
+        })
+    }
+
     /// Whether every number the smoother and the report take from the fix is finite.
     pub fn is_finite(&self) -> bool {
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
@@ -212,32 +249,12 @@ impl<'m> Forward<'m> {
             StepMode::PerStep => (self.phi_since_fix, self.x),
         };
         self.phi_since_fix = StateMatrix::identity();
-        let cov = self.model.update_covariance(&self.p, self.t_s, phi)?;
-        let z = measurement(fix.position_m, fix.velocity_m_s);
-        // eq. (6): δz = z − (p_c, v_c).
-        let dz = measurement(
-            z[ErrorState::GPS_POSITION] - self.pc_m,
-            z[ErrorState::GPS_VELOCITY] - self.vc_m_s,
-        );
-        let (post, residual) = self.model.update_estimate(&cov, &prior, &dz);
-        self.x = post;
-        self.p = cov.p_post;
-        self.last_fix = (self.k, self.t_s, post);
-        Ok(FilteredFix {
-            line: fix.line,
-            sample: self.k,
-            t_s: self.t_s,
-            z,
-            integrated: measurement(self.pc_m, self.vc_m_s),
-            prior,
-            post,
-            residual,
-            s: cov.s,
-            nis: (residual.transpose() * cov.s_inv * residual)[0],
-            p_prior: cov.p_prior,
-            p_prior_inv: cov.p_prior_inv,
-            p_post: cov.p_post,
-            phi_from_previous: phi,
-        })
+        let integrated = measurement(self.pc_m, self.vc_m_s);
+        let at = (self.k, self.t_s);
+        let fixed = FilteredFix::update(self.model, fix, at, integrated, (prior, &self.p, phi))?;
+        self.x = fixed.post;
+        self.p = fixed.p_post;
+        self.last_fix = (self.k, self.t_s, fixed.post);
+        Ok(fixed)
     }
 }

@@ -185,32 +185,12 @@ impl FixFilter<'_> {
     fn update(&mut self, fix: &FixAt, gps: &GpsFix) -> Result<FilteredFix, FilterError> {
         let (phi, p) = self.propagate(fix.sample, fix.t_s, &fix.units);
         let prior = phi * self.x;
-        let cov = self.model.update_covariance(&p, fix.t_s, phi)?;
-        let z = measurement(gps.position_m, gps.velocity_m_s);
         let integrated = fix.integrated[mode_index(self.mode)];
-        // eq. (6): δz = z − (p_c, v_c).
-        let dz = measurement(
-            z[ErrorState::GPS_POSITION] - integrated.pc_m,
-            z[ErrorState::GPS_VELOCITY] - integrated.vc_m_s,
-        );
-        let (post, residual) = self.model.update_estimate(&cov, &prior, &dz);
-        (self.x, self.p, self.last) = (post, cov.p_post, (fix.sample, fix.t_s));
-        Ok(FilteredFix {
-            line: gps.line,
-            sample: fix.sample,
-            t_s: fix.t_s,
-            z,
-            integrated: measurement(integrated.pc_m, integrated.vc_m_s),
-            prior,
-            post,
-            residual,
-            s: cov.s,
-            nis: (residual.transpose() * cov.s_inv * residual)[0],
-            p_prior: cov.p_prior,
-            p_prior_inv: cov.p_prior_inv,
-            p_post: cov.p_post,
-            phi_from_previous: phi,
-        })
+        let integrated = measurement(integrated.pc_m, integrated.vc_m_s);
+        let at = (fix.sample, fix.t_s);
+        let fixed = FilteredFix::update(self.model, gps, at, integrated, (prior, &p, phi))?;
+        (self.x, self.p, self.last) = (fixed.post, fixed.p_post, (fix.sample, fix.t_s));
+        Ok(fixed)
     }
 
     /// The estimate and covariance at the log's last sample.

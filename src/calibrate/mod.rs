@@ -375,6 +375,23 @@ impl Prepared<'_> {
         let nis: Vec<f64> = self.fixes.iter().map(|f| f.nis).collect();
         let (bias_model, bias_random_walk_m_s2_per_sqrt_s, bias_correlation_time_s) =
             FilterRecord::bias_fields(f.bias_model);
+        let fixes: Vec<FixReport> = self
+            .fixes
+            .iter()
+            .zip(&self.smoothed)
+            .map(|(f, sm)| FixReport {
+                t_s: f.t_s,
+                z: f.z.into(),
+                integrated: f.integrated.into(),
+                filtered: f.post.into(),
+                filtered_sigma: sigma(&f.p_post),
+                smoothed: sm.x.into(),
+                smoothed_sigma: sigma(&sm.p),
+                residual: f.residual.into(),
+                residual_sigma: std::array::from_fn(|k| f.s[(k, k)].sqrt()),
+                nis: f.nis,
+            })
+            .collect();
         let (lo, hi) = sc.accepted_step_s();
         let summary = Summary {
             accelcal_version: env!("CARGO_PKG_VERSION"),
@@ -411,28 +428,7 @@ impl Prepared<'_> {
                 bias_random_walk_m_s2_per_sqrt_s,
                 bias_correlation_time_s,
             },
-            warnings: Vec::new(),
-        };
-        let fixes: Vec<FixReport> = self
-            .fixes
-            .iter()
-            .zip(&self.smoothed)
-            .map(|(f, sm)| FixReport {
-                t_s: f.t_s,
-                z: f.z.into(),
-                integrated: f.integrated.into(),
-                filtered: f.post.into(),
-                filtered_sigma: sigma(&f.p_post),
-                smoothed: sm.x.into(),
-                smoothed_sigma: sigma(&sm.p),
-                residual: f.residual.into(),
-                residual_sigma: std::array::from_fn(|k| f.s[(k, k)].sqrt()),
-                nis: f.nis,
-            })
-            .collect();
-        let summary = Summary {
             warnings: summary::prior_warnings(fixes.first()),
-            ..summary
         };
         Calibration { summary, fixes }
     }

@@ -5,7 +5,8 @@ pub mod partials;
 pub mod plain;
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::{Child, Command, ExitStatus, Output};
+use std::time::{Duration, Instant};
 
 use accelcal::checks::Verdicts;
 use accelcal::config::{Config, TruthModel};
@@ -58,4 +59,33 @@ pub fn summary_without_timing(path: &Path) -> serde_json::Value {
     let mut v = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
     strip(&mut v);
     v
+}
+
+/// Waits for `child` at most `limit_s` seconds (then kills it: `None`); its status and stderr
+/// (piped by the caller).
+pub fn wait_limited(mut child: Child, limit_s: u64) -> (Option<ExitStatus>, String) {
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break Some(status);
+        }
+        if start.elapsed() > Duration::from_secs(limit_s) {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
+    (status, stderr)
+}
+
+/// An observer that keeps every fix of a realization.
+pub struct Keep(pub Vec<accelcal::simulation::FixState>);
+
+impl accelcal::simulation::Observer for Keep {
+    fn fix(&mut self, f: &accelcal::simulation::FixState) {
+        self.0.push(*f);
+    }
 }

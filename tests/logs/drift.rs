@@ -53,28 +53,10 @@ fn calibrate(dir: &Path, config: &str, logs: (&str, &str), out: &str) -> serde_j
 fn calibrate_printed(
     dir: &Path,
     config: &str,
-    (accel, gps): (&str, &str),
+    logs: (&str, &str),
     out: &str,
 ) -> (serde_json::Value, String) {
-    let args = [
-        "calibrate",
-        "--config",
-        config,
-        "--accel",
-        accel,
-        "--gps",
-        gps,
-        "--out",
-        out,
-        "-q",
-        "--every-sample",
-    ];
-    let o = run(&args, dir);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let summary =
-        serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap())
-            .unwrap();
-    (summary, String::from_utf8(o.stdout).unwrap())
+    super::calibrate_with(dir, &["--config", config], logs, out)
 }
 
 /// The printed line places the NIS sum against its band in words that agree with the verdict:

@@ -58,21 +58,30 @@ pub fn simulate_logs(dir: &Path) {
 /// Calibrates `accel` and `gps` into `dir/out`, the estimates at every sample; returns the
 /// summary.
 pub fn calibrate(dir: &Path, accel: &str, gps: &str, out: &str) -> serde_json::Value {
-    let o = run(
-        &[
-            "calibrate",
-            "--accel",
-            accel,
-            "--gps",
-            gps,
-            "--out",
-            out,
-            "--quiet",
-            "--every-sample",
-        ],
-        dir,
-    );
+    calibrate_with(dir, &[], (accel, gps), out).0
+}
+
+/// [`calibrate`] with more arguments (`--config FILE`, say); returns the summary and the line
+/// the command printed.
+pub fn calibrate_with(
+    dir: &Path,
+    more: &[&str],
+    (accel, gps): (&str, &str),
+    out: &str,
+) -> (serde_json::Value, String) {
+    let logs = ["--accel", accel, "--gps", gps, "--out", out];
+    let args = [
+        &["calibrate"][..],
+        more,
+        &logs,
+        &["--quiet", "--every-sample"],
+    ]
+    .concat();
+    let o = run(&args, dir);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap();
-    serde_json::from_str(&text).unwrap()
+    (
+        serde_json::from_str(&text).unwrap(),
+        String::from_utf8(o.stdout).unwrap(),
+    )
 }
