@@ -7,6 +7,7 @@ use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
 
 use accelcal::config::{AccelerometerOutput, TruthModel};
 use accelcal::ensemble::Engine;
+use accelcal::likelihood::Key;
 
 /// Calibrates an accelerometer's bias with GPS through a Kalman filter, checks the filter with a
 /// Monte Carlo ensemble, and writes the study as a self-contained HTML report.
@@ -205,9 +206,62 @@ pub struct CalibrateArgs {
     /// (reads the accelerometer log a second time: it must be a file, not a pipe).
     #[arg(long)]
     pub every_sample: bool,
+    /// Estimate [filter] noise statistics from the drive by maximum likelihood of the GPS
+    /// innovations (with profile-likelihood intervals), then calibrate with them.
+    #[arg(long)]
+    pub estimate_noise: bool,
+    /// The statistics --estimate-noise searches [default: the two GPS σ's, and
+    /// bias_random_walk_m_s2_per_sqrt_s when the filter's bias is a random walk].
+    #[arg(long, value_name = "KEY,…", value_delimiter = ',', requires = "estimate_noise")]
+    pub estimate: Vec<EstimateArg>,
+    /// The confidence of --estimate-noise's intervals, in (0, 1).
+    #[arg(long, value_name = "P", default_value_t = 0.95, value_parser = confidence,
+          requires = "estimate_noise")]
+    pub confidence: f64,
     /// Print nothing but the result.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+/// A statistic `--estimate` names: its [filter] key.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EstimateArg {
+    /// GPS position noise σ, m.
+    #[value(name = "gps_position_sigma_m")]
+    GpsPositionSigmaM,
+    /// GPS velocity noise σ, m/s.
+    #[value(name = "gps_velocity_sigma_m_s")]
+    GpsVelocitySigmaMS,
+    /// Accelerometer white-noise variance W, (m/s²)².
+    #[value(name = "accel_noise_var_m2_s4")]
+    AccelNoiseVarM2S4,
+    /// The bias's random-walk K, m/s² per √s (a constant bias becomes a random walk).
+    #[value(name = "bias_random_walk_m_s2_per_sqrt_s")]
+    BiasRandomWalk,
+}
+
+impl From<EstimateArg> for Key {
+    fn from(arg: EstimateArg) -> Self {
+        match arg {
+            EstimateArg::GpsPositionSigmaM => Key::GpsPosition,
+            EstimateArg::GpsVelocitySigmaMS => Key::GpsVelocity,
+            EstimateArg::AccelNoiseVarM2S4 => Key::AccelNoiseVar,
+            EstimateArg::BiasRandomWalk => Key::BiasRandomWalk,
+        }
+    }
+}
+
+/// A confidence strictly between 0 and 1.
+fn confidence(text: &str) -> Result<f64, String> {
+    let p: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number; accepted: 0 < P < 1"))?;
+    if p > 0.0 && p < 1.0 {
+        Ok(p)
+    } else {
+        Err(format!("{p} is outside the accepted range 0 < P < 1"))
+    }
 }
 
 /// The values `--truth` accepts, each with its help; parsed into a [`TruthModel`].

@@ -20,6 +20,7 @@ pub mod export;
 pub mod filter;
 pub mod format;
 pub mod lanes;
+pub mod likelihood;
 pub mod logs;
 pub mod model;
 pub mod output;

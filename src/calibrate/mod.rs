@@ -21,6 +21,7 @@
 mod forward;
 mod intervals;
 mod nis;
+pub mod noise;
 pub mod pass;
 mod scan;
 mod smoother;
@@ -80,6 +81,9 @@ pub struct Settings {
     pub nominal_dt_s: f64,
     /// The NIS test's false-alarm rate α (`checks.false_alarm_rate`).
     pub false_alarm_rate: f64,
+    /// Whether the prior comes from the first fix, its σ's the GPS σ's (so P(0) follows them
+    /// when they are estimated).
+    pub prior_from_first_fix: bool,
 }
 
 impl Settings {
@@ -92,6 +96,7 @@ impl Settings {
             filter_stats: model.filter_stats,
             nominal_dt_s: model.timeline.dt_s,
             false_alarm_rate: c.checks.false_alarm_rate,
+            prior_from_first_fix: false,
         }
     }
 }
@@ -127,6 +132,9 @@ pub struct Prepared<'a> {
     smoothed: Vec<SmoothedFix>,
     /// Filtered estimate and covariance at the last sample.
     end: (StateVector, StateMatrix),
+    /// The noise statistics estimated from the drive (`--estimate-noise`), which the filter
+    /// then ran with.
+    noise: Option<crate::likelihood::NoiseEstimate>,
 }
 
 /// One sample of the forward pass as a visitor sees it.
@@ -144,6 +152,25 @@ pub fn prepare<'a>(
     gps: &dyn LogSource,
     settings: &Settings,
 ) -> Result<Prepared<'a>, CalibrateError> {
+    prepare_with(accel, gps, settings, None)
+}
+
+/// [`prepare`], and with `estimate` the noise statistics it names estimated from the drive
+/// first (maximum likelihood over the reduced log), the filter and smoother then run with them.
+///
+/// # Errors
+/// As [`prepare`]; [`CalibrateError::Filter`] when the likelihood is not finite at the
+/// configured statistics, where the search starts.
+pub fn prepare_with<'a>(
+    accel: &'a dyn LogSource,
+    gps: &dyn LogSource,
+    settings: &Settings,
+    estimate: Option<&crate::likelihood::Request>,
+) -> Result<Prepared<'a>, CalibrateError> {
+    let mut settings = settings.clone();
+    if let Some(request) = estimate {
+        settings.filter_stats = noise::prepare_stats(&settings.filter_stats, request);
+    }
     let fixes = read_gps(gps)?;
     let start = pass::Integrated {
         pc_m: settings.position_mean_m,
@@ -152,22 +179,40 @@ pub fn prepare<'a>(
     let steps = (settings.nominal_dt_s, settings.filter_stats.bias_model);
     let reduced = pass::reduce(accel, &fixes, steps, start)?;
     let scan = Scan::of(&reduced, fixes, gps.name())?;
-    let model = ErrorStateModel::new(settings.nominal_dt_s, &settings.filter_stats);
-    let (fixes, end) = intervals::filter(
-        &scan,
-        &reduced,
-        &model,
-        &settings.filter_stats,
-        accel.name(),
-    )?;
+    let run = |stats: &NoiseStats| {
+        let model = ErrorStateModel::new(settings.nominal_dt_s, stats);
+        let filtered = intervals::filter(&scan, &reduced, &model, stats, accel.name())?;
+        Ok::<_, CalibrateError>((model, filtered))
+    };
+    let mut noise = None;
+    if let Some(request) = estimate {
+        let duration_s = scan.span_s.1 - scan.span_s.0;
+        settings.filter_stats = noise::start_stats(&settings.filter_stats, duration_s);
+        let (_, (fixes, _)) = run(&settings.filter_stats)?;
+        let found = noise::estimate(
+            &fixes,
+            &reduced.fixes,
+            &settings.filter_stats,
+            (request, settings.prior_from_first_fix, duration_s),
+        )
+        // The filter just ran at these statistics, so ℓ is finite there unless a determinant
+        // underflows.
+        .ok_or(FilterError::InnovationNotPositiveDefinite {
+            time_s: scan.span_s.0,
+        })?;
+        settings.filter_stats = found.stats;
+        noise = Some(found);
+    }
+    let (model, (fixes, end)) = run(&settings.filter_stats)?;
     Ok(Prepared {
-        settings: settings.clone(),
+        settings,
         model,
         accel,
         smoothed: smoother::backward(&fixes),
         fixes,
         scan,
         end,
+        noise,
     })
 }
 
@@ -429,8 +474,15 @@ impl Prepared<'_> {
                 bias_correlation_time_s,
             },
             warnings: summary::prior_warnings(fixes.first()),
+            log_likelihood: noise::log_likelihood(&self.fixes),
+            noise_estimate: self.noise.clone().map(noise::NoiseRecord),
         };
         Calibration { summary, fixes }
+    }
+
+    /// The noise statistics estimated from the drive, if asked for.
+    pub fn noise_estimate(&self) -> Option<&crate::likelihood::NoiseEstimate> {
+        self.noise.as_ref()
     }
 
     /// Which Δt mode runs.

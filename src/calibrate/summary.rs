@@ -366,6 +366,11 @@ pub struct Summary {
     /// What the user should know before trusting the numbers, in words (empty when nothing):
     /// a prior that disagrees with the first fix ([`prior_warnings`]).
     pub warnings: Vec<String>,
+    /// The filter's Gaussian log-likelihood of its innovations, −½ Σ (ln det(2π S) + NIS).
+    pub log_likelihood: f64,
+    /// The statistics estimated from the drive (`--estimate-noise`), absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_estimate: Option<super::noise::NoiseRecord>,
 }
 
 /// How far, in σ of its innovation, the first fix may lie from the prior's prediction before

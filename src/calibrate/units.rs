@@ -120,6 +120,16 @@ impl NoiseUnits {
         phi
     }
 
+    /// U_W's (δp δp, δp δv, δv δv) entries, (m², m²/s, m²/s²) per (m/s²)².
+    pub fn white(&self) -> [f64; 3] {
+        self.white
+    }
+
+    /// U_b, per unit of the bias's noise scale s_b (zero for a constant bias).
+    pub fn bias(&self) -> StateMatrix {
+        self.bias
+    }
+
     /// Whether every unit is finite.
     pub fn is_finite(&self) -> bool {
         self.white.iter().all(|u| u.is_finite())

@@ -10,6 +10,8 @@ use super::{load_model, write};
 use crate::cli::{CalibrateArgs, CaseArgs, ModelArgs, SimulateArgs};
 use accelcal::calibrate::CalibrateError;
 use accelcal::calibrate::{self, Settings};
+use accelcal::likelihood::{Key, NoiseEstimate, Request};
+use accelcal::state::BiasModel;
 use accelcal::filter::FilterSchedule;
 use accelcal::format::{count, sig};
 use accelcal::logs::read::{LogFile, LogSource};
@@ -123,8 +125,13 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         ))
         .into());
     }
-    note("checking the logs and running the filter and the smoother…");
-    let mut prepared = calibrate::prepare(&accel, &gps, &settings)?;
+    let request = noise_request(args, &settings)?;
+    note(if request.is_some() {
+        "checking the logs, estimating the noise statistics, running the filter and the smoother…"
+    } else {
+        "checking the logs and running the filter and the smoother…"
+    });
+    let mut prepared = calibrate::prepare_with(&accel, &gps, &settings, request.as_ref())?;
     if args.every_sample {
         prepared.per_sample()?;
     }
@@ -159,6 +166,9 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         "constant" => String::new(),
         name => format!(", bias model {name}"),
     };
+    if let Some(e) = prepared.noise_estimate() {
+        super::say(&noise_lines(e))?;
+    }
     super::say(&format!(
         "bias {} ± {} m/s² at t = {} s ({} samples, {} fixes, Δt mode {}{model}); NIS test {} \
          (sum {} {} [{}, {}]); written to {}\n",
@@ -176,6 +186,79 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         args.out.join(PAGE_FILE).display()
     ))?;
     Ok(())
+}
+
+/// A command line that asks for what the filter cannot do.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub(crate) struct UsageError(pub String);
+
+/// What `--estimate-noise` asks for, if it does.
+fn noise_request(args: &CalibrateArgs, settings: &Settings) -> Result<Option<Request>> {
+    if !args.estimate_noise {
+        return Ok(None);
+    }
+    let stats = &settings.filter_stats;
+    let named: Vec<Key> = args.estimate.iter().map(|&k| k.into()).collect();
+    let keys: Vec<Key> = if named.is_empty() {
+        Key::defaults(stats)
+    } else {
+        Key::ALL.into_iter().filter(|k| named.contains(k)).collect()
+    };
+    if keys.contains(&Key::BiasRandomWalk)
+        && matches!(stats.bias_model, BiasModel::GaussMarkov { .. })
+    {
+        return Err(UsageError(format!(
+            "--estimate {}: K is the random walk's statistic, and the filter's bias model is \
+             gauss_markov; estimate it with bias_model = \"random_walk\" or \"constant\" in [filter]",
+            Key::BiasRandomWalk.name()
+        ))
+        .into());
+    }
+    Ok(Some(Request {
+        keys,
+        confidence: args.confidence,
+    }))
+}
+
+/// The printed lines of a noise estimate: each statistic with its interval, or what the drive
+/// leaves open.
+fn noise_lines(e: &NoiseEstimate) -> String {
+    let pct = sig(100.0 * e.confidence, 3);
+    let mut out = format!(
+        "noise statistics by maximum likelihood (ℓ = {}, {} evaluations; {pct} % profile \
+         intervals):\n",
+        sig(e.log_likelihood, 8),
+        count(e.evaluations)
+    );
+    for k in &e.keys {
+        let unit = k.key.unit();
+        let line = if k.identifiable {
+            format!(
+                "  {} = {} {unit}, interval [{}, {}]\n",
+                k.key.name(),
+                sig(k.value, 4),
+                sig(k.lower, 4),
+                sig(k.upper.unwrap_or(f64::NAN), 4)
+            )
+        } else {
+            let known = match (k.lower > 0.0, k.upper) {
+                (false, Some(u)) => format!("only an upper bound is known: ≤ {} {unit}", sig(u, 4)),
+                (true, None) => format!("only a lower bound is known: ≥ {} {unit}", sig(k.lower, 4)),
+                _ => "the interval spans the whole search range".to_string(),
+            };
+            format!(
+                "  {} not identifiable from this drive: {known} (search range [{}, {}]; the \
+                 filter used {})\n",
+                k.key.name(),
+                sig(k.search_bounds[0], 3),
+                sig(k.search_bounds[1], 3),
+                sig(k.value, 4)
+            )
+        };
+        out.push_str(&line);
+    }
+    out
 }
 
 /// Where the NIS sum lies against its band, in the printed line's words: "in", "below" or
@@ -205,6 +288,16 @@ fn calibrate_command(args: &CalibrateArgs) -> String {
     s.push_str(&format!(" --out {}", args.out.display()));
     if args.every_sample {
         s.push_str(" --every-sample");
+    }
+    if args.estimate_noise {
+        s.push_str(" --estimate-noise");
+        if !args.estimate.is_empty() {
+            let keys: Vec<&str> = args.estimate.iter().map(|&k| Key::from(k).name()).collect();
+            s.push_str(&format!(" --estimate {}", keys.join(",")));
+        }
+        if args.confidence != 0.95 {
+            s.push_str(&format!(" --confidence {}", args.confidence));
+        }
     }
     s
 }

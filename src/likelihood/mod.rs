@@ -1,0 +1,279 @@
+//! Noise statistics from a drive: the maximum of the GPS innovations' Gaussian log-likelihood
+//! over named `[filter]` statistics, with profile-likelihood intervals.
+//!
+//! The innovations of a correctly tuned filter are white with covariance S, so the statistics
+//! that maximise ℓ(θ) = −½ Σᵢ (ln det(2π Sᵢ) + rᵢᵀ Sᵢ⁻¹ rᵢ) are those the drive supports. The
+//! drive enters only through one [`Interval`] per fix, reduced from the log once; each
+//! evaluation of ℓ runs the filter's recursion over them (O(fixes)).
+//!
+//! The search runs over the statistics' logarithms, within a box around the configured values
+//! (×10^±3 for a σ or K, ×10^±6 for the variance W). An interval end that reaches the box is
+//! open: the data bound the statistic there no more than the search does, and the statistic is
+//! reported as not identifiable.
+
+pub mod evaluate;
+mod profile;
+mod search;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+pub use evaluate::{Drive, Interval};
+pub use profile::ProfilePoint;
+use search::Objective;
+
+use crate::state::{BiasModel, NoiseStats};
+use crate::stats::{Tail, chi_squared_quantile};
+
+/// A statistic the search can estimate: its `[filter]` key.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Key {
+    /// `gps_position_sigma_m`, σ_p.
+    GpsPosition,
+    /// `gps_velocity_sigma_m_s`, σ_v.
+    GpsVelocity,
+    /// `accel_noise_var_m2_s4`, W.
+    AccelNoiseVar,
+    /// `bias_random_walk_m_s2_per_sqrt_s`, K.
+    BiasRandomWalk,
+}
+
+impl Key {
+    /// Every key, in the order of `summary.json`.
+    pub const ALL: [Key; 4] = [
+        Key::GpsPosition,
+        Key::GpsVelocity,
+        Key::AccelNoiseVar,
+        Key::BiasRandomWalk,
+    ];
+
+    /// The `[filter]` key.
+    pub fn name(self) -> &'static str {
+        match self {
+            Key::GpsPosition => "gps_position_sigma_m",
+            Key::GpsVelocity => "gps_velocity_sigma_m_s",
+            Key::AccelNoiseVar => "accel_noise_var_m2_s4",
+            Key::BiasRandomWalk => "bias_random_walk_m_s2_per_sqrt_s",
+        }
+    }
+
+    /// The symbol in the report's notation.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            Key::GpsPosition => "σ_p",
+            Key::GpsVelocity => "σ_v",
+            Key::AccelNoiseVar => "W",
+            Key::BiasRandomWalk => "K",
+        }
+    }
+
+    /// The SI unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Key::GpsPosition => "m",
+            Key::GpsVelocity => "m/s",
+            Key::AccelNoiseVar => "(m/s²)²",
+            Key::BiasRandomWalk => "m/s²/√s",
+        }
+    }
+
+    /// The key of a `[filter]` name.
+    pub fn parse(name: &str) -> Option<Key> {
+        Key::ALL.into_iter().find(|k| k.name() == name.trim())
+    }
+
+    /// The search's half-width in decades around the configured value: 3 for a σ or K, 6 for
+    /// the variance W (3 decades of its σ).
+    pub fn decades(self) -> f64 {
+        match self {
+            Key::AccelNoiseVar => 6.0,
+            _ => 3.0,
+        }
+    }
+
+    /// The statistic's value in `stats` (K: 0 unless the bias is a random walk).
+    pub fn get(self, stats: &NoiseStats) -> f64 {
+        match self {
+            Key::GpsPosition => stats.gps_position_sigma_m,
+            Key::GpsVelocity => stats.gps_velocity_sigma_m_s,
+            Key::AccelNoiseVar => stats.accel_noise_var_m2_s4,
+            Key::BiasRandomWalk => match stats.bias_model {
+                BiasModel::RandomWalk { k_m_s2_per_sqrt_s } => k_m_s2_per_sqrt_s,
+                _ => 0.0,
+            },
+        }
+    }
+
+    /// `stats` with the statistic set to `value` (K makes the bias a random walk).
+    pub fn set(self, stats: &mut NoiseStats, value: f64) {
+        match self {
+            Key::GpsPosition => stats.gps_position_sigma_m = value,
+            Key::GpsVelocity => stats.gps_velocity_sigma_m_s = value,
+            Key::AccelNoiseVar => stats.accel_noise_var_m2_s4 = value,
+            Key::BiasRandomWalk => {
+                stats.bias_model = BiasModel::RandomWalk {
+                    k_m_s2_per_sqrt_s: value,
+                }
+            }
+        }
+    }
+
+    /// The keys estimated when none are named: the two GPS σ's, and K when the filter's bias
+    /// is a random walk.
+    pub fn defaults(stats: &NoiseStats) -> Vec<Key> {
+        let mut keys = vec![Key::GpsPosition, Key::GpsVelocity];
+        if matches!(stats.bias_model, BiasModel::RandomWalk { .. }) {
+            keys.push(Key::BiasRandomWalk);
+        }
+        keys
+    }
+}
+
+/// What to estimate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Request {
+    /// The statistics searched, each once, in [`Key::ALL`]'s order.
+    pub keys: Vec<Key>,
+    /// The intervals' confidence, in (0, 1).
+    pub confidence: f64,
+}
+
+/// The search's box for one statistic: the configured value (for K with no random walk
+/// configured, √(σ_b²/duration), the drift that would move the bias by its prior σ over the
+/// drive) times 10^±decades.
+pub fn search_bounds(key: Key, stats: &NoiseStats, duration_s: f64) -> (f64, f64) {
+    let mut center = key.get(stats);
+    if key == Key::BiasRandomWalk && center <= 0.0 {
+        center = (stats.bias_var_m2_s4 / duration_s.max(f64::MIN_POSITIVE)).sqrt();
+    }
+    let f = 10f64.powf(key.decades());
+    (center / f, center * f)
+}
+
+/// One statistic's estimate.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct KeyEstimate {
+    /// The maximum-likelihood value, which the calibration uses (at a bound of the search when
+    /// the data do not determine it: see `identifiable`).
+    pub value: f64,
+    /// The interval's lower end; 0 when it reached the search's lower bound (only an upper
+    /// bound is known).
+    pub lower: f64,
+    /// The upper end; `null` when it reached the search's upper bound.
+    pub upper: Option<f64>,
+    /// Whether both ends lie strictly inside the search's bounds: only then does the drive
+    /// measure the statistic.
+    pub identifiable: bool,
+    /// The search's bounds.
+    pub search_bounds: [f64; 2],
+    /// The likelihood profile: the statistic's values and −2·Δℓ there, in increasing order.
+    #[serde(skip)]
+    pub profile: Vec<(f64, f64)>,
+    /// The statistic.
+    #[serde(skip)]
+    pub key: Key,
+}
+
+/// The maximum-likelihood estimate of the requested statistics.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NoiseEstimate {
+    /// ℓ at the maximum.
+    pub log_likelihood: f64,
+    /// Evaluations of ℓ in all (search and intervals).
+    pub evaluations: u64,
+    /// The intervals' confidence.
+    pub confidence: f64,
+    /// −2·Δℓ at an interval's ends: the χ²₁ quantile at `confidence`.
+    pub deviance_threshold: f64,
+    /// Each statistic, in the request's order.
+    pub keys: Vec<KeyEstimate>,
+    /// The filter's statistics with the estimates in place.
+    pub stats: NoiseStats,
+}
+
+/// Maximises the likelihood of `drive` over `request`'s statistics, the others held at their
+/// values in `start` (also the search's starting point and the centre of its box), and
+/// computes each statistic's profile-likelihood interval. `duration_s` sets K's box when no
+/// random walk is configured.
+///
+/// Returns `None` when ℓ is not finite at the start (a covariance not positive definite).
+pub fn estimate(
+    drive: &Drive,
+    start: &NoiseStats,
+    request: &Request,
+    duration_s: f64,
+) -> Option<NoiseEstimate> {
+    let keys = &request.keys;
+    let bounds: Vec<(f64, f64)> = keys
+        .iter()
+        .map(|&k| search_bounds(k, start, duration_s))
+        .collect();
+    let stats_at = |u: &[f64]| {
+        let mut s = *start;
+        for (k, x) in keys.iter().zip(u) {
+            k.set(&mut s, x.exp());
+        }
+        s
+    };
+    let f = |u: &[f64]| drive.log_likelihood(&stats_at(u));
+    let lo: Vec<f64> = bounds.iter().map(|b| b.0.ln()).collect();
+    let hi: Vec<f64> = bounds.iter().map(|b| b.1.ln()).collect();
+    let u0: Vec<f64> = keys
+        .iter()
+        .zip(&bounds)
+        .map(|(k, b)| match k.get(start) {
+            v if v > 0.0 => v.ln(),
+            _ => (b.0 * b.1).sqrt().ln(),
+        })
+        .collect();
+    let objective = Objective::new(&f, lo.clone(), hi.clone());
+    if !objective.value(&u0).is_finite() {
+        return None;
+    }
+    let free: Vec<usize> = (0..keys.len()).collect();
+    let best = objective.maximize(&u0, &free);
+    let q = chi_squared_quantile(1.0, request.confidence, Tail::Lower);
+    let ends: Vec<profile::End> = (0..2 * keys.len())
+        .into_par_iter()
+        .map(|e| {
+            let side = if e % 2 == 0 { -1.0 } else { 1.0 };
+            profile::interval_end(&f, (&lo, &hi), &best, &free, (e / 2, side, q))
+        })
+        .collect();
+    let evaluations = objective.evaluations() + ends.iter().map(|e| e.evaluations).sum::<u64>();
+    let estimates = keys
+        .iter()
+        .enumerate()
+        .map(|(j, &key)| key_estimate(key, (best.u[j], lo[j], hi[j]), &ends[2 * j..2 * j + 2]))
+        .collect();
+    Some(NoiseEstimate {
+        log_likelihood: best.value,
+        evaluations,
+        confidence: request.confidence,
+        deviance_threshold: q,
+        keys: estimates,
+        stats: stats_at(&best.u),
+    })
+}
+
+/// One statistic's estimate from its maximum `u` (a logarithm) within [lo, hi] and its two
+/// interval ends.
+fn key_estimate(key: Key, (u, lo, hi): (f64, f64, f64), ends: &[profile::End]) -> KeyEstimate {
+    let (lower, upper) = (ends[0].at, ends[1].at);
+    let inside = |x: Option<f64>| x.is_some_and(|x| x > lo && x < hi);
+    let mut profile: Vec<(f64, f64)> = ends
+        .iter()
+        .flat_map(|e| e.points.iter().map(|p| (p.u.exp(), p.deviance)))
+        .chain([(u.exp(), 0.0)])
+        .collect();
+    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
+    KeyEstimate {
+        value: u.exp(),
+        lower: lower.filter(|&x| x > lo).map_or(0.0, f64::exp),
+        upper: upper.filter(|&x| x < hi).map(f64::exp),
+        identifiable: inside(lower) && inside(upper),
+        search_bounds: [lo.exp(), hi.exp()],
+        profile,
+        key,
+    }
+}
