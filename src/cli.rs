@@ -212,7 +212,12 @@ pub struct CalibrateArgs {
     pub estimate_noise: bool,
     /// The statistics --estimate-noise searches [default: the two GPS σ's, and
     /// bias_random_walk_m_s2_per_sqrt_s when the filter's bias is a random walk].
-    #[arg(long, value_name = "KEY,…", value_delimiter = ',', requires = "estimate_noise")]
+    #[arg(
+        long,
+        value_name = "KEY,…",
+        value_delimiter = ',',
+        requires = "estimate_noise"
+    )]
     pub estimate: Vec<EstimateArg>,
     /// The confidence of --estimate-noise's intervals, in (0, 1).
     #[arg(long, value_name = "P", default_value_t = 0.95, value_parser = confidence,

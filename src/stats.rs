@@ -149,6 +149,20 @@ pub fn clopper_pearson(successes: u64, trials: u64, confidence: f64) -> (f64, f6
     (lower, upper)
 }
 
+/// The two-sided band of the number of successes among `n` trials of probability `p` at
+/// false-alarm rate `alpha`: the counts with at most alpha/2 probability below the lower end
+/// and at most alpha/2 above the upper end.
+pub fn binomial_band(n: u64, p: f64, alpha: f64) -> (u64, u64) {
+    use statrs::distribution::{Binomial, DiscreteCDF};
+    let b = Binomial::new(p, n).expect("p in [0, 1]");
+    let lower = (0..=n).find(|&k| b.cdf(k) > alpha / 2.0).unwrap_or(0);
+    let upper = (0..=n)
+        .rev()
+        .find(|&k| k == 0 || b.cdf(k - 1) < 1.0 - alpha / 2.0)
+        .unwrap_or(n);
+    (lower, upper)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -51,19 +51,7 @@ pub struct Coverage {
     pub k_nominal_scatter_ratio: f64,
 }
 
-/// The two-sided band of the number of successes among `n` trials of probability `p` at
-/// false-alarm rate `alpha`: the counts with at most alpha/2 probability below the lower end
-/// and at most alpha/2 above the upper end.
-pub fn binomial_band(n: u64, p: f64, alpha: f64) -> (u64, u64) {
-    use statrs::distribution::{Binomial, DiscreteCDF};
-    let b = Binomial::new(p, n).expect("p in [0, 1]");
-    let lower = (0..=n).find(|&k| b.cdf(k) > alpha / 2.0).unwrap_or(0);
-    let upper = (0..=n)
-        .rev()
-        .find(|&k| k == 0 || b.cdf(k - 1) < 1.0 - alpha / 2.0)
-        .unwrap_or(n);
-    (lower, upper)
-}
+pub use crate::stats::binomial_band;
 
 /// Whether the interval of `term` in `a` contains `truth`; `nominal` takes the fit's nominal
 /// standard error instead of the sandwich one.

@@ -48,10 +48,7 @@ pub fn drive(filtered: &[FilteredFix], reduced: &[FixAt], prior_from_first_fix: 
                 phi: rows(&f.phi_from_previous),
                 white: r.units.white(),
                 bias: rows(&r.units.bias()),
-                dz: [
-                    dz[ErrorState::GPS_POSITION],
-                    dz[ErrorState::GPS_VELOCITY],
-                ],
+                dz: [dz[ErrorState::GPS_POSITION], dz[ErrorState::GPS_VELOCITY]],
             }
         })
         .collect();

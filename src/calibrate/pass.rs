@@ -228,16 +228,32 @@ fn parse_group(layout: &Layout<2>, group: &[Message], mut spare: Vec<Parsed>) ->
         .iter()
         .map(|_| spare.pop().unwrap_or_default())
         .collect();
-    out.par_iter_mut()
-        .zip(group)
-        .for_each(|((rows, error), m)| {
-            rows.clear();
-            *error = match m {
-                Ok(block) => parse_block(layout, block, rows).err(),
-                Err(e) => Some(e.clone()),
-            };
-        });
+    let parse = |((rows, error), m): (&mut Parsed, &Message)| {
+        rows.clear();
+        *error = match m {
+            Ok(block) => parse_block(layout, block, rows).err(),
+            Err(e) => Some(e.clone()),
+        };
+    };
+    if on_pool() {
+        out.iter_mut().zip(group).for_each(parse);
+    } else {
+        out.par_iter_mut().zip(group).for_each(parse);
+    }
     out
+}
+
+/// Whether the pass was started on a worker of the thread pool (a calibration among others run
+/// in parallel): then it parses and stitches on its own threads only, since the pool's workers
+/// may all be blocked in passes of their own, waiting for blocks that only this pass's reading
+/// thread sends. The numbers are the same either way.
+fn on_pool() -> bool {
+    ON_POOL.with(|p| p.get())
+}
+
+thread_local! {
+    /// Set on the stitching thread of a pass started on a pool worker.
+    static ON_POOL: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// Stitches parsed blocks in order; stops at the first problem.
@@ -271,10 +287,18 @@ fn stitch_all(
         {
             group.push(more);
         }
-        let (next, stitched) = rayon::join(
-            || parse_group(layout, &group, std::mem::take(&mut spare)),
-            || stitch_group(&parsed, stitch),
-        );
+        let (next, stitched) = if on_pool() {
+            let stitched = stitch_group(&parsed, stitch);
+            (
+                parse_group(layout, &group, std::mem::take(&mut spare)),
+                stitched,
+            )
+        } else {
+            rayon::join(
+                || parse_group(layout, &group, std::mem::take(&mut spare)),
+                || stitch_group(&parsed, stitch),
+            )
+        };
         stitched?;
         for block in group.drain(..).flatten() {
             // The reader may have stopped; a buffer it does not take is dropped.
@@ -334,7 +358,11 @@ pub fn reduce(
     let (used_tx, used) = mpsc::channel::<Vec<u8>>();
     std::thread::scope(|scope| {
         let (layout, stitch) = (&layout, &mut stitch);
-        let worker = scope.spawn(move || stitch_all(layout, (&rx, &used_tx), stitch));
+        let pool = rayon::current_thread_index().is_some();
+        let worker = scope.spawn(move || {
+            ON_POOL.with(|p| p.set(pool));
+            stitch_all(layout, (&rx, &used_tx), stitch)
+        });
         // The reading stays on this thread (a source need not be sendable); it stops when the
         // text ends, fails, or the stitching stopped at a problem.
         loop {

@@ -10,16 +10,16 @@ use super::{load_model, write};
 use crate::cli::{CalibrateArgs, CaseArgs, ModelArgs, SimulateArgs};
 use accelcal::calibrate::CalibrateError;
 use accelcal::calibrate::{self, Settings};
-use accelcal::likelihood::{Key, NoiseEstimate, Request};
-use accelcal::state::BiasModel;
 use accelcal::filter::FilterSchedule;
 use accelcal::format::{count, sig};
+use accelcal::likelihood::{Key, NoiseEstimate, Request};
 use accelcal::logs::read::{LogFile, LogSource};
 use accelcal::logs::write::LogWriter;
 use accelcal::logs::{ACCEL_FILE, GPS_FILE, TRUTH_FILE};
 use accelcal::logs::{LogError, LogProblem};
 use accelcal::model::Model;
 use accelcal::output::{StagedFiles, check_directory, check_file};
+use accelcal::state::BiasModel;
 use accelcal::{export, realization, report, simulation};
 use anyhow::{Context, Result};
 
@@ -156,7 +156,16 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         .write_all(page.as_bytes())
         .with_context(|| into(PAGE_FILE))?;
     staged.commit()?;
-    let s = &cal.summary;
+    print_result(args, &cal.summary, prepared.noise_estimate())
+}
+
+/// The printed result of a calibration: its warnings on standard error, the noise estimate's
+/// lines and the bias with the NIS test on standard output.
+fn print_result(
+    args: &CalibrateArgs,
+    s: &calibrate::summary::Summary,
+    noise: Option<&NoiseEstimate>,
+) -> Result<()> {
     // Warnings go to standard error even with --quiet: they are about the numbers, not progress.
     for w in &s.warnings {
         eprintln!("warning: {w}");
@@ -166,7 +175,7 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         "constant" => String::new(),
         name => format!(", bias model {name}"),
     };
-    if let Some(e) = prepared.noise_estimate() {
+    if let Some(e) = noise {
         super::say(&noise_lines(e))?;
     }
     super::say(&format!(
@@ -244,7 +253,9 @@ fn noise_lines(e: &NoiseEstimate) -> String {
         } else {
             let known = match (k.lower > 0.0, k.upper) {
                 (false, Some(u)) => format!("only an upper bound is known: ≤ {} {unit}", sig(u, 4)),
-                (true, None) => format!("only a lower bound is known: ≥ {} {unit}", sig(k.lower, 4)),
+                (true, None) => {
+                    format!("only a lower bound is known: ≥ {} {unit}", sig(k.lower, 4))
+                }
                 _ => "the interval spans the whole search range".to_string(),
             };
             format!(

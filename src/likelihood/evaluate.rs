@@ -70,7 +70,11 @@ impl Drive {
                 stats.initial_velocity_sigma_m_s.powi(2),
             )
         };
-        let mut p: M3 = [[p0, 0.0, 0.0], [0.0, v0, 0.0], [0.0, 0.0, stats.bias_var_m2_s4]];
+        let mut p: M3 = [
+            [p0, 0.0, 0.0],
+            [0.0, v0, 0.0],
+            [0.0, 0.0, stats.bias_var_m2_s4],
+        ];
         let mut x = [0.0; 3];
         let ln_2pi = (2.0 * std::f64::consts::PI).ln();
         let mut sum = 0.0;
@@ -88,7 +92,11 @@ impl Drive {
                     }
                 }
             }
-            let (s00, s01, s11) = (pm[0][0] + r[0], 0.5 * (pm[0][1] + pm[1][0]), pm[1][1] + r[1]);
+            let (s00, s01, s11) = (
+                pm[0][0] + r[0],
+                0.5 * (pm[0][1] + pm[1][0]),
+                pm[1][1] + r[1],
+            );
             let det = s00 * s11 - s01 * s01;
             if !(det > 0.0 && s00 > 0.0) {
                 return f64::NEG_INFINITY;
@@ -107,13 +115,9 @@ impl Drive {
             x = std::array::from_fn(|i| xm[i] + gain[i][0] * res[0] + gain[i][1] * res[1]);
             // P⁺ = P⁻ − K·(H·P⁻): K·S·Kᵀ with S·Kᵀ = H·P⁻.
             let upper: M3 = std::array::from_fn(|i| {
-                std::array::from_fn(|j| {
-                    pm[i][j] - gain[i][0] * pm[0][j] - gain[i][1] * pm[1][j]
-                })
+                std::array::from_fn(|j| pm[i][j] - gain[i][0] * pm[0][j] - gain[i][1] * pm[1][j])
             });
-            p = std::array::from_fn(|i| {
-                std::array::from_fn(|j| 0.5 * (upper[i][j] + upper[j][i]))
-            });
+            p = std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (upper[i][j] + upper[j][i])));
         }
         if sum.is_finite() {
             -0.5 * sum

@@ -31,7 +31,13 @@ pub struct End {
 
 /// The profile of variable `j` at `u_j` = `t`: the maximum over the other variables of
 /// `free`, from `warm`.
-fn profile_at(objective: &Objective<'_>, free: &[usize], j: usize, t: f64, warm: &[f64]) -> Maximum {
+fn profile_at(
+    objective: &Objective<'_>,
+    free: &[usize],
+    j: usize,
+    t: f64,
+    warm: &[f64],
+) -> Maximum {
     let mut u = warm.to_vec();
     u[j] = t;
     let others: Vec<usize> = free.iter().copied().filter(|&i| i != j).collect();
@@ -168,7 +174,11 @@ mod tests {
         let o = Objective::new(&f, lo.clone(), hi.clone());
         let best = o.maximize(&[1.0, 1.0], &[0, 1]);
         let q = 3.841_458_820_694_124;
-        for (j, side, want) in [(0, -1.0, -1.96), (0, 1.0, 1.96), (1, -1.0, -1.96 * 2f64.sqrt())] {
+        for (j, side, want) in [
+            (0, -1.0, -1.96),
+            (0, 1.0, 1.96),
+            (1, -1.0, -1.96 * 2f64.sqrt()),
+        ] {
             let e = interval_end(&f, (&lo, &hi), &best, &[0, 1], (j, side, q));
             let at = e.at.expect("a closed end");
             assert!((at - want).abs() < 2e-3, "{j} {side}: {at} against {want}");

@@ -111,7 +111,9 @@ impl<'f> Objective<'f> {
             let moving: Vec<usize> = free
                 .iter()
                 .copied()
-                .filter(|&i| !(u[i] <= self.lo[i] && g[i] < 0.0 || u[i] >= self.hi[i] && g[i] > 0.0))
+                .filter(|&i| {
+                    !(u[i] <= self.lo[i] && g[i] < 0.0 || u[i] >= self.hi[i] && g[i] > 0.0)
+                })
                 .collect();
             if moving.is_empty() {
                 break;
@@ -173,7 +175,11 @@ fn newton_step(g: &[f64], h: &[Vec<f64>], moving: &[usize]) -> Vec<f64> {
             }
             break;
         }
-        lambda = if lambda == 0.0 { 1e-8 * scale } else { lambda * 4.0 };
+        lambda = if lambda == 0.0 {
+            1e-8 * scale
+        } else {
+            lambda * 4.0
+        };
     }
     let longest = d.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
     if longest > MAX_STEP {
@@ -218,6 +224,10 @@ mod tests {
         let f = |u: &[f64]| -(100.0 * (u[1] - u[0] * u[0]).powi(2) + (1.0 - u[0]).powi(2));
         let o = Objective::new(&f, vec![-5.0; 2], vec![5.0; 2]);
         let m = o.maximize(&[-1.2, 1.0], &[0, 1]);
-        assert!((m.u[0] - 1.0).abs() < 1e-3 && (m.u[1] - 1.0).abs() < 1e-3, "{:?}", m.u);
+        assert!(
+            (m.u[0] - 1.0).abs() < 1e-3 && (m.u[1] - 1.0).abs() < 1e-3,
+            "{:?}",
+            m.u
+        );
     }
 }
