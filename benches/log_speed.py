@@ -7,6 +7,7 @@ accelerometer rows, 103 MB; 18 000 fixes) and its gzip copy, then times, each th
 
 - `calibrate` with its default outputs (wall time and peak resident size, /usr/bin/time);
 - the same on the .csv.gz log, and through a pipe (`--accel <(gzip -dc …)`);
+- `calibrate --estimate-noise`, with the two GPS σ's and with all four statistics;
 - `calibrate --every-sample` (MB/s of estimates.csv written);
 - `pandas.read_csv` of the accelerometer log (the peer: a Python user's first step);
 - the one pass alone in MB/s, with 1 and 2 threads (`cargo bench --bench log_read`).
@@ -98,6 +99,19 @@ def main():
     runs = {
         "calibrate (default outputs)": base + ["--accel", "logs/accelerometer.csv", "--out", "o"],
         "calibrate, .csv.gz": base + ["--accel", "logs/accelerometer.csv.gz", "--out", "o"],
+        "calibrate --estimate-noise (two GPS σ's)": base
+        + ["--accel", "logs/accelerometer.csv", "--out", "o", "--estimate-noise"],
+        "calibrate --estimate-noise (σ_p, σ_v, W, K)": base
+        + [
+            "--accel",
+            "logs/accelerometer.csv",
+            "--out",
+            "o",
+            "--estimate-noise",
+            "--estimate",
+            "gps_position_sigma_m,gps_velocity_sigma_m_s,accel_noise_var_m2_s4,"
+            "bias_random_walk_m_s2_per_sqrt_s",
+        ],
     }
     rows = []
     for label, command in runs.items():

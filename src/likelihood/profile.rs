@@ -49,7 +49,7 @@ fn profile_at(
             hessian: Vec::new(),
         };
     }
-    objective.maximize(&u, &others)
+    objective.climb(&u, &others)
 }
 
 /// The end of variable `j`'s interval on the side `side` (−1 below the maximum, +1 above) at
@@ -80,10 +80,17 @@ pub fn interval_end(
     let mut delta = wald_half_width(best, free, j, q).min(room);
     let mut below = (0.0, 0.0_f64);
     let mut above: Option<(f64, f64)> = None;
+    let ridge = ridge(best, free, j);
     let mut warm = best.u.clone();
     for _ in 0..MAX_POINTS {
         let t = u0 + side * delta;
-        let m = profile_at(&objective, free, j, t, &warm);
+        // The others start on the ridge of the quadratic model through the last point below.
+        let start: Vec<f64> = warm
+            .iter()
+            .zip(&ridge)
+            .map(|(w, r)| w + (t - warm[j]) * r)
+            .collect();
+        let m = profile_at(&objective, free, j, t, &start);
         let deviance = (2.0 * (best.value - m.value)).max(0.0);
         end.points.push(ProfilePoint { u: t, deviance });
         if (deviance - q).abs() <= DEVIANCE_TOLERANCE {
@@ -107,6 +114,30 @@ pub fn interval_end(
     }
     end.evaluations = objective.evaluations();
     end
+}
+
+/// How the other variables move with variable `j` along the ridge of the quadratic model at
+/// `best`: du_o/du_j = −H_oo⁻¹·H_oj (1 for j itself, 0 where the Hessian says nothing).
+fn ridge(best: &Maximum, free: &[usize], j: usize) -> Vec<f64> {
+    let mut r = vec![0.0; best.u.len()];
+    r[j] = 1.0;
+    let others: Vec<usize> = free.iter().copied().filter(|&i| i != j).collect();
+    if best.hessian.is_empty() || others.is_empty() {
+        return r;
+    }
+    let m = others.len();
+    let h = &best.hessian;
+    let a = nalgebra::DMatrix::from_fn(m, m, |x, y| -h[others[x]][others[y]]);
+    let b = nalgebra::DVector::from_fn(m, |x, _| h[others[x]][j]);
+    if let Some(c) = a.cholesky() {
+        let d = c.solve(&b);
+        for (x, &i) in others.iter().enumerate() {
+            if d[x].is_finite() {
+                r[i] = d[x];
+            }
+        }
+    }
+    r
 }
 
 /// The Wald half-width √(q·(−H⁻¹)ⱼⱼ) over the variables `free`; 1 when the Hessian is not

@@ -99,14 +99,23 @@ impl<'f> Objective<'f> {
         (g, h)
     }
 
-    /// The maximum over the variables `free`, from `u0` (the others held at `u0`'s values).
+    /// The maximum over the variables `free`, from `u0` (the others held at `u0`'s values),
+    /// with the Hessian there.
     pub fn maximize(&self, u0: &[f64], free: &[usize]) -> Maximum {
+        let mut m = self.climb(u0, free);
+        let (_, hessian) = self.derivatives(&m.u, m.value, free);
+        m.hessian = hessian;
+        m
+    }
+
+    /// The maximum over the variables `free`, from `u0`, without its Hessian (empty): a
+    /// profile's inner search, which needs the value only.
+    pub fn climb(&self, u0: &[f64], free: &[usize]) -> Maximum {
         let mut u = u0.to_vec();
         self.clamp(&mut u);
         let mut fu = self.value(&u);
-        let mut derivatives = self.derivatives(&u, fu, free);
         for _ in 0..MAX_ITERATIONS {
-            let (g, h) = &derivatives;
+            let (g, h) = self.derivatives(&u, fu, free);
             // Variables at a bound whose gradient points out of the box stay there.
             let moving: Vec<usize> = free
                 .iter()
@@ -118,13 +127,12 @@ impl<'f> Objective<'f> {
             if moving.is_empty() {
                 break;
             }
-            let d = newton_step(g, h, &moving);
+            let d = newton_step(&g, &h, &moving);
             let Some((un, fnew)) = self.line_search(&u, fu, &d) else {
                 break;
             };
             let gain = fnew - fu;
             (u, fu) = (un, fnew);
-            derivatives = self.derivatives(&u, fu, free);
             if gain < GAIN_TOLERANCE {
                 break;
             }
@@ -132,7 +140,7 @@ impl<'f> Objective<'f> {
         Maximum {
             u,
             value: fu,
-            hessian: derivatives.1,
+            hessian: Vec::new(),
         }
     }
 
