@@ -7,6 +7,7 @@
 
 pub mod analysis;
 pub mod drift;
+pub mod drive;
 pub mod noise;
 
 use crate::checks::{self, Budget, Verdicts};

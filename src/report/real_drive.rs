@@ -1,0 +1,220 @@
+//! The section "A real drive": the shipped minute of comma2k19 calibrated as a user would, with
+//! the noise statistics estimated from the drive.
+
+use serde::Serialize;
+
+use super::figures::figure;
+use super::outline::{Figure, Numbers, Table};
+use super::view::FigureView;
+use super::{RenderError, rich};
+use crate::format::{fixed, sig};
+use crate::likelihood::KeyEstimate;
+use crate::plot;
+use crate::study::drive::{Axis, DRIVE_DIR, DriveRun};
+
+/// One run's row of the section's table.
+#[derive(Clone, Debug, Serialize)]
+pub struct DriveRow {
+    /// The accelerometer log and the filter's bias model, in words.
+    pub run: String,
+    /// The statistics estimated, each with its interval or what the drive leaves open.
+    pub estimates: Vec<String>,
+    /// The bias at the end ± σ, m/s², and its 95 % interval.
+    pub bias: String,
+    /// The smoothed bias at the start ± σ.
+    pub bias_start: String,
+    /// The NIS sum against its band.
+    pub nis: String,
+    /// `pass` or `fail`.
+    pub verdict: String,
+}
+
+/// The section's view.
+#[derive(Clone, Debug, Serialize)]
+pub struct RealDriveView {
+    /// The table's number.
+    pub table_number: usize,
+    /// Where the files are shipped.
+    pub dir: String,
+    /// Samples, fixes and duration of the drive, in words.
+    pub extent: String,
+    /// The runs.
+    pub rows: Vec<DriveRow>,
+    /// The figures: the bias of the gravity-compensated run with W, and of the raw run with a
+    /// random walk.
+    pub figures: Vec<FigureView>,
+    /// What the numbers say, as HTML paragraphs' text.
+    pub findings_html: Vec<String>,
+}
+
+/// An estimate in words: value and interval, or what the drive leaves open.
+pub fn estimate_words(k: &KeyEstimate) -> String {
+    let name = k.key.symbol();
+    let unit = k.key.unit();
+    if k.identifiable {
+        format!(
+            "{name} = {} [{}, {}] {unit}",
+            sig(k.value, 3),
+            sig(k.lower, 3),
+            sig(k.upper.unwrap_or(f64::NAN), 3)
+        )
+    } else {
+        match (k.lower > 0.0, k.upper) {
+            (false, Some(u)) => format!("{name} not identifiable: ≤ {} {unit}", sig(u, 3)),
+            (true, None) => format!("{name} not identifiable: ≥ {} {unit}", sig(k.lower, 3)),
+            _ => format!("{name} not identifiable"),
+        }
+    }
+}
+
+fn run_words(r: &DriveRun) -> String {
+    let axis = match r.axis {
+        Axis::GravityCompensated => "gravity-compensated",
+        Axis::Raw => "raw",
+    };
+    format!("{axis} axis, {} bias", r.bias_model.name().replace('_', " "))
+}
+
+fn row(r: &DriveRun) -> DriveRow {
+    let s = &r.calibration.summary;
+    let b = (s.bias_m_s2, s.bias_sigma_m_s2);
+    let start = &s.start_smoothed;
+    DriveRow {
+        run: run_words(r),
+        estimates: r.noise.keys.iter().map(estimate_words).collect(),
+        bias: format!(
+            "{} ± {} [{}, {}]",
+            sig(b.0, 3),
+            sig(b.1, 2),
+            sig(b.0 - 1.96 * b.1, 3),
+            sig(b.0 + 1.96 * b.1, 3)
+        ),
+        bias_start: format!("{} ± {}", sig(start.bias_m_s2, 3), sig(start.sigma_bias_m_s2, 2)),
+        nis: format!(
+            "{} in [{}, {}]",
+            fixed(s.nis.sum, 0),
+            fixed(s.nis.lower, 0),
+            fixed(s.nis.upper, 0)
+        ),
+        verdict: s.nis.verdict.to_string(),
+    }
+}
+
+/// The sentences the numbers decide.
+pub fn findings(runs: &[DriveRun]) -> Vec<String> {
+    let mut out = Vec::new();
+    let passes = |r: &DriveRun| r.calibration.summary.nis.verdict == "pass";
+    let w_run = runs
+        .iter()
+        .find(|r| r.axis == Axis::GravityCompensated && r.noise.keys.len() == 3);
+    let sigma_run = runs
+        .iter()
+        .find(|r| r.axis == Axis::GravityCompensated && r.noise.keys.len() == 2);
+    if let (Some(w), Some(g)) = (w_run, sigma_run) {
+        let wk = &w.noise.keys[2];
+        let gs = &g.calibration.summary.nis;
+        let sentence = match (passes(w), passes(g), wk.identifiable) {
+            (true, false, true) => format!(
+                "With only the GPS σ's estimated, the gravity-compensated axis fails the NIS test \
+                 (sum {} {} its band [{}, {}]): the accelerometer's white noise is far above the \
+                 configured 4·10⁻⁴ (m/s²)². Estimated with them, W = {} [{}, {}] (m/s²)², {}× \
+                 the configured value (the engine's and the road's vibration), and the test \
+                 passes.",
+                fixed(gs.sum, 0),
+                if gs.sum > gs.upper { "above" } else { "below" },
+                fixed(gs.lower, 0),
+                fixed(gs.upper, 0),
+                sig(wk.value, 3),
+                sig(wk.lower, 3),
+                sig(wk.upper.unwrap_or(f64::NAN), 3),
+                sig(wk.value / 4e-4, 2)
+            ),
+            (true, true, _) => "The gravity-compensated axis passes the NIS test with the GPS \
+                                σ's estimated alone, and with W estimated too."
+                .to_string(),
+            _ => format!(
+                "The gravity-compensated axis does not pass the NIS test with the estimated \
+                 statistics (W {}): the filter's model does not explain this drive.",
+                if wk.identifiable { "identified" } else { "not identified" }
+            ),
+        };
+        out.push(sentence);
+        let s = &w.calibration.summary;
+        let (b, sb) = (s.bias_m_s2, s.bias_sigma_m_s2);
+        let sign = if b + 1.96 * sb < 0.0 {
+            "negative: its 95 % interval lies below zero"
+        } else if b - 1.96 * sb > 0.0 {
+            "positive: its 95 % interval lies above zero"
+        } else {
+            "not distinguishable from zero: its 95 % interval holds zero"
+        };
+        out.push(format!(
+            "The bias of that run is {} ± {} m/s², {sign}.",
+            sig(b, 3),
+            sig(sb, 2)
+        ));
+    }
+    if let Some(rw) = runs.iter().find(|r| r.axis == Axis::Raw && r.noise.keys.len() == 4) {
+        let k = &rw.noise.keys[3];
+        let s = &rw.calibration.summary;
+        let moved = (s.bias_m_s2 - s.start_smoothed.bias_m_s2).abs();
+        let sentence = if k.identifiable {
+            format!(
+                "On the raw axis the bias is not constant: with a random walk the drive measures \
+                 K = {} [{}, {}] m/s²/√s, and the smoothed bias moves by {} m/s² over the minute \
+                 ({} σ of its end value): gravity's share of the axis follows the pitch.",
+                sig(k.value, 3),
+                sig(k.lower, 3),
+                sig(k.upper.unwrap_or(f64::NAN), 3),
+                sig(moved, 2),
+                fixed(moved / s.bias_sigma_m_s2, 1)
+            )
+        } else {
+            "On the raw axis the drive does not determine a random walk of the bias (K not \
+             identifiable)."
+                .to_string()
+        };
+        out.push(sentence);
+    }
+    out
+}
+
+/// The section's view of `runs`.
+///
+/// # Errors
+/// [`RenderError`] when a figure cannot be drawn.
+pub fn view(runs: &[DriveRun], numbers: &Numbers) -> Result<RealDriveView, RenderError> {
+    let first = &runs[0].calibration.summary;
+    let mut figures = Vec::new();
+    let shown = [
+        (Figure::RealDriveGravityCompensated, 1usize, "real-drive-gravcomp"),
+        (Figure::RealDriveRaw, 3usize, "real-drive-raw"),
+    ];
+    for (fig, i, id) in shown {
+        let Some(r) = runs.get(i) else { continue };
+        figures.push(figure(
+            id,
+            numbers.figure(fig),
+            &format!("Bias estimate, {}", run_words(r)),
+            &format!(
+                "The bias of the {} filtered and smoothed at every fix with ±1σ (top) and the two \
+                 σ (bottom), with the statistics estimated from the drive.",
+                run_words(r)
+            ),
+            plot::calibration_bias(&r.calibration.fixes),
+        )?);
+    }
+    Ok(RealDriveView {
+        table_number: numbers.table(Table::RealDrive),
+        dir: DRIVE_DIR.to_string(),
+        extent: format!(
+            "{} accelerometer samples and {} GPS fixes over {} s",
+            first.samples,
+            first.fixes,
+            fixed(first.duration_s, 1)
+        ),
+        rows: runs.iter().map(row).collect(),
+        figures,
+        findings_html: findings(runs).iter().map(|s| rich::rich(s)).collect(),
+    })
+}

@@ -1,0 +1,145 @@
+//! A real drive: the minute of comma2k19 shipped in `examples/comma2k19/`, calibrated as a user
+//! would calibrate it, with noise statistics estimated from the drive itself.
+//!
+//! The files are compiled into the program, so the report's numbers always come from running
+//! the calibration on the shipped files, wherever the program runs.
+
+use crate::calibrate::summary::Calibration;
+use crate::calibrate::{self, CalibrateError, Settings};
+use crate::config::Config;
+use crate::likelihood::{Key, NoiseEstimate, Request};
+use crate::logs::read::{LogText, read_gps};
+use crate::model::Model;
+use crate::state::BiasModel;
+
+/// The shipped accelerometer log as recorded (gravity's component along the axis included).
+pub const ACCEL_RAW: &[u8] = include_bytes!("../../examples/comma2k19/accel_raw.csv");
+/// The same axis with gravity's component removed.
+pub const ACCEL_GRAVCOMP: &[u8] = include_bytes!("../../examples/comma2k19/accel_gravcomp.csv");
+/// The shipped GPS log.
+pub const GPS: &[u8] = include_bytes!("../../examples/comma2k19/gps.csv");
+/// The directory the files are shipped in, as the report names it.
+pub const DRIVE_DIR: &str = "examples/comma2k19";
+
+/// Which accelerometer log a run takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Axis {
+    /// `accel_gravcomp.csv`.
+    GravityCompensated,
+    /// `accel_raw.csv`.
+    Raw,
+}
+
+impl Axis {
+    /// The file's name.
+    pub fn file(self) -> &'static str {
+        match self {
+            Axis::GravityCompensated => "accel_gravcomp.csv",
+            Axis::Raw => "accel_raw.csv",
+        }
+    }
+
+    fn text(self) -> &'static [u8] {
+        match self {
+            Axis::GravityCompensated => ACCEL_GRAVCOMP,
+            Axis::Raw => ACCEL_RAW,
+        }
+    }
+}
+
+/// One calibration of the drive.
+#[derive(Clone, Debug)]
+pub struct DriveRun {
+    /// The accelerometer log.
+    pub axis: Axis,
+    /// The statistics estimated.
+    pub keys: Vec<Key>,
+    /// The filter's bias model.
+    pub bias_model: BiasModel,
+    /// The calibration's summary and per-fix series.
+    pub calibration: Calibration,
+    /// The estimate of the statistics.
+    pub noise: NoiseEstimate,
+}
+
+/// The runs of the section: the gravity-compensated axis with the GPS σ's estimated, then with the
+/// white noise W too; the raw axis with a constant bias and with a random walk (K estimated).
+pub const RUNS: [(Axis, &[Key]); 4] = [
+    (Axis::GravityCompensated, &[Key::GpsPosition, Key::GpsVelocity]),
+    (
+        Axis::GravityCompensated,
+        &[Key::GpsPosition, Key::GpsVelocity, Key::AccelNoiseVar],
+    ),
+    (
+        Axis::Raw,
+        &[Key::GpsPosition, Key::GpsVelocity, Key::AccelNoiseVar],
+    ),
+    (
+        Axis::Raw,
+        &[
+            Key::GpsPosition,
+            Key::GpsVelocity,
+            Key::AccelNoiseVar,
+            Key::BiasRandomWalk,
+        ],
+    ),
+];
+
+/// The settings of a calibration with no configuration: the default configuration's statistics
+/// and α, the accelerometer's median step, and the integration started from the first fix (its
+/// position carried back by its velocity to the first sample), its prior σ's the GPS σ's.
+///
+/// # Errors
+/// [`CalibrateError::Log`] when a log cannot be read.
+pub fn settings(accel: &LogText, gps: &LogText) -> Result<Settings, CalibrateError> {
+    let model = Model::new(&Config::default()).expect("the default configuration is valid");
+    let mut s = Settings::from_model(&model);
+    let fixes = read_gps(gps)?;
+    let mut reader = crate::logs::read::AccelReader::open(accel)?;
+    let first = reader.next_sample()?;
+    let second = reader.next_sample()?;
+    if let (Some(fix), Some(a), Some(b)) = (fixes.first(), first, second) {
+        s.position_mean_m = fix.position_m - fix.velocity_m_s * (fix.t_s - a.t_s);
+        s.velocity_mean_m_s = fix.velocity_m_s;
+        s.nominal_dt_s = b.t_s - a.t_s;
+    }
+    s.prior_from_first_fix = true;
+    let f = &mut s.filter_stats;
+    f.initial_position_sigma_m = f.gps_position_sigma_m;
+    f.initial_velocity_sigma_m_s = f.gps_velocity_sigma_m_s;
+    Ok(s)
+}
+
+/// Calibrates the drive on `axis` with `keys` estimated.
+///
+/// # Errors
+/// [`CalibrateError`] as [`calibrate::prepare_with`] (not for the shipped files).
+pub fn run_one(axis: Axis, keys: &[Key]) -> Result<DriveRun, CalibrateError> {
+    let accel = LogText::new(&format!("{DRIVE_DIR}/{}", axis.file()), axis.text());
+    let gps = LogText::new(&format!("{DRIVE_DIR}/gps.csv"), GPS);
+    let settings = settings(&accel, &gps)?;
+    let request = Request {
+        keys: keys.to_vec(),
+        confidence: 0.95,
+    };
+    let prepared = calibrate::prepare_with(&accel, &gps, &settings, Some(&request))?;
+    let noise = prepared
+        .noise_estimate()
+        .cloned()
+        .expect("an estimate was asked for");
+    Ok(DriveRun {
+        axis,
+        keys: keys.to_vec(),
+        bias_model: noise.stats.bias_model,
+        calibration: prepared.calibration(),
+        noise,
+    })
+}
+
+/// Every run of [`RUNS`].
+///
+/// # Errors
+/// As [`run_one`].
+pub fn run() -> Result<Vec<DriveRun>, CalibrateError> {
+    RUNS.iter().map(|(axis, keys)| run_one(*axis, keys)).collect()
+}
