@@ -18,6 +18,7 @@
 //!
 //! Nothing is written before the logs have passed every check.
 
+pub mod diagnose;
 mod forward;
 mod intervals;
 mod nis;
@@ -429,6 +430,13 @@ impl Prepared<'_> {
                 bias_correlation_time_s,
             },
             warnings: summary::prior_warnings(fixes.first()),
+            diagnostics: diagnose::diagnose(
+                &self.fixes,
+                &self.smoothed,
+                f,
+                &nis_test(&nis, s.false_alarm_rate),
+                s.false_alarm_rate,
+            ),
         };
         Calibration { summary, fixes }
     }

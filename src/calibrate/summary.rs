@@ -366,6 +366,9 @@ pub struct Summary {
     /// What the user should know before trusting the numbers, in words (empty when nothing):
     /// a prior that disagrees with the first fix ([`prior_warnings`]).
     pub warnings: Vec<String>,
+    /// What the innovations, the per-fix NIS and the bias's path point to, with the sentences
+    /// they choose (field names in [`super::diagnose::Diagnostics`]).
+    pub diagnostics: super::diagnose::Diagnostics,
 }
 
 /// How far, in σ of its innovation, the first fix may lie from the prior's prediction before

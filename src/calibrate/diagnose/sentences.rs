@@ -1,0 +1,360 @@
+//! The diagnosis in words: each sentence is chosen by a test of [`Diagnostics`] and carries that
+//! test's numbers; none depends on where the logs came from.
+
+use super::{BiasDiagnostics, Diagnostics, MeasurementDiagnostics, NisPerFix};
+use crate::calibrate::nis::NisTest;
+use crate::format::{percent, sig};
+
+/// `x` to `digits` significant digits without trailing zeros: 6.00 → "6", 1600.0 → "1600".
+fn num(x: f64, digits: usize) -> String {
+    let s = sig(x, digits);
+    if s.contains('×') || !s.contains('.') {
+        return s;
+    }
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// Above this share of the predicted variance the GPS σ is the statistic a measurement's mean
+/// square points to; below it, the integration's.
+const GPS_SHARE_DOMINANT: f64 = 0.5;
+/// Times of fixes outside the per-fix band named in a sentence.
+const TIMES_NAMED: usize = 5;
+
+/// The sentences for `d`, with the NIS test `nis` of the whole log, in the order a reader acts
+/// on them: the NIS sum, each measurement's mean square and whiteness, the bias, the per-fix
+/// count. One sentence says so when no test rejects.
+pub fn findings(d: &Diagnostics, nis: &NisTest) -> Vec<String> {
+    let mut out = Vec::new();
+    out.extend(nis_sum(nis));
+    for m in &d.measurements {
+        out.extend(mean_square(m));
+        out.extend(whiteness(m, d.fix_rate_hz));
+    }
+    out.extend(bias(&d.bias, d.false_alarm_rate));
+    out.extend(per_fix(&d.nis_per_fix));
+    if out.is_empty() {
+        let lags = d
+            .measurements
+            .iter()
+            .map(|m| m.whiteness.max_lag)
+            .max()
+            .unwrap_or(0);
+        out.push(format!(
+            "No diagnostic rejects at α = {}: the innovations are white at lags 1–{lags} and as \
+             large as predicted, the per-fix NIS leave their band as often as chance explains, \
+             and the bias is as steady as its model says.",
+            percent(d.false_alarm_rate)
+        ));
+    } else if out.len() == 1 && nis.verdict != "pass" {
+        out.push(
+            "No single diagnostic points further: the innovations are white and each \
+             measurement's mean square lies in its band, so the excess is spread thinly over \
+             both; compare the filter's statistics with what the sensors' data sheets give."
+                .to_string(),
+        );
+    }
+    out
+}
+
+/// The NIS sum outside its band, in words.
+fn nis_sum(n: &NisTest) -> Option<String> {
+    if n.verdict == "pass" || n.fixes == 0 {
+        return None;
+    }
+    let (side, what) = if n.sum > n.upper {
+        (
+            "above",
+            "larger than the filter predicts: statistics it assumes are too small, or its \
+             model misses an error the data have",
+        )
+    } else {
+        (
+            "below",
+            "smaller than the filter predicts: statistics it assumes are too large",
+        )
+    };
+    Some(format!(
+        "The NIS sum {} is {side} its band [{}, {}]: the residuals are {what}.",
+        num(n.sum, 5),
+        num(n.lower, 5),
+        num(n.upper, 5)
+    ))
+}
+
+/// A measurement's mean square outside its band, with the statistic it points to.
+fn mean_square(m: &MeasurementDiagnostics) -> Option<String> {
+    let [lo, hi] = m.mean_square_band;
+    let (larger, side) = match m.mean_square_place {
+        "above" => (true, "larger"),
+        "below" => (false, "smaller"),
+        _ => return None,
+    };
+    let head = format!(
+        "The {} innovations are {side} than predicted: their mean square in units of S is {} \
+         (band [{}, {}]); ",
+        m.measurement,
+        num(m.mean_square, 3),
+        num(lo, 3),
+        num(hi, 3)
+    );
+    let suggested = m
+        .gps_sigma_from_residuals
+        .map(|s| format!("; the residuals suggest about {} {}", num(s, 2), m.unit));
+    let pointer = if m.gps_share >= GPS_SHARE_DOMINANT {
+        format!(
+            "{} of that prediction is the GPS's, so {} = {} {} is too {}{}",
+            percent(m.gps_share),
+            m.gps_sigma_key,
+            num(m.gps_sigma, 3),
+            m.unit,
+            if larger { "small" } else { "large" },
+            suggested.unwrap_or_else(|| {
+                "; the residuals are smaller than the integration's predicted spread alone, so \
+                 filter.accel_noise_var_m2_s4 or a prior σ is too large as well"
+                    .to_string()
+            })
+        )
+    } else {
+        format!(
+            "only {} of that prediction is the GPS's, the rest the integration's, so \
+             filter.accel_noise_var_m2_s4 (the accelerometer's white noise, vibration included) \
+             or the bias's statistics are too {}",
+            percent(m.gps_share),
+            if larger { "small" } else { "large" }
+        )
+    };
+    Some(format!("{head}{pointer}."))
+}
+
+/// "1–3, 5, 7–8": sorted lags as runs.
+pub fn lag_runs(lags: &[usize]) -> String {
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for &l in lags {
+        match runs.last_mut() {
+            Some((_, end)) if *end + 1 == l => *end = l,
+            _ => runs.push((l, l)),
+        }
+    }
+    runs.iter()
+        .map(|&(a, b)| {
+            if a == b {
+                a.to_string()
+            } else {
+                format!("{a}–{b}")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A measurement's innovations that are not white, with what that points to.
+fn whiteness(m: &MeasurementDiagnostics, rate_hz: f64) -> Option<String> {
+    let w = &m.whiteness;
+    if w.verdict == "untestable" {
+        return Some(format!(
+            "Too few fixes to test the {} innovations' whiteness: it needs {} fixes.",
+            m.measurement,
+            super::FIXES_PER_LAG
+        ));
+    }
+    let last = *w.lags_outside.last()?;
+    let plural = if w.lags_outside.len() == 1 { "" } else { "s" };
+    let rate = num(rate_hz, 3);
+    let span = if rate_hz > 0.0 {
+        format!(", fixes up to {} s apart", num(last as f64 / rate_hz, 3))
+    } else {
+        String::new()
+    };
+    let cause = if m.measurement == "velocity" {
+        format!(
+            "the GPS velocity errors are not white at {rate} Hz, or the accelerometer's error \
+             changes over that time (a drifting bias, gravity through a changing pitch); \
+             consider a larger {}, a lower fix rate or bias_model = \"random_walk\"",
+            m.gps_sigma_key
+        )
+    } else {
+        format!(
+            "the GPS {} errors are not white at {rate} Hz; consider a larger {} or a lower fix \
+             rate",
+            m.measurement, m.gps_sigma_key
+        )
+    };
+    Some(format!(
+        "The {} innovations are correlated at lag{plural} {} (ρ̂(1) = {}, band ±{}{span}): \
+         {cause}.",
+        m.measurement,
+        lag_runs(&w.lags_outside),
+        num(w.autocorrelation.first().copied().unwrap_or(0.0), 2),
+        num(w.band.first().copied().unwrap_or(1.0), 2),
+    ))
+}
+
+/// A bias that strays from its smoothed path more than its model allows.
+fn bias(b: &BiasDiagnostics, alpha: f64) -> Option<String> {
+    if b.verdict != "fail" {
+        return None;
+    }
+    let advice = match b.bias_model {
+        "constant" => "the bias drifts over the run; try bias_model = \"random_walk\"".to_string(),
+        "random_walk" => format!(
+            "the bias moves more than its random walk allows (the smoothed bias spans {} σ); \
+             try a larger filter.bias_random_walk_m_s2_per_sqrt_s",
+            num(b.smoothed_range_sigmas, 2)
+        ),
+        _ => format!(
+            "the bias moves more than its Gauss–Markov model allows (the smoothed bias spans {} \
+             σ); try a larger filter.bias_var_m2_s4 or a shorter filter.bias_correlation_time_s",
+            num(b.smoothed_range_sigmas, 2)
+        ),
+    };
+    Some(format!(
+        "The filtered bias strays from the smoothed one by up to {} σ of their difference (at t \
+         = {} s; a bias that follows the filter's model stays within {} σ at α = {}): {advice}.",
+        num(b.departure_max_sigmas, 3),
+        num(b.departure_t_s, 4),
+        num(b.departure_bound_sigmas, 3),
+        percent(alpha)
+    ))
+}
+
+/// More fixes outside the per-fix NIS band than chance explains.
+fn per_fix(p: &NisPerFix) -> Option<String> {
+    if p.verdict != "fail" {
+        return None;
+    }
+    let times: Vec<String> = p
+        .outside_t_s
+        .iter()
+        .take(TIMES_NAMED)
+        .map(|t| num(*t, 4))
+        .collect();
+    let more = if p.outside > TIMES_NAMED { ", …" } else { "" };
+    Some(format!(
+        "{} fixes lie outside the per-fix NIS band [{}, {}] ({} above, {} below) where chance \
+         explains at most {} (about {} expected), at t = {}{more} s.",
+        p.outside,
+        num(p.lower, 3),
+        num(p.upper, 3),
+        p.above,
+        p.below,
+        p.outside_bound,
+        num(p.expected_outside, 2),
+        times.join(", ")
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{FixSeries, of};
+    use super::*;
+    use crate::calibrate::nis::nis_test;
+    use crate::state::BiasModel;
+
+    /// 200 fixes at 10 Hz whose residuals are `r(i)` with unit diag S (half of it the GPS's:
+    /// R = 0.5), NIS `nis`, and a bias whose filtered estimate is `b(i)` with variance 2 against a
+    /// smoothed 0 with variance 1.
+    fn series(r: impl Fn(usize) -> f64, nis: f64, b: impl Fn(usize) -> f64) -> Vec<FixSeries> {
+        (0..200)
+            .map(|i| FixSeries {
+                t_s: 0.1 * i as f64,
+                residual: [r(i), r(i)],
+                s_diag: [1.0, 1.0],
+                nis,
+                bias_filtered: [b(i), 2.0],
+                bias_smoothed: [0.0, 1.0],
+            })
+            .collect()
+    }
+
+    /// A sequence that passes every test: ±1 in a pattern with no correlation at lags 1–20.
+    fn white(i: usize) -> f64 {
+        // The signs of a maximal-length shift register: autocorrelation −1/255 at every lag.
+        let mut state = 1u8;
+        for _ in 0..i % 255 {
+            let bit = (state >> 7) ^ (state >> 5) ^ (state >> 4) ^ (state >> 3);
+            state = (state << 1) | (bit & 1);
+        }
+        if state & 1 == 1 { 1.0 } else { -1.0 }
+    }
+
+    fn sentences(s: &[FixSeries], model: BiasModel) -> Vec<String> {
+        let nis = nis_test(&s.iter().map(|f| f.nis).collect::<Vec<_>>(), 0.01);
+        of(s, [0.5f64.sqrt(); 2], model, &nis, 0.01).findings
+    }
+
+    fn any(found: &[String], words: &str) -> bool {
+        found.iter().any(|s| s.contains(words))
+    }
+
+    #[test]
+    fn a_consistent_series_says_nothing_rejects() {
+        let found = sentences(&series(white, 2.0, |_| 0.0), BiasModel::Constant);
+        assert_eq!(found.len(), 1, "{found:?}");
+        assert!(found[0].starts_with("No diagnostic rejects"), "{found:?}");
+    }
+
+    #[test]
+    fn correlated_innovations_name_their_lags_and_the_fix_rate() {
+        // Residuals constant over runs of 4 fixes: correlated at lags 1–3.
+        let found = sentences(&series(|i| white(i / 4), 2.0, |_| 0.0), BiasModel::Constant);
+        assert!(any(&found, "The position innovations are correlated at lags 1–3"), "{found:?}");
+        assert!(
+            any(&found, "not white at 10 Hz; consider a larger filter.gps_position"),
+            "{found:?}"
+        );
+        assert!(any(&found, "The velocity innovations are correlated at lags 1–3"));
+        assert_eq!(lag_runs(&[1, 2, 3, 5, 7, 8]), "1–3, 5, 7–8");
+    }
+
+    #[test]
+    fn mean_squares_point_to_the_gps_sigma_or_the_integration() {
+        // Residuals ±2 with R = 0.5 of S = 1: mean square 4, r² − (S − R) = 3.5.
+        let large = series(|i| 2.0 * white(i), 8.0, |_| 0.0);
+        let found = sentences(&large, BiasModel::Constant);
+        assert!(any(&found, "The NIS sum 1600 is above its band"), "{found:?}");
+        assert!(any(&found, "The position innovations are larger than predicted"));
+        assert!(any(&found, "is too small; the residuals suggest about 1.9 m"));
+        // Residuals ±0.5: mean square 0.25, below; r² − (S − R) < 0: no σ suggested.
+        let small = series(|i| 0.5 * white(i), 0.5, |_| 0.0);
+        let found = sentences(&small, BiasModel::Constant);
+        assert!(any(&found, "is below its band"), "{found:?}");
+        assert!(any(&found, "is too large; the residuals are smaller than the integration's"));
+        // The GPS's share of S small: the integration's statistics are named.
+        let mut s = series(|i| 2.0 * white(i), 8.0, |_| 0.0);
+        s.iter_mut().for_each(|f| f.s_diag = [10.0, 10.0]);
+        s.iter_mut().for_each(|f| f.residual = f.residual.map(|r| r * 10f64.sqrt()));
+        let found = sentences(&s, BiasModel::Constant);
+        assert!(any(&found, "only 5\u{202f}% of that prediction is the GPS's"), "{found:?}");
+    }
+
+    #[test]
+    fn a_straying_bias_suggests_its_model() {
+        // d_i = b_i / √(2 − 1): 0.5 everywhere passes; 6 at one fix fails.
+        let steady = sentences(&series(white, 2.0, |_| 0.5), BiasModel::Constant);
+        assert!(!any(&steady, "strays"), "{steady:?}");
+        let drift = |i: usize| if i == 50 { 6.0 } else { 0.5 };
+        let found = sentences(&series(white, 2.0, drift), BiasModel::Constant);
+        assert!(any(&found, "by up to 6 σ of their difference (at t = 5 s"), "{found:?}");
+        assert!(any(&found, "try bias_model = \"random_walk\""));
+        let walk = BiasModel::RandomWalk {
+            k_m_s2_per_sqrt_s: 0.01,
+        };
+        let found = sentences(&series(white, 2.0, drift), walk);
+        assert!(any(&found, "a larger filter.bias_random_walk_m_s2_per_sqrt_s"));
+    }
+
+    #[test]
+    fn too_many_fixes_outside_the_per_fix_band_are_named_by_time() {
+        let mut s = series(white, 2.0, |_| 0.0);
+        for f in s.iter_mut().skip(10).step_by(20) {
+            f.nis = 30.0;
+        }
+        let found = sentences(&s, BiasModel::Constant);
+        assert!(
+            any(&found, "10 fixes lie outside the per-fix NIS band [0.01, 10.6] (10 above, 0 \
+                 below) where chance explains at most 6"),
+            "{found:?}"
+        );
+        assert!(any(&found, "at t = 1, 3, 5, 7, 9, … s"));
+    }
+}
