@@ -152,9 +152,10 @@ pub struct MeasurementDiagnostics {
     /// The GPS's share of the predicted variance, (1/n) Σ R_kk / S_i,kk: near 1 the residuals'
     /// spread is set by the GPS σ, near 0 by the integration's (W, the bias, the prior).
     pub gps_share: f64,
-    /// The GPS σ the residuals suggest, √((1/n) Σ (r_i² − (S_i,kk − R_kk))), in `unit`: the
-    /// residuals' mean square less what the filter predicts of them besides R; absent when
-    /// that is not positive.
+    /// The GPS σ the residuals suggest, √(mean of r_i² − (S_i,kk − R_kk)), in `unit`: the
+    /// residuals' mean square less what the filter predicts of them besides R, over the fixes
+    /// where R_kk ≥ S_i,kk / 2 (past the prior); absent when that is not positive or no fix
+    /// qualifies.
     pub gps_sigma_from_residuals: Option<f64>,
 }
 
@@ -227,7 +228,8 @@ pub struct Diagnostics {
     /// α, `checks.false_alarm_rate`: each measurement's whiteness and mean-square tests take
     /// α / M (so the M of them reject together at most α), the per-fix count and the bias test α.
     pub false_alarm_rate: f64,
-    /// The fix rate, (n − 1) / (t_n − t_1), Hz.
+    /// The fix rate: 1 / the mean interval between fixes without the gaps (intervals within 0.5
+    /// to 1.5 times the median), Hz; 0 below two fixes.
     pub fix_rate_hz: f64,
     /// Per measured component: position, then velocity.
     pub measurements: Vec<MeasurementDiagnostics>,
@@ -290,11 +292,7 @@ pub fn of(
     nis: &NisTest,
     false_alarm_rate: f64,
 ) -> Diagnostics {
-    let n = series.len();
-    let fix_rate_hz = match (series.first(), series.last()) {
-        (Some(a), Some(z)) if n > 1 && z.t_s > a.t_s => (n - 1) as f64 / (z.t_s - a.t_s),
-        _ => 0.0,
-    };
+    let fix_rate_hz = fix_rate_hz(series);
     let measurements = (0..M)
         .map(|k| measurement(series, k, gps_sigma[k], false_alarm_rate / M as f64))
         .collect();
@@ -310,6 +308,21 @@ pub fn of(
     d
 }
 
+/// 1 / the mean interval between fixes over the intervals within 0.5 to 1.5 times the median
+/// (a missing fix is a gap, not a slower rate); 0 below two fixes.
+fn fix_rate_hz(series: &[FixSeries]) -> f64 {
+    let mut steps: Vec<f64> = series.windows(2).map(|w| w[1].t_s - w[0].t_s).collect();
+    steps.sort_by(f64::total_cmp);
+    let Some(&median) = steps.get(steps.len() / 2) else {
+        return 0.0;
+    };
+    let usual = steps
+        .iter()
+        .filter(|&&dt| (0.5 * median..=1.5 * median).contains(&dt));
+    let (count, sum) = usual.fold((0usize, 0.0), |(c, s), dt| (c + 1, s + dt));
+    if sum > 0.0 { count as f64 / sum } else { 0.0 }
+}
+
 /// The diagnostics of measured component `k` at rate `rate`.
 fn measurement(
     series: &[FixSeries],
@@ -318,7 +331,10 @@ fn measurement(
     rate: f64,
 ) -> MeasurementDiagnostics {
     const _: () = assert!(M == 2, "one GPS σ key per measured component");
-    let keys = ["filter.gps_position_sigma_m", "filter.gps_velocity_sigma_m_s"];
+    let keys = [
+        "filter.gps_position_sigma_m",
+        "filter.gps_velocity_sigma_m_s",
+    ];
     let variable = ErrorState::MEASURED[k];
     let u: Vec<f64> = series
         .iter()
@@ -329,11 +345,14 @@ fn measurement(
     let (lo, hi) = chi_squared_band(n, n, rate);
     let r = gps_sigma * gps_sigma;
     let gps_share = series.iter().map(|f| r / f.s_diag[k]).sum::<f64>() / n;
-    let excess = series
+    // The fixes where the GPS is at least half of S: the first fixes, where the prior's σ
+    // dominates S, would swamp the residuals' spread with S − R.
+    let settled: Vec<&FixSeries> = series.iter().filter(|f| 2.0 * r >= f.s_diag[k]).collect();
+    let excess = settled
         .iter()
         .map(|f| f.residual[k].powi(2) - (f.s_diag[k] - r))
         .sum::<f64>()
-        / n;
+        / settled.len().max(1) as f64;
     MeasurementDiagnostics {
         measurement: variable.key,
         unit: variable.unit,
@@ -344,7 +363,7 @@ fn measurement(
         mean_square_band: [lo, hi],
         mean_square_place: place(mean_square, lo, hi),
         gps_share,
-        gps_sigma_from_residuals: (excess > 0.0).then(|| excess.sqrt()),
+        gps_sigma_from_residuals: (excess > 0.0 && !settled.is_empty()).then(|| excess.sqrt()),
     }
 }
 
@@ -408,8 +427,12 @@ fn bias(series: &[FixSeries], model: BiasModel, alpha: f64) -> BiasDiagnostics {
         .iter()
         .filter_map(|f| {
             let gain = f.bias_filtered[1] - f.bias_smoothed[1];
-            (gain > MIN_VARIANCE_GAIN * f.bias_filtered[1])
-                .then(|| (f.t_s, (f.bias_filtered[0] - f.bias_smoothed[0]) / gain.sqrt()))
+            (gain > MIN_VARIANCE_GAIN * f.bias_filtered[1]).then(|| {
+                (
+                    f.t_s,
+                    (f.bias_filtered[0] - f.bias_smoothed[0]) / gain.sqrt(),
+                )
+            })
         })
         .collect();
     let (t_s, worst) = departures
@@ -455,16 +478,24 @@ mod tests {
         ];
         for (n, lag, rate, expected) in cases {
             let h = lag_band(n, lag, rate);
-            assert!((h - expected).abs() < 1e-9, "n {n} lag {lag}: {h} vs {expected}");
+            assert!(
+                (h - expected).abs() < 1e-9,
+                "n {n} lag {lag}: {h} vs {expected}"
+            );
         }
         assert_eq!(lag_band(5, 5, 0.01), 1.0);
     }
 
     #[test]
     fn autocorrelation_of_an_alternating_sequence_is_minus_one_at_lag_one() {
-        let u: Vec<f64> = (0..100).map(|i| if i % 2 == 0 { 1.0 } else { -1.0 }).collect();
+        let u: Vec<f64> = (0..100)
+            .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
         let r = autocorrelation(&u, 2);
-        assert!((r[0] + 0.99).abs() < 1e-12 && (r[1] - 0.98).abs() < 1e-12, "{r:?}");
+        assert!(
+            (r[0] + 0.99).abs() < 1e-12 && (r[1] - 0.98).abs() < 1e-12,
+            "{r:?}"
+        );
         let w = whiteness(&u, 0.01);
         assert_eq!((w.max_lag, w.verdict), (10, "fail"));
         assert_eq!(w.lags_outside, (1..=10).collect::<Vec<_>>());

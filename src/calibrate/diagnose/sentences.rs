@@ -297,12 +297,24 @@ mod tests {
     fn correlated_innovations_name_their_lags_and_the_fix_rate() {
         // Residuals constant over runs of 4 fixes: correlated at lags 1–3.
         let found = sentences(&series(|i| white(i / 4), 2.0, |_| 0.0), BiasModel::Constant);
-        assert!(any(&found, "The position innovations are correlated at lags 1–3"), "{found:?}");
         assert!(
-            any(&found, "not white at 10 Hz; consider a larger filter.gps_position"),
+            any(
+                &found,
+                "The position innovations are correlated at lags 1–3"
+            ),
             "{found:?}"
         );
-        assert!(any(&found, "The velocity innovations are correlated at lags 1–3"));
+        assert!(
+            any(
+                &found,
+                "not white at 10 Hz; consider a larger filter.gps_position"
+            ),
+            "{found:?}"
+        );
+        assert!(any(
+            &found,
+            "The velocity innovations are correlated at lags 1–3"
+        ));
         assert_eq!(lag_runs(&[1, 2, 3, 5, 7, 8]), "1–3, 5, 7–8");
     }
 
@@ -311,20 +323,36 @@ mod tests {
         // Residuals ±2 with R = 0.5 of S = 1: mean square 4, r² − (S − R) = 3.5.
         let large = series(|i| 2.0 * white(i), 8.0, |_| 0.0);
         let found = sentences(&large, BiasModel::Constant);
-        assert!(any(&found, "The NIS sum 1600 is above its band"), "{found:?}");
-        assert!(any(&found, "The position innovations are larger than predicted"));
-        assert!(any(&found, "is too small; the residuals suggest about 1.9 m"));
+        assert!(
+            any(&found, "The NIS sum 1600 is above its band"),
+            "{found:?}"
+        );
+        assert!(any(
+            &found,
+            "The position innovations are larger than predicted"
+        ));
+        assert!(any(
+            &found,
+            "is too small; the residuals suggest about 1.9 m"
+        ));
         // Residuals ±0.5: mean square 0.25, below; r² − (S − R) < 0: no σ suggested.
         let small = series(|i| 0.5 * white(i), 0.5, |_| 0.0);
         let found = sentences(&small, BiasModel::Constant);
         assert!(any(&found, "is below its band"), "{found:?}");
-        assert!(any(&found, "is too large; the residuals are smaller than the integration's"));
+        assert!(any(
+            &found,
+            "is too large; the residuals are smaller than the integration's"
+        ));
         // The GPS's share of S small: the integration's statistics are named.
         let mut s = series(|i| 2.0 * white(i), 8.0, |_| 0.0);
         s.iter_mut().for_each(|f| f.s_diag = [10.0, 10.0]);
-        s.iter_mut().for_each(|f| f.residual = f.residual.map(|r| r * 10f64.sqrt()));
+        s.iter_mut()
+            .for_each(|f| f.residual = f.residual.map(|r| r * 10f64.sqrt()));
         let found = sentences(&s, BiasModel::Constant);
-        assert!(any(&found, "only 5\u{202f}% of that prediction is the GPS's"), "{found:?}");
+        assert!(
+            any(&found, "only 5\u{202f}% of that prediction is the GPS's"),
+            "{found:?}"
+        );
     }
 
     #[test]
@@ -334,13 +362,19 @@ mod tests {
         assert!(!any(&steady, "strays"), "{steady:?}");
         let drift = |i: usize| if i == 50 { 6.0 } else { 0.5 };
         let found = sentences(&series(white, 2.0, drift), BiasModel::Constant);
-        assert!(any(&found, "by up to 6 σ of their difference (at t = 5 s"), "{found:?}");
+        assert!(
+            any(&found, "by up to 6 σ of their difference (at t = 5 s"),
+            "{found:?}"
+        );
         assert!(any(&found, "try bias_model = \"random_walk\""));
         let walk = BiasModel::RandomWalk {
             k_m_s2_per_sqrt_s: 0.01,
         };
         let found = sentences(&series(white, 2.0, drift), walk);
-        assert!(any(&found, "a larger filter.bias_random_walk_m_s2_per_sqrt_s"));
+        assert!(any(
+            &found,
+            "a larger filter.bias_random_walk_m_s2_per_sqrt_s"
+        ));
     }
 
     #[test]
@@ -351,8 +385,11 @@ mod tests {
         }
         let found = sentences(&s, BiasModel::Constant);
         assert!(
-            any(&found, "10 fixes lie outside the per-fix NIS band [0.01, 10.6] (10 above, 0 \
-                 below) where chance explains at most 6"),
+            any(
+                &found,
+                "10 fixes lie outside the per-fix NIS band [0.01, 10.6] (10 above, 0 \
+                 below) where chance explains at most 6"
+            ),
             "{found:?}"
         );
         assert!(any(&found, "at t = 1, 3, 5, 7, 9, … s"));
