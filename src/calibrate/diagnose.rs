@@ -148,6 +148,53 @@ pub struct Diagnostics {
     pub findings: Vec<String>,
 }
 
+impl Diagnostics {
+    /// The tests that reject, in one line for the command's output ("position innovations not
+    /// white at lags 1–20, smaller than predicted; …"), or that none does.
+    pub fn headline(&self) -> String {
+        let mut parts: Vec<String> = Vec::new();
+        for m in &self.measurements {
+            let mut what = Vec::new();
+            if m.whiteness.verdict == "fail" {
+                what.push(format!(
+                    "not white at lags {}",
+                    lag_runs(&m.whiteness.lags_outside)
+                ));
+            }
+            if m.mean_square_place != "in" {
+                let side = if m.mean_square_place == "above" {
+                    "larger"
+                } else {
+                    "smaller"
+                };
+                what.push(format!("{side} than predicted"));
+            }
+            if !what.is_empty() {
+                parts.push(format!("{} innovations {}", m.measurement, what.join(", ")));
+            }
+        }
+        if self.bias.verdict == "fail" {
+            parts.push(format!(
+                "the bias strays {}σ from its smoothed path (bound {}σ)",
+                crate::format::short(self.bias.departure_max_sigmas),
+                crate::format::short(self.bias.departure_bound_sigmas)
+            ));
+        }
+        let p = &self.nis_per_fix;
+        if p.verdict == "fail" {
+            parts.push(format!(
+                "{} fixes outside the per-fix NIS band (chance explains {})",
+                p.outside, p.outside_bound
+            ));
+        }
+        if parts.is_empty() {
+            "no diagnostic rejects".to_string()
+        } else {
+            parts.join("; ")
+        }
+    }
+}
+
 /// One fix as the diagnosis reads it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FixSeries {

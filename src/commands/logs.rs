@@ -175,6 +175,7 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
         sig(s.nis.upper, 5),
         args.out.join(PAGE_FILE).display()
     ))?;
+    super::say(&format!("diagnosis: {}\n", s.diagnostics.headline()))?;
     Ok(())
 }
 

@@ -4,6 +4,7 @@
 //! the other tests of a consistent filter reject no more often than their rates allow.
 
 use accelcal::calibrate::diagnose::{Diagnostics, whiteness};
+use accelcal::calibrate::summary::Calibration;
 use accelcal::calibrate::{Settings, prepare};
 use accelcal::config::{Config, TruthModel};
 use accelcal::logs::read::LogText;
@@ -81,6 +82,11 @@ fn whiteness_rejects_white_sequences_at_its_rate_and_flags_correlated_ones() {
 /// The diagnostics of realization `l` of `config`'s simulation, its GPS position error
 /// replaced by an AR(1) error of the same σ and correlation φ per fix when `phi` is given.
 fn diagnose_simulated(config: &Config, l: u64, phi: Option<f64>) -> Diagnostics {
+    calibrate_simulated(config, l, phi).summary.diagnostics
+}
+
+/// The calibration of [`diagnose_simulated`].
+fn calibrate_simulated(config: &Config, l: u64, phi: Option<f64>) -> Calibration {
     let (model, schedule) = common::model_of(config);
     let settings = Settings::from_model(&model);
     let (mut accel, mut gps, mut truth) = (Vec::new(), Vec::new(), Vec::new());
@@ -92,7 +98,7 @@ fn diagnose_simulated(config: &Config, l: u64, phi: Option<f64>) -> Diagnostics 
     }
     let (accel, gps) = (LogText::new("a.csv", accel), LogText::new("g.csv", gps));
     let prepared = prepare(&accel, &gps, &settings).unwrap();
-    prepared.calibration().summary.diagnostics
+    prepared.calibration()
 }
 
 /// The GPS log `gps` with each position the truth's (from `truth`, at the same time stamp)
@@ -170,4 +176,50 @@ fn a_correlated_gps_position_error_is_flagged() {
     eprintln!("AR(1) GPS position error: {flagged} of {logs} logs flagged, {words} say so");
     assert!(flagged >= logs - 2, "{flagged} of {logs}");
     assert_eq!(words, flagged);
+}
+
+#[test]
+fn the_page_and_the_summary_show_the_diagnosis() {
+    let mut config = Config::default();
+    config.ensemble.truth = TruthModel::Euler;
+    let cal = calibrate_simulated(&config, 0, Some((-0.1f64).exp()));
+    let html = accelcal::report::calibration::render(&cal, "accelcal calibrate", false).unwrap();
+    for id in [
+        "id=\"diagnosis\"",
+        "id=\"fig-autocorrelation\"",
+        "id=\"fig-bias-departure\"",
+    ] {
+        assert!(html.contains(id), "the page has no {id}");
+    }
+    let d = &cal.summary.diagnostics;
+    let sentence = d
+        .findings
+        .iter()
+        .find(|s| s.contains("position innovations are correlated"))
+        .expect("the sentence on the position innovations");
+    let escaped = sentence.replace('"', "&quot;").replace('\'', "&#x27;");
+    assert!(
+        html.contains(sentence.as_str()) || html.contains(&escaped),
+        "the page does not say: {sentence}"
+    );
+    // summary.json: the existing fields in their order, then `diagnostics`.
+    let json = cal.summary.to_json();
+    let value: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let keys: Vec<&String> = value.as_object().unwrap().keys().collect();
+    let at = |k: &str| json.find(&format!("\n  \"{k}\"")).unwrap();
+    assert!(at("nis") < at("filter") && at("filter") < at("warnings"));
+    assert!(at("warnings") < at("diagnostics"), "{keys:?}");
+    let m = &value["diagnostics"]["measurements"][0];
+    for field in ["whiteness", "mean_square", "mean_square_band", "gps_share"] {
+        assert!(
+            !m[field].is_null(),
+            "no diagnostics.measurements[0].{field}"
+        );
+    }
+    let w = &m["whiteness"];
+    assert_eq!(w["verdict"], "fail");
+    assert_eq!(w["max_lag"], 15);
+    assert_eq!(w["autocorrelation"].as_array().unwrap().len(), 15);
+    assert!(!value["diagnostics"]["nis_per_fix"]["outside_t_s"].is_null());
+    assert!(!value["diagnostics"]["bias"]["departure_bound_sigmas"].is_null());
 }

@@ -147,7 +147,19 @@ pub fn lag_runs(lags: &[usize]) -> String {
         .join(", ")
 }
 
-/// A measurement's innovations that are not white, with what that points to.
+/// Whether the lags outside their band are, on balance, positively correlated.
+fn positively_correlated(m: &MeasurementDiagnostics) -> bool {
+    let w = &m.whiteness;
+    let sum: f64 = w
+        .lags_outside
+        .iter()
+        .map(|&l| w.autocorrelation[l - 1])
+        .sum();
+    sum > 0.0
+}
+
+/// A measurement's innovations that are not white, with what that points to: slow errors
+/// (positive correlation) or a filter that overshoots (negative).
 fn whiteness(m: &MeasurementDiagnostics, rate_hz: f64) -> Option<String> {
     let w = &m.whiteness;
     if w.verdict == "untestable" {
@@ -160,27 +172,50 @@ fn whiteness(m: &MeasurementDiagnostics, rate_hz: f64) -> Option<String> {
     let last = *w.lags_outside.last()?;
     let plural = if w.lags_outside.len() == 1 { "" } else { "s" };
     let rate = num(rate_hz, 3);
-    let span = if rate_hz > 0.0 {
-        format!(", fixes up to {} s apart", num(last as f64 / rate_hz, 3))
-    } else {
-        String::new()
+    let seconds = |lags: usize| num(lags as f64 / rate_hz, 3);
+    let (span, thinned) = match (rate_hz > 0.0, last == w.max_lag) {
+        (false, _) => (String::new(), String::new()),
+        (true, true) => (
+            format!(", fixes up to {} s apart", seconds(last)),
+            format!(
+                " (the correlation outlasts lag {last}, {} s)",
+                seconds(last)
+            ),
+        ),
+        (true, false) => (
+            format!(", fixes up to {} s apart", seconds(last)),
+            format!(" (one fix every {} s or less often)", seconds(last + 1)),
+        ),
     };
-    let cause = if m.measurement == "velocity" {
-        format!(
+    let key = m.gps_sigma_key;
+    let cause = match (positively_correlated(m), m.measurement) {
+        (false, measurement) => format!(
+            "successive corrections overshoot: the filter's process noise \
+             (filter.accel_noise_var_m2_s4) is large against {key}, or the GPS {measurement} \
+             errors alternate from fix to fix; consider a smaller filter.accel_noise_var_m2_s4"
+        ),
+        (true, "velocity") => format!(
             "the GPS velocity errors are not white at {rate} Hz, or the accelerometer's error \
              changes over that time (a drifting bias, gravity through a changing pitch); \
-             consider a larger {}, a lower fix rate or bias_model = \"random_walk\"",
-            m.gps_sigma_key
-        )
+             consider a larger {key}, a lower fix rate{thinned} or bias_model = \"random_walk\""
+        ),
+        (true, measurement) if m.mean_square_place == "below" => format!(
+            "the GPS {measurement} errors are not white at {rate} Hz, and small from fix to fix \
+             because the filter follows them; rather than the smaller {key} their size \
+             suggests, take a lower fix rate{thinned}"
+        ),
+        (true, measurement) => format!(
+            "the GPS {measurement} errors are not white at {rate} Hz; consider a larger {key} \
+             or a lower fix rate{thinned}"
+        ),
+    };
+    let sign = if positively_correlated(m) {
+        ""
     } else {
-        format!(
-            "the GPS {} errors are not white at {rate} Hz; consider a larger {} or a lower fix \
-             rate",
-            m.measurement, m.gps_sigma_key
-        )
+        "negatively "
     };
     Some(format!(
-        "The {} innovations are correlated at lag{plural} {} (ρ̂(1) = {}, band ±{}{span}): \
+        "The {} innovations are {sign}correlated at lag{plural} {} (ρ̂(1) = {}, band ±{}{span}): \
          {cause}.",
         m.measurement,
         lag_runs(&w.lags_outside),
@@ -244,154 +279,4 @@ fn per_fix(p: &NisPerFix) -> Option<String> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::super::{FixSeries, of};
-    use super::*;
-    use crate::calibrate::nis::nis_test;
-    use crate::state::BiasModel;
-
-    /// 200 fixes at 10 Hz whose residuals are `r(i)` with unit diag S (half of it the GPS's:
-    /// R = 0.5), NIS `nis`, and a bias whose filtered estimate is `b(i)` with variance 2 against a
-    /// smoothed 0 with variance 1.
-    fn series(r: impl Fn(usize) -> f64, nis: f64, b: impl Fn(usize) -> f64) -> Vec<FixSeries> {
-        (0..200)
-            .map(|i| FixSeries {
-                t_s: 0.1 * i as f64,
-                residual: [r(i), r(i)],
-                s_diag: [1.0, 1.0],
-                nis,
-                bias_filtered: [b(i), 2.0],
-                bias_smoothed: [0.0, 1.0],
-            })
-            .collect()
-    }
-
-    /// A sequence that passes every test: ±1 in a pattern with no correlation at lags 1–20.
-    fn white(i: usize) -> f64 {
-        // The signs of a maximal-length shift register: autocorrelation −1/255 at every lag.
-        let mut state = 1u8;
-        for _ in 0..i % 255 {
-            let bit = (state >> 7) ^ (state >> 5) ^ (state >> 4) ^ (state >> 3);
-            state = (state << 1) | (bit & 1);
-        }
-        if state & 1 == 1 { 1.0 } else { -1.0 }
-    }
-
-    fn sentences(s: &[FixSeries], model: BiasModel) -> Vec<String> {
-        let nis = nis_test(&s.iter().map(|f| f.nis).collect::<Vec<_>>(), 0.01);
-        of(s, [0.5f64.sqrt(); 2], model, &nis, 0.01).findings
-    }
-
-    fn any(found: &[String], words: &str) -> bool {
-        found.iter().any(|s| s.contains(words))
-    }
-
-    #[test]
-    fn a_consistent_series_says_nothing_rejects() {
-        let found = sentences(&series(white, 2.0, |_| 0.0), BiasModel::Constant);
-        assert_eq!(found.len(), 1, "{found:?}");
-        assert!(found[0].starts_with("No diagnostic rejects"), "{found:?}");
-    }
-
-    #[test]
-    fn correlated_innovations_name_their_lags_and_the_fix_rate() {
-        // Residuals constant over runs of 4 fixes: correlated at lags 1–3.
-        let found = sentences(&series(|i| white(i / 4), 2.0, |_| 0.0), BiasModel::Constant);
-        assert!(
-            any(
-                &found,
-                "The position innovations are correlated at lags 1–3"
-            ),
-            "{found:?}"
-        );
-        assert!(
-            any(
-                &found,
-                "not white at 10 Hz; consider a larger filter.gps_position"
-            ),
-            "{found:?}"
-        );
-        assert!(any(
-            &found,
-            "The velocity innovations are correlated at lags 1–3"
-        ));
-        assert_eq!(lag_runs(&[1, 2, 3, 5, 7, 8]), "1–3, 5, 7–8");
-    }
-
-    #[test]
-    fn mean_squares_point_to_the_gps_sigma_or_the_integration() {
-        // Residuals ±2 with R = 0.5 of S = 1: mean square 4, r² − (S − R) = 3.5.
-        let large = series(|i| 2.0 * white(i), 8.0, |_| 0.0);
-        let found = sentences(&large, BiasModel::Constant);
-        assert!(
-            any(&found, "The NIS sum 1600 is above its band"),
-            "{found:?}"
-        );
-        assert!(any(
-            &found,
-            "The position innovations are larger than predicted"
-        ));
-        assert!(any(
-            &found,
-            "is too small; the residuals suggest about 1.9 m"
-        ));
-        // Residuals ±0.5: mean square 0.25, below; r² − (S − R) < 0: no σ suggested.
-        let small = series(|i| 0.5 * white(i), 0.5, |_| 0.0);
-        let found = sentences(&small, BiasModel::Constant);
-        assert!(any(&found, "is below its band"), "{found:?}");
-        assert!(any(
-            &found,
-            "is too large; the residuals are smaller than the integration's"
-        ));
-        // The GPS's share of S small: the integration's statistics are named.
-        let mut s = series(|i| 2.0 * white(i), 8.0, |_| 0.0);
-        s.iter_mut().for_each(|f| f.s_diag = [10.0, 10.0]);
-        s.iter_mut()
-            .for_each(|f| f.residual = f.residual.map(|r| r * 10f64.sqrt()));
-        let found = sentences(&s, BiasModel::Constant);
-        assert!(
-            any(&found, "only 5\u{202f}% of that prediction is the GPS's"),
-            "{found:?}"
-        );
-    }
-
-    #[test]
-    fn a_straying_bias_suggests_its_model() {
-        // d_i = b_i / √(2 − 1): 0.5 everywhere passes; 6 at one fix fails.
-        let steady = sentences(&series(white, 2.0, |_| 0.5), BiasModel::Constant);
-        assert!(!any(&steady, "strays"), "{steady:?}");
-        let drift = |i: usize| if i == 50 { 6.0 } else { 0.5 };
-        let found = sentences(&series(white, 2.0, drift), BiasModel::Constant);
-        assert!(
-            any(&found, "by up to 6 σ of their difference (at t = 5 s"),
-            "{found:?}"
-        );
-        assert!(any(&found, "try bias_model = \"random_walk\""));
-        let walk = BiasModel::RandomWalk {
-            k_m_s2_per_sqrt_s: 0.01,
-        };
-        let found = sentences(&series(white, 2.0, drift), walk);
-        assert!(any(
-            &found,
-            "a larger filter.bias_random_walk_m_s2_per_sqrt_s"
-        ));
-    }
-
-    #[test]
-    fn too_many_fixes_outside_the_per_fix_band_are_named_by_time() {
-        let mut s = series(white, 2.0, |_| 0.0);
-        for f in s.iter_mut().skip(10).step_by(20) {
-            f.nis = 30.0;
-        }
-        let found = sentences(&s, BiasModel::Constant);
-        assert!(
-            any(
-                &found,
-                "10 fixes lie outside the per-fix NIS band [0.01, 10.6] (10 above, 0 \
-                 below) where chance explains at most 6"
-            ),
-            "{found:?}"
-        );
-        assert!(any(&found, "at t = 1, 3, 5, 7, 9, … s"));
-    }
-}
+mod tests;
