@@ -115,7 +115,7 @@ pub struct BiasDiagnostics {
     /// Largest, m/s².
     pub smoothed_max_m_s2: f64,
     /// (max − min) of the smoothed bias in units of its median σ at the fixes: 0 for a constant
-    /// bias, whose smoothed estimate is one number.
+    /// bias, whose smoothed estimate is one number (the last fix's is taken for min and max).
     pub smoothed_range_sigmas: f64,
     /// max |d_i|.
     pub departure_max_sigmas: f64,
@@ -379,9 +379,18 @@ pub fn bias_departure(filtered: [f64; 2], smoothed: [f64; 2]) -> Option<f64> {
 
 /// The bias's path through `series` for a filter assuming `model`, tested at α.
 fn bias(series: &[FixSeries], model: BiasModel, alpha: f64) -> BiasDiagnostics {
-    let smoothed = series.iter().map(|f| f.bias_smoothed[0]);
-    let lo = smoothed.clone().fold(f64::INFINITY, f64::min);
-    let hi = smoothed.fold(f64::NEG_INFINITY, f64::max);
+    // A constant bias's smoothed estimate is one number, the last fix's: the others differ from
+    // it by rounding alone, which is no range.
+    let path: Vec<f64> = match model {
+        BiasModel::Constant => series
+            .last()
+            .map(|f| f.bias_smoothed[0])
+            .into_iter()
+            .collect(),
+        _ => series.iter().map(|f| f.bias_smoothed[0]).collect(),
+    };
+    let lo = path.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = path.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let mut sigmas: Vec<f64> = series.iter().map(|f| f.bias_smoothed[1].sqrt()).collect();
     sigmas.sort_by(f64::total_cmp);
     let median_sigma = sigmas.get(sigmas.len() / 2).copied().unwrap_or(f64::NAN);
