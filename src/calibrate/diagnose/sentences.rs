@@ -123,7 +123,15 @@ fn mean_square(m: &MeasurementDiagnostics) -> Option<String> {
             if larger { "small" } else { "large" }
         )
     };
-    Some(format!("{head}{pointer}."))
+    // Correlated residuals that are too large need not be the GPS's: the integration may drift
+    // between fixes more than the filter assumes, and a larger GPS σ would hide that.
+    let caveat = if larger && m.whiteness.verdict == "fail" && positively_correlated(m) {
+        "; they are also correlated (see below), which a drifting integration explains as well \
+         as a GPS σ that is too small"
+    } else {
+        ""
+    };
+    Some(format!("{head}{pointer}{caveat}."))
 }
 
 /// "1–3, 5, 7–8": sorted lags as runs.
@@ -195,9 +203,11 @@ fn whiteness(m: &MeasurementDiagnostics, rate_hz: f64) -> Option<String> {
              errors alternate from fix to fix; consider a smaller filter.accel_noise_var_m2_s4"
         ),
         (true, "velocity") => format!(
-            "the GPS velocity errors are not white at {rate} Hz, or the accelerometer's error \
-             changes over that time (a drifting bias, gravity through a changing pitch); \
-             consider a larger {key}, a lower fix rate{thinned} or bias_model = \"random_walk\""
+            "the GPS velocity errors are not white at {rate} Hz, or the integration drifts \
+             between fixes more than the filter assumes (white noise and vibration above \
+             filter.accel_noise_var_m2_s4, a drifting bias, gravity through a changing pitch); \
+             consider a larger filter.accel_noise_var_m2_s4, bias_model = \"random_walk\", a \
+             larger {key} or a lower fix rate{thinned}"
         ),
         (true, measurement) if m.mean_square_place == "below" => format!(
             "the GPS {measurement} errors are not white at {rate} Hz, and small from fix to fix \

@@ -117,8 +117,15 @@ fn mean_squares_point_to_the_gps_sigma_or_the_integration() {
     ));
     assert!(any(
         &found,
-        "is too small; the residuals suggest about 1.9 m"
+        "is too small; the residuals suggest about 1.9 m."
     ));
+    // Large and slow: the caveat that the integration may be to blame.
+    let slow = series(|i| 2.0 * white(i / 4), 8.0, |_| 0.0);
+    let found = sentences(&slow, BiasModel::Constant);
+    assert!(
+        any(&found, "which a drifting integration explains as well"),
+        "{found:?}"
+    );
     // Residuals ±0.5: mean square 0.25, below; r² − (S − R) < 0: no σ suggested.
     let small = series(|i| 0.5 * white(i), 0.5, |_| 0.0);
     let found = sentences(&small, BiasModel::Constant);
