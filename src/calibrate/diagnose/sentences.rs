@@ -28,7 +28,7 @@ pub fn findings(d: &Diagnostics, nis: &NisTest) -> Vec<String> {
     out.extend(nis_sum(nis));
     for m in &d.measurements {
         out.extend(mean_square(m));
-        out.extend(whiteness(m, d.fix_rate_hz));
+        out.extend(whiteness(m, d.fix_rate_hz, d.bias.bias_model));
     }
     out.extend(bias(&d.bias, d.false_alarm_rate));
     out.extend(per_fix(&d.nis_per_fix));
@@ -168,7 +168,7 @@ fn positively_correlated(m: &MeasurementDiagnostics) -> bool {
 
 /// A measurement's innovations that are not white, with what that points to: slow errors
 /// (positive correlation) or a filter that overshoots (negative).
-fn whiteness(m: &MeasurementDiagnostics, rate_hz: f64) -> Option<String> {
+fn whiteness(m: &MeasurementDiagnostics, rate_hz: f64, bias_model: &str) -> Option<String> {
     let w = &m.whiteness;
     if w.verdict == "untestable" {
         return Some(format!(
@@ -196,20 +196,32 @@ fn whiteness(m: &MeasurementDiagnostics, rate_hz: f64) -> Option<String> {
         ),
     };
     let key = m.gps_sigma_key;
+    let drift = if bias_model == "constant" {
+        "bias_model = \"random_walk\""
+    } else {
+        "a faster bias drift"
+    };
+    let small = m.mean_square_place == "below";
     let cause = match (positively_correlated(m), m.measurement) {
         (false, measurement) => format!(
             "successive corrections overshoot: the filter's process noise \
              (filter.accel_noise_var_m2_s4) is large against {key}, or the GPS {measurement} \
              errors alternate from fix to fix; consider a smaller filter.accel_noise_var_m2_s4"
         ),
+        (true, "velocity") if small => format!(
+            "the GPS velocity errors are not white at {rate} Hz, or the integration's error \
+             varies slowly in a way the filter's model does not (a drifting bias, gravity \
+             through a changing pitch); the residuals are small, so rather than the smaller \
+             {key} their size suggests, take a lower fix rate{thinned} or {drift}"
+        ),
         (true, "velocity") => format!(
             "the GPS velocity errors are not white at {rate} Hz, or the integration drifts \
              between fixes more than the filter assumes (white noise and vibration above \
              filter.accel_noise_var_m2_s4, a drifting bias, gravity through a changing pitch); \
-             consider a larger filter.accel_noise_var_m2_s4, bias_model = \"random_walk\", a \
-             larger {key} or a lower fix rate{thinned}"
+             consider a larger filter.accel_noise_var_m2_s4, {drift}, a larger {key} or a \
+             lower fix rate{thinned}"
         ),
-        (true, measurement) if m.mean_square_place == "below" => format!(
+        (true, measurement) if small => format!(
             "the GPS {measurement} errors are not white at {rate} Hz, and small from fix to fix \
              because the filter follows them; rather than the smaller {key} their size \
              suggests, take a lower fix rate{thinned}"
