@@ -71,6 +71,17 @@ fn correlated_innovations_name_their_lags_and_the_fix_rate() {
         "The velocity innovations are correlated at lags 1–3"
     ));
     assert_eq!(lag_runs(&[1, 2, 3, 5, 7, 8]), "1–3, 5, 7–8");
+    // The velocity's advice names the integration's drift, and the bias model's next step.
+    let drift = "consider a larger filter.accel_noise_var_m2_s4, bias_model = \"random_walk\"";
+    assert!(any(&found, drift), "{found:?}");
+    let walk = BiasModel::RandomWalk {
+        k_m_s2_per_sqrt_s: 0.01,
+    };
+    let found = sentences(&series(|i| white(i / 4), 2.0, |_| 0.0), walk);
+    assert!(
+        any(&found, "accel_noise_var_m2_s4, a faster bias drift"),
+        "{found:?}"
+    );
     // Small and slow: a lower fix rate, not the smaller σ their size suggests.
     let found = sentences(
         &series(|i| 0.3 * white(i / 4), 2.0, |_| 0.0),
