@@ -151,7 +151,7 @@ fn row(m: &MeasurementDiagnostics) -> DiagnosisRow {
             _ => "—".to_string(),
         },
         mean_square: format!(
-            "{} in [{}, {}]: {}",
+            "{} (band [{}, {}]): {}",
             sig(m.mean_square, 3),
             sig(lo, 3),
             sig(hi, 3),
