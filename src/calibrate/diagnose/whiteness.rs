@@ -16,12 +16,13 @@ pub const FIXES_PER_LAG: usize = 10;
 /// sample mean: a mean away from 0 is itself a failure of the model and shows as correlation at
 /// every lag). For independent N(0, 1) values u/|u| is uniform on the sphere, so
 /// E ρ̂(ℓ) = 0 and Var ρ̂(ℓ) = (n − ℓ) / (n(n + 2)) exactly; (1 + ρ̂(ℓ))/2 is taken as
-/// Beta(a_ℓ, a_ℓ) with that variance, a_ℓ = (n(n + 2)/(n − ℓ) − 1)/2 (the moment-matched
-/// approximation of serial correlation coefficients; R. L. Anderson 1942). The band of each lag
-/// is ±h(ℓ), h(ℓ) = 1 − 2·I⁻¹(α_w / (2L); a_ℓ, a_ℓ), the lags split α_w evenly (Bonferroni):
-/// the sequence is "not white" when any lag leaves its band, with probability at most α_w for
-/// white innovations (measured: 0.49 % at α_w = 0.5 % for n = 150, L = 15 and 0.53 % for
-/// n = 577, L = 20, over 200 000 sequences each; the normal band ±z/√n gives 0.39 % at n = 150).
+/// Beta(a_ℓ, a_ℓ) with that variance, a_ℓ = (n(n + 2)/(n − ℓ) − 1)/2: a symmetric law on
+/// [−1, 1] like ρ̂'s own, whose tails a normal ±z/√n band misjudges at small n. The band of
+/// each lag is ±h(ℓ), h(ℓ) = 1 − 2·I⁻¹(α_w / (2L); a_ℓ, a_ℓ), the lags splitting α_w evenly
+/// (Bonferroni): the sequence is "not white" when any lag leaves its band, which white
+/// innovations do with probability at most α_w were the Beta law exact (measured: 0.49 % at
+/// α_w = 0.5 % for n = 150, L = 15 and 0.53 % for n = 577, L = 20, over 200 000 sequences
+/// each; the normal band ±z/√n gives 0.39 % at n = 150).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Whiteness {
     /// The false-alarm rate α_w of this test (over all its lags).
