@@ -18,6 +18,7 @@
 //!
 //! Nothing is written before the logs have passed every check.
 
+pub mod diagnose;
 mod forward;
 mod intervals;
 mod nis;

@@ -1,7 +1,7 @@
 //! A calibration's results as they are handed on: the summary and the per-fix series.
 
 use super::summary::{Calibration, FilterRecord, FixReport, StateRecord, Summary, sigma};
-use super::{Prepared, StepMode, nis_test, noise, warnings};
+use super::{Prepared, StepMode, diagnose, nis_test, noise, warnings};
 use crate::state::{ErrorState, StateVector};
 
 impl Prepared<'_> {
@@ -76,6 +76,13 @@ impl Prepared<'_> {
                 bias_correlation_time_s,
             },
             warnings: warnings::prior_warnings(fixes.first()),
+            diagnostics: diagnose::diagnose(
+                &self.fixes,
+                &self.smoothed,
+                f,
+                &nis_test(&nis, s.false_alarm_rate),
+                s.false_alarm_rate,
+            ),
             log_likelihood: noise::log_likelihood(&self.fixes),
             noise_estimate: self.noise.clone().map(noise::NoiseRecord),
         };

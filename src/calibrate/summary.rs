@@ -367,6 +367,9 @@ pub struct Summary {
     /// a prior that disagrees with the first fix
     /// ([`prior_warnings`](super::warnings::prior_warnings)).
     pub warnings: Vec<String>,
+    /// What the innovations, the per-fix NIS and the bias's path point to, with the sentences
+    /// they choose (field names in [`super::diagnose::Diagnostics`]).
+    pub diagnostics: super::diagnose::Diagnostics,
     /// The filter's Gaussian log-likelihood of its innovations, −½ Σ (ln det(2π S) + NIS).
     pub log_likelihood: f64,
     /// The statistics estimated from the drive (`--estimate-noise`), absent otherwise.

@@ -194,6 +194,7 @@ fn print_result(
         sig(s.nis.upper, 5),
         args.out.join(PAGE_FILE).display()
     ))?;
+    super::say(&format!("diagnosis: {}\n", s.diagnostics.headline()))?;
     Ok(())
 }
 

@@ -370,7 +370,8 @@ pub fn calibration_residuals(fixes: &[FixReport]) -> PlotResult {
 }
 
 /// The NIS rᵀS⁻¹r of every fix on a log axis, against its expected value M and the per-fix χ²(M)
-/// band of `test`; the title gives the test of the whole sequence.
+/// band of `test`, the fixes outside it in vermillion; the title gives the test of the whole
+/// sequence.
 pub fn calibration_nis(fixes: &[FixReport], test: &NisTest) -> PlotResult {
     let (t0, t1) = time_span(fixes.iter().map(|f| f.t_s));
     let time = Axis::linear("time", "s", (t0, t1), 8);
@@ -383,6 +384,7 @@ pub fn calibration_nis(fixes: &[FixReport], test: &NisTest) -> PlotResult {
     let y_area_px = y_label_area(&[&axis]);
     let legend = [
         Entry::new(Swatch::Marker(BLUISH_GREEN.filled()), "NIS of a fix"),
+        Entry::new(Swatch::Marker(VERMILLION.filled()), "outside the band"),
         Entry::new(
             Swatch::Line(BLACK.mix(0.4).stroke_width(1)),
             format!("expected value {M}"),
@@ -406,11 +408,11 @@ pub fn calibration_nis(fixes: &[FixReport], test: &NisTest) -> PlotResult {
         p.hline(M as f64, BLACK.mix(0.4).stroke_width(1))?;
         p.hline(test.per_fix_lower, BLACK.stroke_width(1))?;
         p.hline(test.per_fix_upper, BLACK.stroke_width(1))?;
-        markers(
-            &p,
-            fixes.iter().map(|f| (f.t_s, f.nis)).collect(),
-            BLUISH_GREEN.filled(),
-        )?;
-        Ok(())
+        let inside = |f: &&FixReport| (test.per_fix_lower..=test.per_fix_upper).contains(&f.nis);
+        let (within, outside): (Vec<&FixReport>, Vec<&FixReport>) = fixes.iter().partition(inside);
+        let at = |f: Vec<&FixReport>| f.iter().map(|f| (f.t_s, f.nis)).collect();
+        markers(&p, at(within), BLUISH_GREEN.filled())?;
+        // Drawn last and always as markers: the few fixes the diagnosis names by time.
+        p.dots(at(outside), 3, VERMILLION.filled())
     })
 }

@@ -28,6 +28,7 @@ mod calibration;
 mod cases;
 mod consistency;
 mod covariance;
+mod diagnosis;
 mod drift;
 mod errors;
 mod geometry;
@@ -46,6 +47,7 @@ pub use calibration::{
 pub use cases::{CaseSeries, accuracy_ratio, mean_error_in_sigma};
 pub use consistency::consistency;
 pub use covariance::covariance;
+pub use diagnosis::{calibration_autocorrelation, calibration_bias_departure};
 pub use drift::{DriftSeries, drift_sigma};
 pub use errors::realization_errors;
 pub use mean_error::mean_error;

@@ -45,6 +45,8 @@ pub struct CalibrationView {
     pub settings: Vec<Row>,
     /// The four figures.
     pub figures: Vec<FigureView>,
+    /// The diagnosis: Table 3, Figures 5 and 6.
+    pub diagnosis: super::calibration_diagnosis::DiagnosisView,
     /// The command that wrote the page.
     pub command: String,
     /// What `estimates.csv` holds, in words.
@@ -201,6 +203,7 @@ pub fn build(
         },
         settings: settings(s),
         figures: figures(cal)?,
+        diagnosis: super::calibration_diagnosis::build(cal, 3, 5)?,
         command: command.to_string(),
         estimates_words: if every_sample {
             "filtered and smoothed estimates at every sample"
@@ -265,7 +268,7 @@ fn figures(cal: &Calibration) -> Result<Vec<FigureView>, RenderError> {
             caption_html: rich(&format!(
                 "The NIS r^{{T}}S^{{−1}}r of each fix, χ²(2) for a consistent filter, with its \
              expected value 2 and the per-fix band [{}, {}] that holds it with probability \
-             1 − α = {}.",
+             1 − α = {}; the fixes outside it in vermillion.",
                 sig(n.per_fix_lower, 3),
                 sig(n.per_fix_upper, 3),
                 percent(1.0 - n.false_alarm_rate)

@@ -9,6 +9,7 @@
 //! template per section, and the templates under `templates/` only place that text.
 
 pub mod calibration;
+pub mod calibration_diagnosis;
 pub mod cases;
 pub mod drift;
 pub mod equations;

@@ -7,6 +7,7 @@
 mod common;
 
 mod bad_logs;
+mod diagnostics;
 mod drift;
 mod fast;
 mod prior;
