@@ -21,7 +21,12 @@ fn the_real_drive_calibrates_as_the_report_says() {
     assert!(w.identifiable, "{w:?}");
     assert!(w.lower > 0.1 && w.upper.unwrap() < 2.0, "{w:?}");
     let s = &runs[1].calibration.summary;
-    assert!(s.bias_m_s2 + 1.96 * s.bias_sigma_m_s2 < 0.0, "{} ± {}", s.bias_m_s2, s.bias_sigma_m_s2);
+    assert!(
+        s.bias_m_s2 + 1.96 * s.bias_sigma_m_s2 < 0.0,
+        "{} ± {}",
+        s.bias_m_s2,
+        s.bias_sigma_m_s2
+    );
     // The raw axis with a random walk: K is identified (gravity's share moves with the pitch).
     let k = &runs[3].noise.keys[3];
     assert!(k.identifiable, "{k:?}");

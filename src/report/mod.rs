@@ -20,6 +20,7 @@ pub mod outline;
 pub mod page;
 pub mod params;
 pub mod prose;
+pub mod real_drive;
 pub mod rich;
 pub mod sections;
 pub mod sensitivity;
@@ -148,8 +149,13 @@ pub fn outline_of(input: &ReportInput) -> Outline {
         input.study.sensitivity.is_some(),
         input.static_noise.is_some(),
     );
-    if input.study.drift.is_some() {
+    let outline = if input.study.drift.is_some() {
         outline.with_drift()
+    } else {
+        outline
+    };
+    if input.study.real_drive.is_some() {
+        outline.with_real_drive()
     } else {
         outline
     }

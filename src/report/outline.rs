@@ -34,6 +34,8 @@ pub enum Section {
     StaticNoise,
     /// A drifting bias seen by a constant-bias and a random-walk filter.
     Drift,
+    /// The shipped real drive calibrated with noise statistics estimated from it.
+    RealDrive,
     /// Conclusions.
     Conclusions,
     /// Configuration and reproduction.
@@ -66,6 +68,8 @@ pub enum Table {
     StaticNoiseCoverage,
     /// Two filters on a drifting bias: claims, errors and verdicts.
     Drift,
+    /// The real drive's calibrations.
+    RealDrive,
 }
 
 /// A numbered figure.
@@ -87,6 +91,10 @@ pub enum Figure {
     AllanDeviation,
     /// Claimed against achieved σ of two filters on a drifting bias.
     Drift,
+    /// The real drive's bias, gravity-compensated axis.
+    RealDriveGravityCompensated,
+    /// The real drive's bias, raw axis with a random walk.
+    RealDriveRaw,
 }
 
 /// A numbered display equation.
@@ -175,6 +183,11 @@ impl Section {
                 T(Table::StaticNoiseCoverage),
             ],
             Section::Drift => vec![F(Figure::Drift), T(Table::Drift)],
+            Section::RealDrive => vec![
+                T(Table::RealDrive),
+                F(Figure::RealDriveGravityCompensated),
+                F(Figure::RealDriveRaw),
+            ],
         }
     }
 }
@@ -242,6 +255,17 @@ impl Outline {
             .position(|n| n.section == Section::Conclusions)
             .unwrap_or(self.nodes.len());
         self.nodes.insert(at, Node::leaf(Section::Drift));
+        self
+    }
+
+    /// The same outline with the real drive's section before the conclusions.
+    pub fn with_real_drive(mut self) -> Self {
+        let at = self
+            .nodes
+            .iter()
+            .position(|n| n.section == Section::Conclusions)
+            .unwrap_or(self.nodes.len());
+        self.nodes.insert(at, Node::leaf(Section::RealDrive));
         self
     }
 

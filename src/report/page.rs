@@ -188,6 +188,8 @@ pub enum SectionView {
     StaticNoise(Box<crate::allan::section::AllanSection>),
     /// A drifting bias.
     Drift(Box<super::drift::DriftView>),
+    /// A real drive.
+    RealDrive(Box<super::real_drive::RealDriveView>),
     /// Conclusions.
     Conclusions(ConclusionsView),
     /// Configuration and reproduction.
@@ -208,6 +210,7 @@ impl SectionView {
             SectionView::Sensitivity(_) => "sensitivity".to_string(),
             SectionView::StaticNoise(_) => "allan".to_string(),
             SectionView::Drift(_) => "drifting-bias".to_string(),
+            SectionView::RealDrive(_) => "real-drive".to_string(),
             SectionView::Conclusions(_) => "conclusions".to_string(),
             SectionView::Appendix(_) => "appendix".to_string(),
         }
@@ -226,6 +229,7 @@ impl SectionView {
             SectionView::Sensitivity(_) => "Sensitivity to the assumed statistics".to_string(),
             SectionView::StaticNoise(_) => "Noise statistics from a static log".to_string(),
             SectionView::Drift(_) => "A drifting bias".to_string(),
+            SectionView::RealDrive(_) => "A real drive".to_string(),
             SectionView::Conclusions(_) => "Conclusions".to_string(),
             SectionView::Appendix(_) => "Appendix: configuration and reproduction".to_string(),
         }

@@ -27,6 +27,8 @@ pub struct DriveRow {
     pub nis: String,
     /// `pass` or `fail`.
     pub verdict: String,
+    /// The innovations' whiteness per measurement, in words.
+    pub whiteness: String,
 }
 
 /// The section's view.
@@ -72,7 +74,10 @@ fn run_words(r: &DriveRun) -> String {
         Axis::GravityCompensated => "gravity-compensated",
         Axis::Raw => "raw",
     };
-    format!("{axis} axis, {} bias", r.bias_model.name().replace('_', " "))
+    format!(
+        "{axis} axis, {} bias",
+        r.bias_model.name().replace('_', " ")
+    )
 }
 
 fn row(r: &DriveRun) -> DriveRow {
@@ -89,7 +94,11 @@ fn row(r: &DriveRun) -> DriveRow {
             sig(b.0 - 1.96 * b.1, 3),
             sig(b.0 + 1.96 * b.1, 3)
         ),
-        bias_start: format!("{} ± {}", sig(start.bias_m_s2, 3), sig(start.sigma_bias_m_s2, 2)),
+        bias_start: format!(
+            "{} ± {}",
+            sig(start.bias_m_s2, 3),
+            sig(start.sigma_bias_m_s2, 2)
+        ),
         nis: format!(
             "{} in [{}, {}]",
             fixed(s.nis.sum, 0),
@@ -97,6 +106,13 @@ fn row(r: &DriveRun) -> DriveRow {
             fixed(s.nis.upper, 0)
         ),
         verdict: s.nis.verdict.to_string(),
+        whiteness: s
+            .diagnostics
+            .measurements
+            .iter()
+            .map(|m| format!("{}: {}", m.measurement, m.whiteness.verdict))
+            .collect::<Vec<_>>()
+            .join("; "),
     }
 }
 
@@ -127,7 +143,7 @@ pub fn findings(runs: &[DriveRun]) -> Vec<String> {
                 sig(wk.value, 3),
                 sig(wk.lower, 3),
                 sig(wk.upper.unwrap_or(f64::NAN), 3),
-                sig(wk.value / 4e-4, 2)
+                crate::format::count((wk.value / 4e-4).round() as u64)
             ),
             (true, true, _) => "The gravity-compensated axis passes the NIS test with the GPS \
                                 σ's estimated alone, and with W estimated too."
@@ -135,7 +151,11 @@ pub fn findings(runs: &[DriveRun]) -> Vec<String> {
             _ => format!(
                 "The gravity-compensated axis does not pass the NIS test with the estimated \
                  statistics (W {}): the filter's model does not explain this drive.",
-                if wk.identifiable { "identified" } else { "not identified" }
+                if wk.identifiable {
+                    "identified"
+                } else {
+                    "not identified"
+                }
             ),
         };
         out.push(sentence);
@@ -154,7 +174,10 @@ pub fn findings(runs: &[DriveRun]) -> Vec<String> {
             sig(sb, 2)
         ));
     }
-    if let Some(rw) = runs.iter().find(|r| r.axis == Axis::Raw && r.noise.keys.len() == 4) {
+    if let Some(rw) = runs
+        .iter()
+        .find(|r| r.axis == Axis::Raw && r.noise.keys.len() == 4)
+    {
         let k = &rw.noise.keys[3];
         let s = &rw.calibration.summary;
         let moved = (s.bias_m_s2 - s.start_smoothed.bias_m_s2).abs();
@@ -187,7 +210,11 @@ pub fn view(runs: &[DriveRun], numbers: &Numbers) -> Result<RealDriveView, Rende
     let first = &runs[0].calibration.summary;
     let mut figures = Vec::new();
     let shown = [
-        (Figure::RealDriveGravityCompensated, 1usize, "real-drive-gravcomp"),
+        (
+            Figure::RealDriveGravityCompensated,
+            1usize,
+            "real-drive-gravcomp",
+        ),
         (Figure::RealDriveRaw, 3usize, "real-drive-raw"),
     ];
     for (fig, i, id) in shown {

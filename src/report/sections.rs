@@ -97,6 +97,13 @@ impl Context<'_> {
                     .expect("the outline shows the drifting bias only when the study ran it"),
                 self.numbers,
             )?)),
+            Section::RealDrive => SectionView::RealDrive(Box::new(super::real_drive::view(
+                study
+                    .real_drive
+                    .as_ref()
+                    .expect("the outline shows the real drive only when the study ran it"),
+                self.numbers,
+            )?)),
             Section::Conclusions => SectionView::Conclusions(self.conclusions()),
             Section::Appendix => SectionView::Appendix(AppendixView {
                 command: self.input.command.to_string(),

@@ -65,7 +65,10 @@ pub struct DriveRun {
 /// The runs of the section: the gravity-compensated axis with the GPS σ's estimated, then with the
 /// white noise W too; the raw axis with a constant bias and with a random walk (K estimated).
 pub const RUNS: [(Axis, &[Key]); 4] = [
-    (Axis::GravityCompensated, &[Key::GpsPosition, Key::GpsVelocity]),
+    (
+        Axis::GravityCompensated,
+        &[Key::GpsPosition, Key::GpsVelocity],
+    ),
     (
         Axis::GravityCompensated,
         &[Key::GpsPosition, Key::GpsVelocity, Key::AccelNoiseVar],
@@ -141,5 +144,7 @@ pub fn run_one(axis: Axis, keys: &[Key]) -> Result<DriveRun, CalibrateError> {
 /// # Errors
 /// As [`run_one`].
 pub fn run() -> Result<Vec<DriveRun>, CalibrateError> {
-    RUNS.iter().map(|(axis, keys)| run_one(*axis, keys)).collect()
+    RUNS.iter()
+        .map(|(axis, keys)| run_one(*axis, keys))
+        .collect()
 }

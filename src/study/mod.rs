@@ -96,6 +96,8 @@ pub struct Study {
     pub sensitivity: Option<Sensitivity>,
     /// The drifting-bias study, when it was run ([`Study::with_drift`]).
     pub drift: Option<drift::DriftStudy>,
+    /// The real drive's calibrations, when they were run ([`Study::with_real_drive`]).
+    pub real_drive: Option<Vec<drive::DriveRun>>,
 }
 
 impl Study {
@@ -140,6 +142,7 @@ impl Study {
             realization_case,
             sensitivity: None,
             drift: None,
+            real_drive: None,
         })
     }
 
@@ -163,6 +166,15 @@ impl Study {
     /// [`FilterError`] when a filter's covariance stops being positive definite.
     pub fn with_drift(mut self, progress: &mut dyn Progress) -> Result<Self, FilterError> {
         self.drift = drift::run(&self.model.config, progress)?;
+        Ok(self)
+    }
+
+    /// The study with the shipped real drive calibrated ([`drive::run`]).
+    ///
+    /// # Errors
+    /// [`crate::calibrate::CalibrateError`] only if the shipped files did not calibrate.
+    pub fn with_real_drive(mut self) -> Result<Self, crate::calibrate::CalibrateError> {
+        self.real_drive = Some(drive::run()?);
         Ok(self)
     }
 
