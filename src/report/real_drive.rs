@@ -178,26 +178,7 @@ pub fn findings(runs: &[DriveRun]) -> Vec<String> {
         .iter()
         .find(|r| r.axis == Axis::Raw && r.noise.keys.len() == 4)
     {
-        let k = &rw.noise.keys[3];
-        let s = &rw.calibration.summary;
-        let moved = (s.bias_m_s2 - s.start_smoothed.bias_m_s2).abs();
-        let sentence = if k.identifiable {
-            format!(
-                "On the raw axis the bias is not constant: with a random walk the drive measures \
-                 K = {} [{}, {}] m/s²/√s, and the smoothed bias moves by {} m/s² over the minute \
-                 ({} σ of its end value): gravity's share of the axis follows the pitch.",
-                sig(k.value, 3),
-                sig(k.lower, 3),
-                sig(k.upper.unwrap_or(f64::NAN), 3),
-                sig(moved, 2),
-                fixed(moved / s.bias_sigma_m_s2, 1)
-            )
-        } else {
-            "On the raw axis the drive does not determine a random walk of the bias (K not \
-             identifiable)."
-                .to_string()
-        };
-        out.push(sentence);
+        out.push(raw_drift(rw));
     }
     out
 }
@@ -244,4 +225,29 @@ pub fn view(runs: &[DriveRun], numbers: &Numbers) -> Result<RealDriveView, Rende
         figures,
         findings_html: findings(runs).iter().map(|s| rich::rich(s)).collect(),
     })
+}
+
+/// The raw axis's random walk in words: whether the drive measures K, and how far the
+/// smoothed bias moves.
+fn raw_drift(rw: &DriveRun) -> String {
+    let k = &rw.noise.keys[3];
+    let s = &rw.calibration.summary;
+    let moved = (s.bias_m_s2 - s.start_smoothed.bias_m_s2).abs();
+    if k.identifiable {
+        format!(
+            "On the raw axis the bias is not constant: with a random walk the drive measures \
+             K = {} [{}, {}] m/s²/√s, and the smoothed bias moves by {} m/s² over the minute \
+             ({} σ of its end value): gravity's share of the axis follows the pitch.",
+            sig(k.value, 3),
+            sig(k.lower, 3),
+            sig(k.upper.unwrap_or(f64::NAN), 3),
+            sig(moved, 2),
+            fixed(moved / s.bias_sigma_m_s2, 1)
+        )
+    } else {
+        "On the raw axis the drive does not determine a random walk of the bias (K not \
+         identifiable)."
+            .to_string()
+    };
+    sentence
 }
