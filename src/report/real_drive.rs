@@ -248,6 +248,5 @@ fn raw_drift(rw: &DriveRun) -> String {
         "On the raw axis the drive does not determine a random walk of the bias (K not \
          identifiable)."
             .to_string()
-    };
-    sentence
+    }
 }
