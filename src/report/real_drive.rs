@@ -250,3 +250,33 @@ fn raw_drift(rw: &DriveRun) -> String {
             .to_string()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_sentences_follow_the_numbers() {
+        let runs = crate::study::drive::run().expect("the shipped drive calibrates");
+        let said = findings(&runs);
+        assert!(said[0].contains("fails the NIS test") && said[0].contains("passes"));
+        assert!(said[1].contains("negative"));
+        assert!(said[2].contains("measures K"));
+        // Flipped numbers flip the words: the GPS-only run passing, the bias's sign, K open.
+        let mut flipped = runs.clone();
+        flipped[0].calibration.summary.nis.verdict = "pass";
+        let s = &mut flipped[1].calibration.summary;
+        s.bias_m_s2 = -s.bias_m_s2;
+        flipped[3].noise.keys[3].identifiable = false;
+        let said = findings(&flipped);
+        assert!(
+            said[0].contains("with the GPS σ's estimated alone"),
+            "{}",
+            said[0]
+        );
+        assert!(said[1].contains("positive"), "{}", said[1]);
+        assert!(said[2].contains("does not determine"), "{}", said[2]);
+        flipped[1].calibration.summary.nis.verdict = "fail";
+        assert!(findings(&flipped)[0].contains("does not pass"));
+    }
+}
