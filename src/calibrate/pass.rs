@@ -38,7 +38,7 @@ pub struct Integrated {
 impl Integrated {
     /// eq. (3) over a step of `dt` with `half_dt2` = Δt²/2, written as the simulation does.
     #[inline]
-    fn advance(&mut self, a: f64, dt: f64, half_dt2: f64) {
+    pub fn advance(&mut self, a: f64, dt: f64, half_dt2: f64) {
         self.pc_m += self.vc_m_s * dt + a * half_dt2;
         self.vc_m_s += a * dt;
     }
@@ -46,28 +46,79 @@ impl Integrated {
     fn is_finite(&self) -> bool {
         self.pc_m.is_finite() && self.vc_m_s.is_finite()
     }
+
+    /// Carried over a fraction `tau_s` of a step with the output `a` (itself at τ = 0).
+    pub fn advanced(self, a: f64, tau_s: f64) -> Self {
+        let mut out = self;
+        if tau_s != 0.0 {
+            out.advance(a, tau_s, 0.5 * tau_s * tau_s);
+        }
+        out
+    }
 }
 
-/// A GPS fix at the accelerometer sample nearest to it (the earlier one of a tie).
+/// Where the integration of eq. (3) starts: p_c(t₀), v_c(t₀) at the log's first sample t₀.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Start {
+    /// The configured prior means (`[initial]`).
+    Prior(Integrated),
+    /// The first GPS fix (z_p, z_v) at `t_s`, carried back to t₀ at its own velocity:
+    /// p_c(t₀) = z_p − z_v·(t_fix − t₀), v_c(t₀) = z_v.
+    FirstFix {
+        /// Time of the fix, s.
+        t_s: f64,
+        /// z_p, m.
+        position_m: f64,
+        /// z_v, m/s.
+        velocity_m_s: f64,
+    },
+}
+
+impl Start {
+    /// (p_c, v_c) at the first sample, at `t0_s`.
+    pub fn at(&self, t0_s: f64) -> Integrated {
+        match *self {
+            Start::Prior(start) => start,
+            Start::FirstFix {
+                t_s,
+                position_m,
+                velocity_m_s,
+            } => Integrated {
+                pc_m: position_m - velocity_m_s * (t_s - t0_s),
+                vc_m_s: velocity_m_s,
+            },
+        }
+    }
+}
+
+/// The time a fix at `fix_t_s` is applied at, in the step from the sample at `sample_t_s`
+/// (`last`: the log's last sample, which starts no step): its own, or the sample's for a fix
+/// before the first sample or after the last (within half a median step, which
+/// [`super::scan::Scan::of`] checks).
+pub fn update_time_s(fix_t_s: f64, sample_t_s: f64, last: bool) -> f64 {
+    if last || fix_t_s < sample_t_s {
+        sample_t_s
+    } else {
+        fix_t_s
+    }
+}
+
+/// A GPS fix placed in the step of the accelerometer sample at or before it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FixAt {
     /// Index of the fix in the GPS log.
     pub fix: usize,
-    /// Index of the sample.
+    /// Index of the sample whose step holds the fix (t_sample ≤ t_s < the next sample's).
     pub sample: u64,
-    /// Its time stamp, s.
+    /// The time the filter updates at, s: the fix's own ([`update_time_s`]).
     pub t_s: f64,
-    /// Its line in the accelerometer log.
+    /// The sample's line in the accelerometer log.
     pub line: u64,
-    /// |t_fix − t_sample|, s.
-    pub distance_s: f64,
-    /// The samples around the fix: the time stamp before it, and the sample after it.
-    pub before_s: f64,
-    /// Index and time stamp of the sample after the fix, if any.
-    pub after: Option<(u64, f64)>,
-    /// (p_c, v_c) at the sample with the nominal Δt and with each step's own.
+    /// (p_c, v_c) at `t_s` with the nominal Δt and with each step's own: the sample's, carried
+    /// over the fraction τ = t_s − t_sample of its step by eq. (3) with that sample's output.
     pub integrated: [Integrated; 2],
-    /// The per-step process noise since the previous fix's sample (the log's first).
+    /// The per-step process noise since the previous fix's time (the log's first sample), the
+    /// fractions of the steps the two fixes cut included as steps of their own.
     pub units: NoiseUnits,
 }
 
@@ -84,7 +135,8 @@ pub struct Reduced {
     pub median: StepMedian,
     /// The shortest and the longest step.
     pub step_range: (StepAt, StepAt),
-    /// Whether every step equals the nominal Δt within [`NOMINAL_TOLERANCE`].
+    /// Whether every step equals the nominal Δt within [`NOMINAL_TOLERANCE`] and every fix
+    /// lies on a sample (its time stamp that sample's, or beyond the log's ends).
     pub nominal: bool,
     /// Every fix at its sample, in the GPS log's order.
     pub fixes: Vec<FixAt>,
@@ -111,9 +163,9 @@ struct Stitch<'g> {
     bias: BiasModel,
     half_dt2_s2: f64,
     gps: &'g [GpsFix],
+    start: Start,
     k: u64,
     current: Option<Current>,
-    before_s: f64,
     integrated: [Integrated; 2],
     units: NoiseUnits,
     reduced: Reduced,
@@ -121,31 +173,42 @@ struct Stitch<'g> {
 }
 
 impl Stitch<'_> {
-    /// Assigns to the current sample every remaining fix nearer to it than to the next sample
-    /// at `next_s` (all of them at the last sample).
-    fn assign(&mut self, c: Current, next_s: Option<f64>) {
+    /// Places in the step from the current sample `c` every remaining fix before the next
+    /// sample at `next_s` (every one at the last sample), each at its own time: the units get the
+    /// fraction of the step up to it as a step of its own. Returns the part of the step already
+    /// in the units, s.
+    fn assign(&mut self, c: Current, next_s: Option<f64>) -> f64 {
+        let mut done_s = 0.0;
         while let Some(f) = self.gps.get(self.reduced.fixes.len()) {
-            let d = (f.t_s - c.t_s).abs();
-            if next_s.is_some_and(|n| d > (n - f.t_s).abs()) {
+            if next_s.is_some_and(|n| f.t_s >= n) {
                 break;
             }
-            let (before_s, after) = if f.t_s >= c.t_s {
-                (c.t_s, next_s.map(|n| (self.k + 1, n)))
-            } else {
-                (self.before_s, Some((self.k, c.t_s)))
-            };
+            let t_s = update_time_s(f.t_s, c.t_s, next_s.is_none());
+            let tau_s = t_s - c.t_s;
+            if tau_s > done_s {
+                self.reduced.nominal = false;
+                self.add_step(tau_s - done_s);
+                done_s = tau_s;
+            }
             let fix = FixAt {
                 fix: self.reduced.fixes.len(),
                 sample: self.k,
-                t_s: c.t_s,
+                t_s,
                 line: c.line,
-                distance_s: d,
-                before_s,
-                after,
-                integrated: self.integrated,
+                integrated: self.integrated.map(|i| i.advanced(c.accel_m_s2, tau_s)),
                 units: std::mem::take(&mut self.units),
             };
             self.reduced.fixes.push(fix);
+        }
+        done_s
+    }
+
+    /// The process noise of a step (or a piece of one) of `tau_s`.
+    #[inline]
+    fn add_step(&mut self, tau_s: f64) {
+        self.units.add_step(tau_s);
+        if self.bias.drifts() {
+            self.units.add_bias_step(tau_s, self.bias);
         }
     }
 
@@ -159,7 +222,8 @@ impl Stitch<'_> {
         };
         let Some(c) = self.current else {
             self.current = Some(next);
-            (self.before_s, self.reduced.span_s, self.reduced.first_line) = (t_s, (t_s, t_s), line);
+            self.integrated = [self.start.at(t_s); 2];
+            (self.reduced.span_s, self.reduced.first_line) = ((t_s, t_s), line);
             return Ok(());
         };
         if t_s <= c.t_s {
@@ -185,16 +249,16 @@ impl Stitch<'_> {
             r.step_range.1 = at;
         }
         r.nominal &= (step - self.dt_s).abs() <= NOMINAL_TOLERANCE * self.dt_s;
-        if self.reduced.fixes.len() < self.gps.len() {
-            self.assign(c, Some(t_s));
-        }
+        let done_s = if self.reduced.fixes.len() < self.gps.len() {
+            self.assign(c, Some(t_s))
+        } else {
+            0.0
+        };
         let a = c.accel_m_s2;
         self.integrated[0].advance(a, self.dt_s, self.half_dt2_s2);
         self.integrated[1].advance(a, step, 0.5 * step * step);
-        self.units.add_step(step);
-        if self.bias.drifts() {
-            self.units.add_bias_step(step, self.bias);
-        }
+        // The rest of the step after its last fix (all of it without one: the same bits).
+        self.add_step(step - done_s);
         let finite = [
             self.integrated[0].is_finite(),
             self.integrated[1].is_finite() && self.units.is_finite(),
@@ -204,7 +268,7 @@ impl Stitch<'_> {
                 *overflow = Some((self.k, c.line));
             }
         }
-        (self.before_s, self.current, self.k) = (c.t_s, Some(next), self.k + 1);
+        (self.current, self.k) = (Some(next), self.k + 1);
         Ok(())
     }
 
@@ -289,8 +353,8 @@ fn stitch_all(
 
 /// Streams the accelerometer log `source` once: every row checked (format, increasing time
 /// stamps), the steps counted, and the log reduced between the `gps` fixes for either Δt mode
-/// (`nominal_dt_s` the configured step, `bias` the filter's bias model for the per-step units).
-/// Starts eq. (3) from `start` = (p_c(0), v_c(0)).
+/// (`nominal_dt_s` the configured step, NaN when none is, `bias` the filter's bias model for the
+/// per-step units). Starts eq. (3) from `start` at the first sample.
 ///
 /// # Errors
 /// [`LogError`] naming the line of the first malformed row or time stamp not after the
@@ -299,7 +363,7 @@ pub fn reduce(
     source: &dyn LogSource,
     gps: &[GpsFix],
     (nominal_dt_s, bias): (f64, BiasModel),
-    start: Integrated,
+    start: Start,
 ) -> Result<Reduced, LogError> {
     let (layout, mut feed) = open_blocks(source, ACCEL_COLUMNS)?;
     let empty = StepAt {
@@ -312,10 +376,10 @@ pub fn reduce(
         bias,
         half_dt2_s2: 0.5 * nominal_dt_s * nominal_dt_s,
         gps,
+        start,
         k: 0,
         current: None,
-        before_s: 0.0,
-        integrated: [start; 2],
+        integrated: [Integrated::default(); 2],
         units: NoiseUnits::default(),
         reduced: Reduced {
             samples: 0,
