@@ -187,8 +187,8 @@ impl CalibrateError {
 pub struct Prepared<'a> {
     settings: Settings,
     model: ErrorStateModel,
-    /// Where the integration starts.
-    start: pass::Start,
+    /// (p_c, v_c) at the first sample, where the integration starts.
+    start: pass::Integrated,
     accel: &'a dyn LogSource,
     scan: Scan,
     fixes: Vec<FilteredFix>,
@@ -217,6 +217,7 @@ pub fn prepare<'a>(
     );
     let reduced = pass::reduce(accel, &fixes, steps, start)?;
     let scan = Scan::of(&reduced, fixes, gps.name())?;
+    let start = start.at(scan.span_s.0, reduced.first_accel_m_s2);
     let dt_s = settings.nominal_dt_s.unwrap_or(scan.median_step_s);
     let model = ErrorStateModel::new(dt_s, &settings.filter_stats);
     let (fixes, end) = intervals::filter(
@@ -293,7 +294,7 @@ impl Prepared<'_> {
             })
             .collect();
         let (lo, hi) = sc.accepted_step_s();
-        let start = self.start.at(sc.span_s.0);
+        let start = self.start;
         let summary = Summary {
             accelcal_version: env!("CARGO_PKG_VERSION"),
             accelerometer_log: self.accel.name().to_string(),

@@ -62,8 +62,10 @@ impl Integrated {
 pub enum Start {
     /// The configured prior means (`[initial]`).
     Prior(Integrated),
-    /// The first GPS fix (z_p, z_v) at `t_s`, carried back to t₀ at its own velocity:
-    /// p_c(t₀) = z_p − z_v·(t_fix − t₀), v_c(t₀) = z_v.
+    /// The first GPS fix (z_p, z_v) at `t_s`, carried back to t₀ by eq. (3) run backwards over
+    /// Δ = t_fix − t₀ with the first sample's output a_c(t₀): v_c(t₀) = z_v − a_c(t₀)·Δ,
+    /// p_c(t₀) = z_p − z_v·Δ + a_c(t₀)·Δ²/2, so that eq. (3) run forward from there with that
+    /// output reaches the fix (exactly when the fix lies within the first step).
     FirstFix {
         /// Time of the fix, s.
         t_s: f64,
@@ -75,18 +77,21 @@ pub enum Start {
 }
 
 impl Start {
-    /// (p_c, v_c) at the first sample, at `t0_s`.
-    pub fn at(&self, t0_s: f64) -> Integrated {
+    /// (p_c, v_c) at the first sample, at `t0_s` with the output `a0_m_s2`.
+    pub fn at(&self, t0_s: f64, a0_m_s2: f64) -> Integrated {
         match *self {
             Start::Prior(start) => start,
             Start::FirstFix {
                 t_s,
                 position_m,
                 velocity_m_s,
-            } => Integrated {
-                pc_m: position_m - velocity_m_s * (t_s - t0_s),
-                vc_m_s: velocity_m_s,
-            },
+            } => {
+                let dt = t_s - t0_s;
+                Integrated {
+                    pc_m: position_m - velocity_m_s * dt + 0.5 * a0_m_s2 * dt * dt,
+                    vc_m_s: velocity_m_s - a0_m_s2 * dt,
+                }
+            }
         }
     }
 }
@@ -131,6 +136,8 @@ pub struct Reduced {
     pub span_s: (f64, f64),
     /// Line of the first sample.
     pub first_line: u64,
+    /// The output of the first sample, m/s².
+    pub first_accel_m_s2: f64,
     /// The steps' histogram, with the first step of each key.
     pub median: StepMedian,
     /// The shortest and the longest step.
@@ -222,8 +229,9 @@ impl Stitch<'_> {
         };
         let Some(c) = self.current else {
             self.current = Some(next);
-            self.integrated = [self.start.at(t_s); 2];
+            self.integrated = [self.start.at(t_s, accel_m_s2); 2];
             (self.reduced.span_s, self.reduced.first_line) = ((t_s, t_s), line);
+            self.reduced.first_accel_m_s2 = accel_m_s2;
             return Ok(());
         };
         if t_s <= c.t_s {
@@ -385,6 +393,7 @@ pub fn reduce(
             samples: 0,
             span_s: (0.0, 0.0),
             first_line: 0,
+            first_accel_m_s2: 0.0,
             median: StepMedian::new(),
             step_range: (empty, StepAt::default()),
             nominal: true,

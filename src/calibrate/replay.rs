@@ -40,11 +40,10 @@ impl Prepared<'_> {
         // The accelerometer line of the previous fix: the rows integrated since are behind the
         // next fix's prediction.
         let mut since_line = current.line;
-        let start = self.start.at(current.t_s);
         let state = ErrorState {
             stats: self.settings.filter_stats,
         };
-        let mut fw = Forward::new(&self.model, state, self.scan.mode, start, current.t_s);
+        let mut fw = Forward::new(&self.model, state, self.scan.mode, self.start, current.t_s);
         // The fixes applied since the last row.
         let mut applied: Vec<FilteredFix> = Vec::new();
         loop {

@@ -7,10 +7,12 @@
 mod common;
 
 mod bad_logs;
+mod between;
 mod drift;
 mod fast;
 mod prior;
 mod reader;
+mod recordings;
 mod reference;
 mod round_trip;
 mod smoother;
