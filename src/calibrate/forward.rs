@@ -182,7 +182,9 @@ impl<'m> Forward<'m> {
                 // fix when one cut the step.
                 self.pc_m += self.vc_m_s * dt + a * half_dt2;
                 self.vc_m_s += a * dt;
-                self.propagate_to(t_next_s);
+                // The rest of a step a fix cut is a piece of it.
+                let cut = (self.filter_t_s != self.t_s).then_some(dt);
+                self.propagate_to(t_next_s, cut);
             }
         }
         self.k += 1;
@@ -190,16 +192,41 @@ impl<'m> Forward<'m> {
         self.filter_t_s = t_next_s;
     }
 
-    /// The estimate and its covariance carried from their time to `t_s` (per-step mode).
-    fn propagate_to(&mut self, t_s: f64) {
+    /// The estimate and its covariance carried from their time to `t_s` (per-step mode): a
+    /// whole step, or a piece of the step of `cut` = Some(Δt_j) that a fix cuts, whose white
+    /// noise is taken as white within the step ([`super::pass::NoiseUnits::add_piece`]).
+    fn propagate_to(&mut self, t_s: f64, cut: Option<f64>) {
         let tau = t_s - self.filter_t_s;
         let phi = self.state.transition(self.filter_t_s, tau);
         self.x = phi * self.x;
-        self.p = propagate_over(&self.state, &self.p, self.filter_t_s, tau);
+        self.p = match cut {
+            None => propagate_over(&self.state, &self.p, self.filter_t_s, tau),
+            Some(step_s) => {
+                let p = phi * self.p * phi.transpose() + self.piece_noise(tau, step_s);
+                (p + p.transpose()) * 0.5
+            }
+        };
         if !self.composes {
             self.phi_since_fix = phi * self.phi_since_fix;
         }
         self.filter_t_s = t_s;
+    }
+
+    /// Q of a piece of `tau_s` of a step of `step_s`: W·Δt_j·[[τ³/3, τ²/2], [τ²/2, τ]] and the
+    /// bias's own q_b(τ).
+    fn piece_noise(&self, tau_s: f64, step_s: f64) -> StateMatrix {
+        let (p, v, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
+        let stats = &self.state.stats;
+        let q = stats.accel_noise_var_m2_s4 * step_s;
+        let mut m = StateMatrix::zeros();
+        m[(p, p)] = q * tau_s * tau_s * tau_s / 3.0;
+        m[(p, v)] = q * 0.5 * tau_s * tau_s;
+        m[(v, p)] = m[(p, v)];
+        m[(v, v)] = q * tau_s;
+        if stats.bias_model.drifts() {
+            m[(b, b)] = stats.bias_model.step(tau_s, stats.bias_var_m2_s4).1;
+        }
+        m
     }
 
     /// Whether the time stamp, the integration, the estimate and its covariance are finite.
@@ -252,9 +279,9 @@ impl<'m> Forward<'m> {
         self.update_at(fix, self.t_s, integrated)
     }
 
-    /// The measurement update with `fix` at `t_fix_s`, inside the step from the current sample
-    /// whose output is `accel_m_s2` (per-step mode): the filter propagated over the fraction of
-    /// the step up to the fix, the integration carried there by eq. (3).
+    /// The measurement update with `fix` at `t_fix_s`, inside the step of `step_s` from the
+    /// current sample whose output is `accel_m_s2` (per-step mode): the filter propagated over
+    /// the piece of the step up to the fix, the integration carried there by eq. (3).
     ///
     /// # Errors
     /// [`FilterError`] when a covariance is not positive definite.
@@ -262,9 +289,9 @@ impl<'m> Forward<'m> {
         &mut self,
         fix: &GpsFix,
         accel_m_s2: f64,
-        t_fix_s: f64,
+        (t_fix_s, step_s): (f64, f64),
     ) -> Result<FilteredFix, FilterError> {
-        self.propagate_to(t_fix_s);
+        self.propagate_to(t_fix_s, Some(step_s));
         let at_sample = Integrated {
             pc_m: self.pc_m,
             vc_m_s: self.vc_m_s,

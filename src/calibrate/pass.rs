@@ -122,8 +122,8 @@ pub struct FixAt {
     /// (p_c, v_c) at `t_s` with the nominal Δt and with each step's own: the sample's, carried
     /// over the fraction τ = t_s − t_sample of its step by eq. (3) with that sample's output.
     pub integrated: [Integrated; 2],
-    /// The per-step process noise since the previous fix's time (the log's first sample), the
-    /// fractions of the steps the two fixes cut included as steps of their own.
+    /// The per-step process noise since the previous fix's time (the log's first sample), with
+    /// the pieces of the steps the two fixes cut ([`NoiseUnits::add_piece`]).
     pub units: NoiseUnits,
 }
 
@@ -194,7 +194,9 @@ impl Stitch<'_> {
             let tau_s = t_s - c.t_s;
             if tau_s > done_s {
                 self.reduced.nominal = false;
-                self.add_step(tau_s - done_s);
+                // A fix before the next sample: `next_s` is known.
+                let step_s = next_s.map_or(0.0, |n| n - c.t_s);
+                self.add_piece(tau_s - done_s, step_s);
                 done_s = tau_s;
             }
             let fix = FixAt {
@@ -210,10 +212,19 @@ impl Stitch<'_> {
         done_s
     }
 
-    /// The process noise of a step (or a piece of one) of `tau_s`.
+    /// The process noise of a step of `tau_s`.
     #[inline]
     fn add_step(&mut self, tau_s: f64) {
         self.units.add_step(tau_s);
+        if self.bias.drifts() {
+            self.units.add_bias_step(tau_s, self.bias);
+        }
+    }
+
+    /// The process noise of a piece of `tau_s` of a step of `step_s` cut by a fix
+    /// ([`NoiseUnits::add_piece`]).
+    fn add_piece(&mut self, tau_s: f64, step_s: f64) {
+        self.units.add_piece(tau_s, step_s);
         if self.bias.drifts() {
             self.units.add_bias_step(tau_s, self.bias);
         }
@@ -265,8 +276,12 @@ impl Stitch<'_> {
         let a = c.accel_m_s2;
         self.integrated[0].advance(a, self.dt_s, self.half_dt2_s2);
         self.integrated[1].advance(a, step, 0.5 * step * step);
-        // The rest of the step after its last fix (all of it without one: the same bits).
-        self.add_step(step - done_s);
+        // The rest of the step after its last fix, or all of it without one.
+        if done_s > 0.0 {
+            self.add_piece(step - done_s, step);
+        } else {
+            self.add_step(step);
+        }
         let finite = [
             self.integrated[0].is_finite(),
             self.integrated[1].is_finite() && self.units.is_finite(),

@@ -65,8 +65,11 @@ impl Prepared<'_> {
             }
             visit(&fw, &applied)?;
             applied.clear();
+            // A fix inside the step has a next sample.
+            let step_s = next.map_or(0.0, |n| n.t_s - current.t_s);
             for (i, t_fix) in within {
-                let place = (reader.file(), since_line, Some((current.accel_m_s2, t_fix)));
+                let inside = (current.accel_m_s2, t_fix, step_s);
+                let place = (reader.file(), since_line, Some(inside));
                 applied.push(self.update_finite(&mut fw, i, place)?);
                 since_line = current.line;
             }
@@ -86,7 +89,7 @@ impl Prepared<'_> {
     }
 
     /// The measurement update with fix `i` of the scan, at the current sample or, with
-    /// `within` = (the sample's output, the fix's time), inside its step; `accel` is the
+    /// `within` = (the sample's output, the fix's time, the step), inside its step; `accel` is the
     /// accelerometer log's name and the line of the previous fix's sample.
     ///
     /// # Errors
@@ -98,12 +101,12 @@ impl Prepared<'_> {
         &self,
         fw: &mut Forward<'_>,
         i: usize,
-        (accel, since_line, within): (&str, u64, Option<(f64, f64)>),
+        (accel, since_line, within): (&str, u64, Option<(f64, f64, f64)>),
     ) -> Result<FilteredFix, CalibrateError> {
         let gps = &self.scan.gps[i];
         let fix = match within {
             None => fw.update(gps)?,
-            Some((a, t_fix_s)) => fw.update_within(gps, a, t_fix_s)?,
+            Some((a, t_fix_s, step_s)) => fw.update_within(gps, a, (t_fix_s, step_s))?,
         };
         if fix.is_finite() {
             return Ok(fix);

@@ -300,3 +300,59 @@ fn a_recording_compressed_or_piped_calibrates_to_the_same_bits() {
         assert_eq!(summary(out), summary("plain"), "{out}");
     }
 }
+
+/// The bias's σ holds where fixes cut the steps most: over 80 recordings of each of the two
+/// kinds with the fewest samples per fix (1 Hz samples with 1 Hz fixes between them; 10 Hz
+/// samples with 20 Hz fixes), Σ z² of z = (b̂ − b)/σ is χ²(80) for a consistent filter, tested
+/// two-sided at 0.5 % per kind (1 % in all). Negative control: the same z with σ/1.5 (the
+/// understatement measured when each piece of a cut step took the noise of a whole step's
+/// share, rms z 1.53 and 1.38) leave the band.
+#[test]
+fn the_bias_sigma_holds_where_fixes_cut_the_steps() {
+    use accelcal::stats::chi_squared_band;
+    let m = 80;
+    let (lo, hi) = chi_squared_band(m as f64, 1.0, 0.005);
+    let kinds = [
+        Kind {
+            name: "1 Hz/1 Hz",
+            rate_hz: 1.0,
+            fix_hz: 1.0,
+            first_fix_s: 0.43,
+            duration_s: 600.0,
+            ..BASE
+        },
+        Kind {
+            name: "10 Hz/20 Hz",
+            rate_hz: 10.0,
+            fix_hz: 20.0,
+            first_fix_s: 0.021,
+            duration_s: 120.0,
+            ..BASE
+        },
+    ];
+    for kind in &kinds {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let z: Vec<f64> = (0..m)
+            .map(|seed| {
+                let (accel, gps, _) = generate(&Kind {
+                    seed: 1000 + seed,
+                    ..*kind
+                });
+                std::fs::write(d.join("a.csv"), accel).unwrap();
+                std::fs::write(d.join("g.csv"), gps).unwrap();
+                let s = calibrate(d, "a.csv", "o");
+                let sigma = s["bias_sigma_m_s2"].as_f64().unwrap();
+                (s["bias_m_s2"].as_f64().unwrap() - BIAS_M_S2) / sigma
+            })
+            .collect();
+        let sum: f64 = z.iter().map(|z| z * z).sum();
+        let understated: f64 = z.iter().map(|z| (1.5 * z).powi(2)).sum();
+        eprintln!(
+            "{}: Σz² = {sum:.1} in [{lo:.1}, {hi:.1}]; with σ/1.5: {understated:.1}",
+            kind.name
+        );
+        assert!((lo..=hi).contains(&sum), "{}: {sum}", kind.name);
+        assert!(understated > hi, "{}: {understated}", kind.name);
+    }
+}

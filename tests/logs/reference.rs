@@ -106,6 +106,8 @@ struct Node {
     a: f64,
     fix: Option<(f64, f64)>,
     sample: bool,
+    /// The step of the sample that starts or holds it, s (0 at the last sample).
+    step: f64,
 }
 
 /// The samples of `accel` and the fixes of `gps` in time order: a fix at a sample's time stamp
@@ -118,11 +120,13 @@ fn nodes(accel: &[(f64, f64)], gps: &[(f64, f64, f64)]) -> Vec<Node> {
     for k in 0..n {
         let (t, a) = accel[k];
         let end = accel.get(k + 1).map_or(f64::INFINITY, |s| s.0);
+        let step = accel.get(k + 1).map_or(0.0, |s| s.0 - t);
         let mut sample = Node {
             t,
             a,
             fix: None,
             sample: true,
+            step,
         };
         let mut within = Vec::new();
         while let Some(&&(tf, zp, zv)) = fixes.peek() {
@@ -137,6 +141,7 @@ fn nodes(accel: &[(f64, f64)], gps: &[(f64, f64, f64)]) -> Vec<Node> {
                     a,
                     fix: Some((zp, zv)),
                     sample: false,
+                    step,
                 });
             }
             fixes.next();
@@ -195,12 +200,12 @@ pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> 
                 }
             };
             let f = [[1.0, dt, -dt * dt / 2.0], [0.0, 1.0, -dt], [0.0, 0.0, phi]];
-            let g = [-dt * dt / 2.0, -dt, 0.0];
             x = mul_v(&f, &x);
             p = mul(&mul(&f, &p), &transpose(&f));
-            for i in 0..3 {
-                for j in 0..3 {
-                    p[i][j] += prior.accel_noise_var * g[i] * g[j];
+            let q = white_noise(&nodes[k], &nodes[k + 1], dt);
+            for i in 0..2 {
+                for j in 0..2 {
+                    p[i][j] += prior.accel_noise_var * q[i][j];
                 }
             }
             p[2][2] += q_b;
@@ -210,21 +215,41 @@ pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> 
         }
     }
     smooth(&mut all, &f_step, &x_prior_next, &p_prior_next);
-    // The samples' rows only.
-    let keep = |v: Vec<_>| -> Vec<_> {
+    samples_only(all, &nodes)
+}
+
+/// The rows of the samples of `all`, whose rows are `nodes`.
+fn samples_only(all: Processed, nodes: &[Node]) -> Processed {
+    let keep = |v: Vec<[f64; 3]>| -> Vec<[f64; 3]> {
         v.into_iter()
-            .zip(&nodes)
+            .zip(nodes)
             .filter(|(_, node)| node.sample)
             .map(|(x, _)| x)
             .collect()
     };
     Processed {
-        t: keep_f(&all.t, &nodes),
-        pc: keep_f(&all.pc, &nodes),
+        t: keep_f(&all.t, nodes),
+        pc: keep_f(&all.pc, nodes),
         x: keep(all.x),
-        p: keep_m(all.p, &nodes),
+        p: keep_m(all.p, nodes),
         xs: keep(all.xs),
-        ps: keep_m(all.ps, &nodes),
+        ps: keep_m(all.ps, nodes),
+    }
+}
+
+/// The white noise's (δp, δv) covariance per unit of W over `dt` from node `a` to node `b`: a
+/// whole step holds the sample's noise; a piece of a step cut by a fix takes it as white within
+/// the step, of density W·Δt_j.
+fn white_noise(a: &Node, b: &Node, dt: f64) -> [[f64; 2]; 2] {
+    if a.sample && b.sample {
+        let g = [-dt * dt / 2.0, -dt];
+        [[g[0] * g[0], g[0] * g[1]], [g[1] * g[0], g[1] * g[1]]]
+    } else {
+        let h = a.step;
+        [
+            [h * dt.powi(3) / 3.0, h * dt * dt / 2.0],
+            [h * dt * dt / 2.0, h * dt],
+        ]
     }
 }
 
