@@ -11,7 +11,7 @@ use crate::simulation::measurement;
 use crate::state::{ErrorState, MeasMatrix, MeasVector, StateMatrix, StateModel, StateVector};
 
 use super::StepMode;
-use super::pass::Integrated;
+use super::integration::Integrated;
 
 /// What the filter did at one GPS fix: everything the smoother and the report need.
 #[derive(Clone, Debug, PartialEq)]

@@ -15,7 +15,8 @@ use super::scan::Scan;
 use super::{CalibrateError, StepMode};
 
 /// A problem found after the pass, at the sample where a sample-by-sample pass meets it, and
-/// in the order it meets them there (a step, the fix, the integration).
+/// in the order it meets them there (a step, a fix on the sample, the integration over the
+/// step, a fix inside the step).
 struct Found {
     sample: u64,
     phase: u8,
@@ -270,7 +271,12 @@ pub fn filter(
     let mut fixes = Vec::with_capacity(stop_fix);
     let mut since_line = reduced.first_line;
     for fix in &reduced.fixes[..stop_fix] {
-        if found.as_ref().is_some_and(|e| e.key() < (fix.sample, 2)) {
+        // A fix inside a step needs the step: after the step's own overflow (phase 3).
+        let phase = if fix.tau_s > 0.0 { 4 } else { 2 };
+        if found
+            .as_ref()
+            .is_some_and(|e| e.key() < (fix.sample, phase))
+        {
             break;
         }
         let gps = &scan.gps[fix.fix];

@@ -19,6 +19,7 @@
 //! Nothing is written before the logs have passed every check.
 
 mod forward;
+mod integration;
 mod intervals;
 mod nis;
 pub mod pass;

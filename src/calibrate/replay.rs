@@ -8,7 +8,7 @@ use crate::logs::{LogError, LogProblem};
 use crate::state::ErrorState;
 
 use super::forward::{FilteredFix, Forward};
-use super::pass::update_time_s;
+use super::integration::update_time_s;
 use super::scan::FixMatcher;
 use super::summary::{self, EstimateRow};
 use super::{CalibrateError, Prepared, StepMode, smoother};

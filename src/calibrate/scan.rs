@@ -6,7 +6,8 @@ use crate::logs::steps::ACCEPTED_STEP_RATIO;
 use crate::logs::{AccelSample, GpsFix, LogError, LogProblem};
 
 use super::StepMode;
-use super::pass::{Reduced, update_time_s};
+use super::integration::update_time_s;
+use super::pass::Reduced;
 
 /// What the first pass learned.
 #[derive(Clone, Debug)]
