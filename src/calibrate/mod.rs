@@ -6,15 +6,16 @@
 //!
 //! 1. `pass` reads the GPS log and streams the accelerometer log once (blocks parsed on all
 //!    threads, stitched in order): format, increasing time stamps, the steps' histogram, whether
-//!    every step equals the configured Δt (the nominal mode), each fix at its nearest sample,
-//!    and between fixes what the filter needs: the integrated (p_c, v_c) at each fix and, per
-//!    step, the interval's process noise as unit contributions.
-//! 2. `intervals` checks what needed the median step (gaps, fixes between samples) and runs the
-//!    filter fix to fix: in nominal mode the in-memory filter's recursion, operation for
-//!    operation; then `smoother::backward` runs the Rauch–Tung–Striebel pass over the fixes.
+//!    every step equals the configured Δt (the nominal mode), each fix in the step that holds
+//!    it, and between fixes what the filter needs: the integrated (p_c, v_c) at each fix's own
+//!    time (`integration`: from the prior, or from the first fix) and, per step or piece of a
+//!    step a fix cuts, the interval's process noise as unit contributions.
+//! 2. `intervals` checks what needed the median step (gaps, two fixes at one end sample) and
+//!    runs the filter fix to fix: in nominal mode the in-memory filter's recursion, operation
+//!    for operation; then `smoother::backward` runs the Rauch–Tung–Striebel pass over the fixes.
 //! 3. [`Prepared::write_fix_estimates`] writes one row per fix; with `--every-sample`,
-//!    [`Prepared::write_estimates`] streams the log again, repeating the filter sample by
-//!    sample (`forward`), and writes each sample's filtered and smoothed estimates.
+//!    [`Prepared::write_estimates`] streams the log again (`replay`), repeating the filter
+//!    sample by sample (`forward`), and writes each sample's filtered and smoothed estimates.
 //!
 //! Nothing is written before the logs have passed every check.
 

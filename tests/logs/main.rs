@@ -8,6 +8,7 @@ mod common;
 
 mod bad_logs;
 mod between;
+mod configuration;
 mod drift;
 mod fast;
 mod prior;
