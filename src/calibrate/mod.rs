@@ -332,14 +332,39 @@ impl Prepared<'_> {
                 bias_random_walk_m_s2_per_sqrt_s,
                 bias_correlation_time_s,
             },
-            // A prior taken from the first fix agrees with it by construction.
+            // A prior taken from the first fix agrees with it by construction; it may lie far
+            // from the log's start.
             warnings: if s.prior_from_first_fix {
-                Vec::new()
+                self.first_fix_warnings()
             } else {
                 summary::prior_warnings(fixes.first())
             },
         };
         Calibration { summary, fixes }
+    }
+
+    /// A prior carried back from a first fix that lies so long after the log's first sample
+    /// that the bias, at its prior σ_b, moves the carried-back velocity by more than the prior's
+    /// velocity σ: σ_b·Δ > σ_v (P(0) takes the two as independent; they are not, by b·Δ).
+    fn first_fix_warnings(&self) -> Vec<String> {
+        let (Some(first), f) = (self.scan.gps.first(), &self.settings.filter_stats) else {
+            return Vec::new();
+        };
+        let after_s = first.t_s - self.scan.span_s.0;
+        let moved_m_s = f.bias_var_m2_s4.sqrt() * after_s;
+        if moved_m_s <= f.initial_velocity_sigma_m_s {
+            return Vec::new();
+        }
+        vec![format!(
+            "the prior is the first fix, {} s after the first accelerometer sample: over that \
+             time the bias (σ {} m/s²) moves the velocity carried back to the start by up to {} \
+             m/s, more than the prior's σ of {} m/s; trim the accelerometer log to start near \
+             the first fix, or give an [initial] section",
+            crate::format::short(after_s),
+            crate::format::short(f.bias_var_m2_s4.sqrt()),
+            crate::format::short(moved_m_s),
+            crate::format::short(f.initial_velocity_sigma_m_s)
+        )]
     }
 
     /// Which Δt mode runs.

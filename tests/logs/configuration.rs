@@ -121,6 +121,36 @@ fn without_initial_the_prior_is_the_first_fix() {
     let s = summary(d, "first");
     let z = (s["bias_m_s2"].as_f64().unwrap() - b) / s["bias_sigma_m_s2"].as_f64().unwrap();
     assert!(z.abs() < 4.0, "{z}");
+    assert_eq!(s["warnings"].as_array().unwrap().len(), 0);
+    // A first fix 2.2 s after the start: the bias at its prior σ (0.1 m/s²) moves the velocity
+    // carried back by 0.22 m/s, more than the prior's 0.04 m/s. Said, not refused.
+    let late: String = std::fs::read_to_string(d.join("logs/gps.csv"))
+        .unwrap()
+        .lines()
+        .enumerate()
+        .filter(|(i, _)| *i == 0 || *i > 10)
+        .map(|(_, l)| format!("{l}\n"))
+        .collect();
+    std::fs::write(d.join("late.csv"), late).unwrap();
+    let args = [
+        "calibrate",
+        "--accel",
+        "logs/accelerometer.csv",
+        "--gps",
+        "late.csv",
+        "--out",
+        "late",
+        "-q",
+    ];
+    let o = run(&args, d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let warnings = summary(d, "late")["warnings"].clone();
+    let text = warnings[0].as_str().unwrap();
+    assert!(
+        text.contains("2.2 s after") && text.contains("[initial]"),
+        "{text}"
+    );
+    assert!(stderr(&o).contains(&format!("warning: {text}")));
     // The library's settings say so, and follow new GPS σ's.
     let config = Config::from_toml_str("[filter]\ngps_position_sigma_m = 2.0\n").unwrap();
     let settings = Settings::from_config(&config, false, false).unwrap();
