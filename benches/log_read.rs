@@ -10,7 +10,7 @@ use std::io::Read;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use accelcal::calibrate::pass::{Integrated, reduce};
+use accelcal::calibrate::pass::{Integrated, Start, reduce};
 use accelcal::logs::read::{LogFile, LogSource, read_gps};
 use accelcal::model::BiasModel;
 
@@ -85,8 +85,13 @@ fn main() {
         vc_m_s: 100.0,
     };
     measure("one pass (parse, check, reduce)", repeats, bytes, || {
-        let reduced =
-            reduce(&accel, &fixes, (0.001, BiasModel::Constant), start).expect("a good log");
+        let reduced = reduce(
+            &accel,
+            &fixes,
+            (0.001, BiasModel::Constant),
+            Start::Prior(start),
+        )
+        .expect("a good log");
         std::hint::black_box(reduced);
     });
 }

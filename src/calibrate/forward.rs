@@ -1,5 +1,8 @@
 //! The forward pass over a log: the accelerometer integrated by eq. (3) and the error-state
-//! filter, one sample at a time, with the step of each pair of time stamps.
+//! filter, one sample at a time, with the step of each pair of time stamps. A fix between two
+//! samples cuts the filter's step in two: Φ and Q of the fraction up to the fix, the update
+//! there, then Φ and Q of the rest of the step; the integration at the samples runs whole steps,
+//! and the fix's (p_c, v_c) is the sample's carried over the fraction by eq. (3).
 
 use crate::error::FilterError;
 use crate::filter::{ErrorStateModel, propagate_over};
@@ -8,15 +11,16 @@ use crate::simulation::measurement;
 use crate::state::{ErrorState, MeasMatrix, MeasVector, StateMatrix, StateModel, StateVector};
 
 use super::StepMode;
+use super::integration::Integrated;
 
 /// What the filter did at one GPS fix: everything the smoother and the report need.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FilteredFix {
     /// Line of the fix in the GPS log.
     pub line: u64,
-    /// Accelerometer sample the fix is applied at (0 = the log's first).
+    /// Accelerometer sample whose step holds the fix (0 = the log's first).
     pub sample: u64,
-    /// Time stamp of that sample, s.
+    /// Time of the update, s: the fix's own (the end sample's for a fix beyond an end).
     pub t_s: f64,
     /// The fix z = (z_p, z_v), (m, m/s).
     pub z: MeasVector,
@@ -96,7 +100,7 @@ impl FilteredFix {
 }
 
 /// The integration and the filter at the current sample.
-pub(super) struct Forward<'m> {
+pub struct Forward<'m> {
     model: &'m ErrorStateModel,
     /// The error state the filter assumes, for steps of their own length.
     state: ErrorState,
@@ -107,6 +111,9 @@ pub(super) struct Forward<'m> {
     pub k: u64,
     /// Its time stamp, s.
     pub t_s: f64,
+    /// The time the estimate refers to: the sample's, or a fix's after an update between
+    /// samples, s.
+    filter_t_s: f64,
     /// Integrated position p_c, m.
     pub pc_m: f64,
     /// Integrated velocity v_c, m/s.
@@ -124,13 +131,12 @@ pub(super) struct Forward<'m> {
 }
 
 impl<'m> Forward<'m> {
-    /// The start of the log at `t0_s`: eq. (3) from the prior means, δx̂ = 0, P = P(0).
+    /// The start of the log at `t0_s`: eq. (3) from `start`, δx̂ = 0, P = P(0).
     pub fn new(
         model: &'m ErrorStateModel,
         state: ErrorState,
         mode: StepMode,
-        position_mean_m: f64,
-        velocity_mean_m_s: f64,
+        start: Integrated,
         t0_s: f64,
     ) -> Self {
         let dt = model.dt_s;
@@ -141,8 +147,9 @@ impl<'m> Forward<'m> {
             half_dt2_s2: 0.5 * dt * dt,
             k: 0,
             t_s: t0_s,
-            pc_m: position_mean_m,
-            vc_m_s: velocity_mean_m_s,
+            filter_t_s: t0_s,
+            pc_m: start.pc_m,
+            vc_m_s: start.vc_m_s,
             x: StateVector::zeros(),
             p: model.p0,
             last_fix: (0, t0_s, StateVector::zeros()),
@@ -171,19 +178,55 @@ impl<'m> Forward<'m> {
             StepMode::PerStep => {
                 let dt = t_next_s - self.t_s;
                 let half_dt2 = 0.5 * dt * dt;
-                // eq. (3) with this step's Δt_j; Φ(Δt_j) and Q(Δt_j) for eq. (5).
+                // eq. (3) with this step's Δt_j; Φ(Δt_j) and Q(Δt_j) for eq. (5), from the last
+                // fix when one cut the step.
                 self.pc_m += self.vc_m_s * dt + a * half_dt2;
                 self.vc_m_s += a * dt;
-                let phi = self.state.transition(self.t_s, dt);
-                self.x = phi * self.x;
-                self.p = propagate_over(&self.state, &self.p, self.t_s, dt);
-                if !self.composes {
-                    self.phi_since_fix = phi * self.phi_since_fix;
-                }
+                // The rest of a step a fix cut is a piece of it.
+                let cut = (self.filter_t_s != self.t_s).then_some(dt);
+                self.propagate_to(t_next_s, cut);
             }
         }
         self.k += 1;
         self.t_s = t_next_s;
+        self.filter_t_s = t_next_s;
+    }
+
+    /// The estimate and its covariance carried from their time to `t_s` (per-step mode): a
+    /// whole step, or a piece of the step of `cut` = Some(Δt_j) that a fix cuts, whose white
+    /// noise is taken as white within the step ([`super::pass::NoiseUnits::add_piece`]).
+    fn propagate_to(&mut self, t_s: f64, cut: Option<f64>) {
+        let tau = t_s - self.filter_t_s;
+        let phi = self.state.transition(self.filter_t_s, tau);
+        self.x = phi * self.x;
+        self.p = match cut {
+            None => propagate_over(&self.state, &self.p, self.filter_t_s, tau),
+            Some(step_s) => {
+                let p = phi * self.p * phi.transpose() + self.piece_noise(tau, step_s);
+                (p + p.transpose()) * 0.5
+            }
+        };
+        if !self.composes {
+            self.phi_since_fix = phi * self.phi_since_fix;
+        }
+        self.filter_t_s = t_s;
+    }
+
+    /// Q of a piece of `tau_s` of a step of `step_s`: W·Δt_j·[[τ³/3, τ²/2], [τ²/2, τ]] and the
+    /// bias's own q_b(τ).
+    fn piece_noise(&self, tau_s: f64, step_s: f64) -> StateMatrix {
+        let (p, v, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
+        let stats = &self.state.stats;
+        let q = stats.accel_noise_var_m2_s4 * step_s;
+        let mut m = StateMatrix::zeros();
+        m[(p, p)] = q * tau_s * tau_s * tau_s / 3.0;
+        m[(p, v)] = q * 0.5 * tau_s * tau_s;
+        m[(v, p)] = m[(p, v)];
+        m[(v, v)] = q * tau_s;
+        if stats.bias_model.drifts() {
+            m[(b, b)] = stats.bias_model.step(tau_s, stats.bias_var_m2_s4).1;
+        }
+        m
     }
 
     /// Whether the time stamp, the integration, the estimate and its covariance are finite.
@@ -211,7 +254,9 @@ impl<'m> Forward<'m> {
                 StepMode::Nominal => self
                     .state
                     .transition(0.0, (next.sample - self.k) as f64 * self.model.dt_s),
-                StepMode::PerStep => self.state.transition(self.t_s, next.t_s - self.t_s),
+                StepMode::PerStep => self
+                    .state
+                    .transition(self.filter_t_s, next.t_s - self.filter_t_s),
             };
         }
         let (p, v, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
@@ -230,6 +275,39 @@ impl<'m> Forward<'m> {
     /// # Errors
     /// [`FilterError`] when a covariance is not positive definite.
     pub fn update(&mut self, fix: &GpsFix) -> Result<FilteredFix, FilterError> {
+        let integrated = measurement(self.pc_m, self.vc_m_s);
+        self.update_at(fix, self.t_s, integrated)
+    }
+
+    /// The measurement update with `fix` at `t_fix_s`, inside the step of `step_s` from the
+    /// current sample whose output is `accel_m_s2` (per-step mode): the filter propagated over
+    /// the piece of the step up to the fix, the integration carried there by eq. (3).
+    ///
+    /// # Errors
+    /// [`FilterError`] when a covariance is not positive definite.
+    pub fn update_within(
+        &mut self,
+        fix: &GpsFix,
+        accel_m_s2: f64,
+        (t_fix_s, step_s): (f64, f64),
+    ) -> Result<FilteredFix, FilterError> {
+        self.propagate_to(t_fix_s, Some(step_s));
+        let at_sample = Integrated {
+            pc_m: self.pc_m,
+            vc_m_s: self.vc_m_s,
+        };
+        let i = at_sample.advanced(accel_m_s2, t_fix_s - self.t_s);
+        self.update_at(fix, t_fix_s, measurement(i.pc_m, i.vc_m_s))
+    }
+
+    /// The update at `t_s` (the filter's time), where the accelerometer integrates to
+    /// `integrated`.
+    fn update_at(
+        &mut self,
+        fix: &GpsFix,
+        t_s: f64,
+        integrated: MeasVector,
+    ) -> Result<FilteredFix, FilterError> {
         let (k0, t0, post0) = self.last_fix;
         let (phi, prior) = match self.mode {
             // As the in-memory filter: one transition over the whole interval since the last fix
@@ -243,18 +321,15 @@ impl<'m> Forward<'m> {
                 };
                 (phi, phi * post0)
             }
-            StepMode::PerStep if self.composes => {
-                (self.state.transition(t0, self.t_s - t0), self.x)
-            }
+            StepMode::PerStep if self.composes => (self.state.transition(t0, t_s - t0), self.x),
             StepMode::PerStep => (self.phi_since_fix, self.x),
         };
         self.phi_since_fix = StateMatrix::identity();
-        let integrated = measurement(self.pc_m, self.vc_m_s);
-        let at = (self.k, self.t_s);
+        let at = (self.k, t_s);
         let fixed = FilteredFix::update(self.model, fix, at, integrated, (prior, &self.p, phi))?;
         self.x = fixed.post;
         self.p = fixed.p_post;
-        self.last_fix = (self.k, self.t_s, fixed.post);
+        self.last_fix = (self.k, t_s, fixed.post);
         Ok(fixed)
     }
 }

@@ -1,6 +1,6 @@
 //! The filter over the reduced log, fix to fix, and the checks that needed the whole log first
-//! (the median step): gaps, fixes far from every sample, two fixes on one sample. The first
-//! problem in the order of the samples is reported, as a sample-by-sample pass meets it.
+//! (the median step): gaps, two fixes applied at one end sample. The first problem in the order
+//! of the samples is reported, as a sample-by-sample pass meets it.
 
 use crate::error::FilterError;
 use crate::filter::ErrorStateModel;
@@ -15,7 +15,8 @@ use super::scan::Scan;
 use super::{CalibrateError, StepMode};
 
 /// A problem found after the pass, at the sample where a sample-by-sample pass meets it, and
-/// in the order it meets them there (a step, the fix, the integration).
+/// in the order it meets them there (a step, a fix on the sample, the integration over the
+/// step, a fix inside the step).
 struct Found {
     sample: u64,
     phase: u8,
@@ -56,48 +57,25 @@ fn first_gap(scan: &Scan, reduced: &Reduced, accel: &str) -> Option<Found> {
     })
 }
 
-/// The first fix that no sample takes or that falls on a sample already taken, and its index.
+/// The first fix applied at the time of the fix before it (two fixes beyond one end of the log,
+/// both applied at its end sample), and its index.
 fn first_misplaced_fix(scan: &Scan, fixes: &[FixAt]) -> Option<(usize, Found)> {
-    let tol = scan.tolerance_s();
-    let gps = |i: usize| &scan.gps[fixes[i].fix];
-    for (i, f) in fixes.iter().enumerate() {
-        let at = |problem| LogError::at(&scan.gps_name, gps(i).line, problem);
-        if f.distance_s > tol {
-            let (sample, after_s) = f.after.unwrap_or((f.sample, f.t_s));
-            let problem = LogProblem::FixBetweenSamples {
-                t_s: gps(i).t_s,
-                before_s: f.before_s,
-                after_s,
-                tolerance_s: tol,
-            };
-            let error = at(problem);
-            return Some((
-                i,
-                Found {
-                    sample,
-                    phase: 1,
-                    error,
-                },
-            ));
-        }
-        if i > 0 && fixes[i - 1].sample == f.sample {
-            let problem = LogProblem::FixOnTakenSample {
-                t_s: gps(i).t_s,
-                sample_s: f.t_s,
-                other_line: gps(i - 1).line,
-            };
-            let error = at(problem);
-            return Some((
-                i,
-                Found {
-                    sample: f.sample,
-                    phase: 1,
-                    error,
-                },
-            ));
-        }
-    }
-    None
+    let i = (1..fixes.len()).find(|&i| fixes[i - 1].t_s == fixes[i].t_s)?;
+    let (f, gps) = (&fixes[i], &scan.gps[fixes[i].fix]);
+    let problem = LogProblem::FixOnTakenSample {
+        t_s: gps.t_s,
+        sample_s: f.t_s,
+        other_line: scan.gps[fixes[i - 1].fix].line,
+    };
+    let error = LogError::at(&scan.gps_name, gps.line, problem);
+    Some((
+        i,
+        Found {
+            sample: f.sample,
+            phase: 1,
+            error,
+        },
+    ))
 }
 
 /// The first sample whose step overflows the integration in `mode`.
@@ -123,7 +101,9 @@ pub fn mode_index(mode: StepMode) -> usize {
     }
 }
 
-/// The filter at the last fix (the log's first sample before any).
+/// The filter at the last fix (the log's first sample before any). A fix between samples is
+/// reached over the fractions of the steps it cuts (the pass's units hold them as steps of their
+/// own), so per-step intervals run from fix time to fix time.
 struct FixFilter<'m> {
     model: &'m ErrorStateModel,
     stats: NoiseStats,
@@ -131,7 +111,7 @@ struct FixFilter<'m> {
     /// compose (a nominal log's intervals take few lengths).
     powers: Vec<(u64, StateMatrix)>,
     mode: StepMode,
-    /// Sample and time stamp of the last fix.
+    /// Sample and time of the last fix.
     last: (u64, f64),
     x: StateVector,
     p: StateMatrix,
@@ -260,7 +240,7 @@ pub type Filtered = (Vec<FilteredFix>, (StateVector, StateMatrix));
 /// Checks the reduced log against the median step and runs the filter over its fixes.
 ///
 /// # Errors
-/// The first problem in sample order: a gap, a fix between samples or on a taken sample, a
+/// The first problem in sample order: a gap, two fixes applied at one end sample, a
 /// covariance not positive definite, a non-finite residual, or an overflowing integration.
 pub fn filter(
     scan: &Scan,
@@ -291,7 +271,12 @@ pub fn filter(
     let mut fixes = Vec::with_capacity(stop_fix);
     let mut since_line = reduced.first_line;
     for fix in &reduced.fixes[..stop_fix] {
-        if found.as_ref().is_some_and(|e| e.key() < (fix.sample, 2)) {
+        // A fix inside a step needs the step: after the step's own overflow (phase 3).
+        let phase = if fix.tau_s > 0.0 { 4 } else { 2 };
+        if found
+            .as_ref()
+            .is_some_and(|e| e.key() < (fix.sample, phase))
+        {
             break;
         }
         let gps = &scan.gps[fix.fix];

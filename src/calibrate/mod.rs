@@ -6,25 +6,28 @@
 //!
 //! 1. `pass` reads the GPS log and streams the accelerometer log once (blocks parsed on all
 //!    threads, stitched in order): format, increasing time stamps, the steps' histogram, whether
-//!    every step equals the configured Δt (the nominal mode), each fix at its nearest sample,
-//!    and between fixes what the filter needs: the integrated (p_c, v_c) at each fix and, per
-//!    step, the interval's process noise as unit contributions.
-//! 2. `intervals` checks what needed the median step (gaps, fixes between samples) and runs the
-//!    filter fix to fix: in nominal mode the in-memory filter's recursion, operation for
-//!    operation; then `smoother::backward` runs the Rauch–Tung–Striebel pass over the fixes.
+//!    every step equals the configured Δt (the nominal mode), each fix in the step that holds
+//!    it, and between fixes what the filter needs: the integrated (p_c, v_c) at each fix's own
+//!    time (`integration`: from the prior, or from the first fix) and, per step or piece of a
+//!    step a fix cuts, the interval's process noise as unit contributions.
+//! 2. `intervals` checks what needed the median step (gaps, two fixes at one end sample) and
+//!    runs the filter fix to fix: in nominal mode the in-memory filter's recursion, operation
+//!    for operation; then `smoother::backward` runs the Rauch–Tung–Striebel pass over the fixes.
 //! 3. [`Prepared::write_fix_estimates`] writes one row per fix; with `--every-sample`,
-//!    [`Prepared::write_estimates`] streams the log again, repeating the filter sample by
-//!    sample (`forward`), and writes each sample's filtered and smoothed estimates.
+//!    [`Prepared::write_estimates`] streams the log again (`replay`), repeating the filter
+//!    sample by sample (`forward`), and writes each sample's filtered and smoothed estimates.
 //!
 //! Nothing is written before the logs have passed every check.
 
 pub mod diagnose;
 mod forward;
+mod integration;
 mod intervals;
 mod nis;
 pub mod noise;
 pub mod pass;
 mod record;
+mod replay;
 mod scan;
 mod smoother;
 pub mod summary;
@@ -36,18 +39,18 @@ use std::io::Write;
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::error::FilterError;
+use crate::config::Config;
+use crate::error::{ConfigError, FilterError};
 use crate::filter::ErrorStateModel;
-use crate::logs::read::{AccelReader, LogSource, read_gps};
-use crate::logs::{LogError, LogProblem};
-use crate::model::{Model, NoiseStats};
-use crate::state::{ErrorState, StateMatrix, StateVector};
+use crate::logs::read::{LogSource, read_gps};
+use crate::logs::{GpsFix, LogError};
+use crate::model::{Model, NoiseStats, filter_stats, validate_calibration};
+use crate::state::{StateMatrix, StateVector};
 use forward::FilteredFix;
 pub use nis::{NisTest, nis_test};
 pub use pass::NOMINAL_TOLERANCE;
-use scan::{FixMatcher, Scan};
+use scan::Scan;
 use smoother::SmoothedFix;
-use summary::EstimateRow;
 
 /// How each step's Δt is taken.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -74,32 +77,92 @@ impl StepMode {
 /// What a calibration takes from the configuration.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
-    /// p_c(0): the mean of p(0), m.
+    /// p_c(0): the mean of p(0), m (unused when `prior_from_first_fix`).
     pub position_mean_m: f64,
-    /// v_c(0): the mean of v(0), m/s.
+    /// v_c(0): the mean of v(0), m/s (unused when `prior_from_first_fix`).
     pub velocity_mean_m_s: f64,
-    /// The statistics the filter assumes (`[filter]`, defaulting to the truth sections).
+    /// The statistics the filter assumes (`[filter]`, defaulting to the truth sections). With
+    /// `prior_from_first_fix`, P(0)'s σ's are the GPS σ's: `initial_position_sigma_m` =
+    /// `gps_position_sigma_m`, `initial_velocity_sigma_m_s` = `gps_velocity_sigma_m_s`.
     pub filter_stats: NoiseStats,
-    /// The configured step Δt = 1 / accelerometer.sample_rate_hz, s.
-    pub nominal_dt_s: f64,
+    /// The configured step Δt = 1 / accelerometer.sample_rate_hz, s; `None` when the
+    /// configuration sets no rate: the log's median step is taken, and the Δt mode is per-step.
+    pub nominal_dt_s: Option<f64>,
     /// The NIS test's false-alarm rate α (`checks.false_alarm_rate`).
     pub false_alarm_rate: f64,
-    /// Whether the prior comes from the first fix, its σ's the GPS σ's (so P(0) follows them
-    /// when they are estimated).
+    /// Whether the prior comes from the first GPS fix (no `[initial]` section): its position and
+    /// velocity carried back to the first sample ([`pass::Start::FirstFix`]), with the GPS σ's
+    /// as P(0)'s σ's. Code that changes the GPS σ's of `filter_stats` re-derives P(0) with
+    /// [`Settings::with_gps_sigmas`].
     pub prior_from_first_fix: bool,
 }
 
 impl Settings {
-    /// The settings of a validated model.
+    /// The settings of a validated model: the configured prior and rate.
     pub fn from_model(model: &Model) -> Self {
         let c = &model.config;
         Self {
             position_mean_m: c.initial.position_mean_m,
             velocity_mean_m_s: c.initial.velocity_mean_m_s,
             filter_stats: model.filter_stats,
-            nominal_dt_s: model.timeline.dt_s,
+            nominal_dt_s: Some(model.timeline.dt_s),
             false_alarm_rate: c.checks.false_alarm_rate,
             prior_from_first_fix: false,
+        }
+    }
+
+    /// The settings of a recording's configuration `config`, checking only the keys a
+    /// calibration uses ([`validate_calibration`]): `rate_set` when it sets
+    /// `accelerometer.sample_rate_hz`, `initial_set` when it has an `[initial]` section.
+    ///
+    /// # Errors
+    /// [`ConfigError::Invalid`] naming the first key outside its accepted range.
+    pub fn from_config(
+        config: &Config,
+        rate_set: bool,
+        initial_set: bool,
+    ) -> Result<Self, ConfigError> {
+        validate_calibration(config, rate_set, initial_set)?;
+        let settings = Self {
+            position_mean_m: config.initial.position_mean_m,
+            velocity_mean_m_s: config.initial.velocity_mean_m_s,
+            filter_stats: filter_stats(config),
+            nominal_dt_s: rate_set.then(|| 1.0 / config.accelerometer.sample_rate_hz),
+            false_alarm_rate: config.checks.false_alarm_rate,
+            prior_from_first_fix: !initial_set,
+        };
+        let (p, v) = (
+            settings.filter_stats.gps_position_sigma_m,
+            settings.filter_stats.gps_velocity_sigma_m_s,
+        );
+        Ok(settings.with_gps_sigmas(p, v))
+    }
+
+    /// The same settings with the GPS σ's `position_sigma_m` and `velocity_sigma_m_s`, and
+    /// with them P(0)'s σ's when the prior comes from the first fix.
+    pub fn with_gps_sigmas(mut self, position_sigma_m: f64, velocity_sigma_m_s: f64) -> Self {
+        let f = &mut self.filter_stats;
+        f.gps_position_sigma_m = position_sigma_m;
+        f.gps_velocity_sigma_m_s = velocity_sigma_m_s;
+        if self.prior_from_first_fix {
+            f.initial_position_sigma_m = position_sigma_m;
+            f.initial_velocity_sigma_m_s = velocity_sigma_m_s;
+        }
+        self
+    }
+
+    /// Where the integration starts, given the GPS log's `fixes`.
+    fn start(&self, fixes: &[GpsFix]) -> pass::Start {
+        match fixes.first() {
+            Some(f) if self.prior_from_first_fix => pass::Start::FirstFix {
+                t_s: f.t_s,
+                position_m: f.position_m,
+                velocity_m_s: f.velocity_m_s,
+            },
+            _ => pass::Start::Prior(pass::Integrated {
+                pc_m: self.position_mean_m,
+                vc_m_s: self.velocity_mean_m_s,
+            }),
         }
     }
 }
@@ -129,6 +192,8 @@ impl CalibrateError {
 pub struct Prepared<'a> {
     settings: Settings,
     model: ErrorStateModel,
+    /// (p_c, v_c) at the first sample, where the integration starts.
+    start: pass::Integrated,
     accel: &'a dyn LogSource,
     scan: Scan,
     fixes: Vec<FilteredFix>,
@@ -139,10 +204,6 @@ pub struct Prepared<'a> {
     /// then ran with.
     noise: Option<crate::likelihood::NoiseEstimate>,
 }
-
-/// One sample of the forward pass as a visitor sees it.
-type Visit<'v> =
-    dyn FnMut(&forward::Forward<'_>, Option<&FilteredFix>) -> Result<(), CalibrateError> + 'v;
 
 /// Checks the logs and reduces the accelerometer log in one streamed pass, then runs the
 /// filter fix to fix and the smoother's backward pass: O(fixes) after the pass.
@@ -175,15 +236,18 @@ pub fn prepare_with<'a>(
         settings.filter_stats = noise::prepare_stats(&settings.filter_stats, request);
     }
     let fixes = read_gps(gps)?;
-    let start = pass::Integrated {
-        pc_m: settings.position_mean_m,
-        vc_m_s: settings.velocity_mean_m_s,
-    };
-    let steps = (settings.nominal_dt_s, settings.filter_stats.bias_model);
+    let start = settings.start(&fixes);
+    // Without a configured rate no step is nominal (NaN equals none).
+    let steps = (
+        settings.nominal_dt_s.unwrap_or(f64::NAN),
+        settings.filter_stats.bias_model,
+    );
     let reduced = pass::reduce(accel, &fixes, steps, start)?;
     let scan = Scan::of(&reduced, fixes, gps.name())?;
+    let start = start.at(scan.span_s.0, reduced.first_accel_m_s2);
+    let dt_s = settings.nominal_dt_s.unwrap_or(scan.median_step_s);
     let run = |stats: &NoiseStats| {
-        let model = ErrorStateModel::new(settings.nominal_dt_s, stats);
+        let model = ErrorStateModel::new(dt_s, stats);
         let filtered = intervals::filter(&scan, &reduced, &model, stats, accel.name())?;
         Ok::<_, CalibrateError>((model, filtered))
     };
@@ -210,6 +274,7 @@ pub fn prepare_with<'a>(
     Ok(Prepared {
         settings,
         model,
+        start,
         accel,
         smoothed: smoother::backward(&fixes),
         fixes,
@@ -220,133 +285,6 @@ pub fn prepare_with<'a>(
 }
 
 impl Prepared<'_> {
-    /// One pass of the integration and the filter over the accelerometer log, handing every
-    /// sample (after its fix, if any) to `visit`. Returns the number of samples.
-    fn forward_pass(&self, visit: &mut Visit<'_>) -> Result<u64, CalibrateError> {
-        let mut reader = AccelReader::open(self.accel)?;
-        let changed = || LogError::of_file(self.accel.name(), LogProblem::Changed);
-        let mut matcher = FixMatcher::new(&self.scan);
-        let Some(mut current) = reader.next_sample()? else {
-            return Err(changed().into());
-        };
-        let s = &self.settings;
-        // The accelerometer line of the previous fix: the rows integrated since are behind the
-        // next fix's prediction.
-        let mut since_line = current.line;
-        let mut fw = forward::Forward::new(
-            &self.model,
-            ErrorState {
-                stats: self.settings.filter_stats,
-            },
-            self.scan.mode,
-            s.position_mean_m,
-            s.velocity_mean_m_s,
-            current.t_s,
-        );
-        loop {
-            let next = reader.next_sample()?;
-            if let Some(n) = &next {
-                self.scan.check_step(reader.file(), &current, n)?;
-            }
-            let fix = match matcher.at_sample(current.t_s, next.map(|n| n.t_s))? {
-                Some(i) => Some(self.update_finite(&mut fw, i, (reader.file(), since_line))?),
-                None => None,
-            };
-            if fix.is_some() {
-                since_line = current.line;
-            }
-            visit(&fw, fix.as_ref())?;
-            match next {
-                Some(n) => {
-                    fw.advance(current.accel_m_s2, n.t_s);
-                    // Overflow in the step or the integration: the row integrated is to blame.
-                    if !fw.is_finite() {
-                        let what = "the step to the next row, the integrated velocity and \
-                                    position or their covariance is no longer a finite number: \
-                                    a time stamp or acceleration here is too large"
-                            .to_string();
-                        let problem = LogProblem::Overflow { what };
-                        return Err(LogError::at(reader.file(), current.line, problem).into());
-                    }
-                    current = n;
-                }
-                None => break,
-            }
-        }
-        matcher.finish()?;
-        if fw.k + 1 != self.scan.samples {
-            return Err(changed().into());
-        }
-        Ok(fw.k + 1)
-    }
-
-    /// The measurement update with fix `i` of the scan; `accel` is the accelerometer log's name
-    /// and the line of the previous fix's sample.
-    ///
-    /// # Errors
-    /// [`FilterError`] as [`forward::Forward::update`]; [`LogProblem::Overflow`] when the fix's
-    /// residual, NIS or estimate is not finite: naming the fix's line when the fix is the larger
-    /// of the fix and the integrated (p_c, v_c) it is compared with, else the accelerometer rows
-    /// integrated since the previous fix.
-    fn update_finite(
-        &self,
-        fw: &mut forward::Forward<'_>,
-        i: usize,
-        (accel, since_line): (&str, u64),
-    ) -> Result<FilteredFix, CalibrateError> {
-        let gps = &self.scan.gps[i];
-        let fix = fw.update(gps)?;
-        if fix.is_finite() {
-            return Ok(fix);
-        }
-        let largest = |v: &[f64]| v.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
-        let error = if largest(fix.z.as_slice()) >= largest(fix.integrated.as_slice()) {
-            let what = "the filter's residual, NIS or estimate at this fix is no longer a \
-                        finite number: its position or velocity is too large"
-                .to_string();
-            LogError::at(&self.scan.gps_name, gps.line, LogProblem::Overflow { what })
-        } else {
-            let what = format!(
-                "the residual of the fix at {} line {} is no longer a finite number: the velocity \
-                 and position integrated from this row to that fix's sample are too large (an \
-                 acceleration of those rows is)",
-                self.scan.gps_name, gps.line
-            );
-            let line = since_line.max(1);
-            LogError::at(accel, line, LogProblem::Overflow { what })
-        };
-        Err(error.into())
-    }
-
-    /// Runs the filter sample by sample over the log once more, as `--every-sample` writes
-    /// it, and takes its fixes: in per-step mode their numbers then are those of the
-    /// per-sample recursion (the reduced pass agrees to rounding); in nominal mode they are
-    /// the same bits already, and nothing is read.
-    ///
-    /// # Errors
-    /// As [`Prepared::write_estimates`].
-    pub fn per_sample(&mut self) -> Result<(), CalibrateError> {
-        if self.scan.mode == StepMode::Nominal {
-            return Ok(());
-        }
-        let mut fixes = Vec::with_capacity(self.fixes.len());
-        let mut end = self.end;
-        self.forward_pass(&mut |fw, fix| {
-            if let Some(f) = fix {
-                fixes.push(f.clone());
-            }
-            end = (fw.x, fw.p);
-            Ok(())
-        })?;
-        if fixes.len() != self.fixes.len() {
-            return Err(LogError::of_file(self.accel.name(), LogProblem::Changed).into());
-        }
-        self.smoothed = smoother::backward(&fixes);
-        self.fixes = fixes;
-        self.end = end;
-        Ok(())
-    }
-
     /// Writes `estimates.csv` to `out`, one row per GPS fix: the a priori, a posteriori and
     /// smoothed estimates with their σ, the innovation with its σ, and the NIS.
     ///
@@ -363,46 +301,6 @@ impl Prepared<'_> {
             out.write_all(row.as_bytes())?;
         }
         out.flush()?;
-        Ok(())
-    }
-
-    /// Writes `estimates.csv` to `out`, one row per sample in time order (`--every-sample`):
-    /// the log read again.
-    ///
-    /// # Errors
-    /// [`CalibrateError::Write`] when `out` fails; [`LogProblem::Changed`] when the log no longer
-    /// reads as it did.
-    pub fn write_estimates(&self, out: &mut dyn Write) -> Result<(), CalibrateError> {
-        let header = format!("{}\n", summary::ESTIMATES_COLUMNS.join(","));
-        out.write_all(header.as_bytes())?;
-        let mut rows = summary::EstimateChunks::new(out);
-        let mut next = 0usize;
-        let changed = || LogError::of_file(self.accel.name(), LogProblem::Changed);
-        self.forward_pass(&mut |fw, fix| {
-            if let Some(f) = fix
-                && self.fixes.get(next) != Some(f)
-            {
-                return Err(changed().into());
-            }
-            // The first fix after this sample: its smoothed estimate carries back to here.
-            while self.fixes.get(next).is_some_and(|f| f.sample <= fw.k) {
-                next += 1;
-            }
-            let (xs, ps) = match (self.fixes.get(next), self.smoothed.get(next)) {
-                (Some(f), Some(sm)) => sm.smooth(&fw.x, &fw.p, &fw.transition_to(f)),
-                _ => (fw.x, fw.p),
-            };
-            let row = EstimateRow {
-                t_s: fw.t_s,
-                fix: fix.is_some(),
-                integrated: [fw.pc_m, fw.vc_m_s],
-                filtered: (&fw.x, &fw.p),
-                smoothed: (&xs, &ps),
-            };
-            rows.push(row.values())?;
-            Ok(())
-        })?;
-        rows.flush()?;
         Ok(())
     }
 }

@@ -17,6 +17,7 @@ use crate::logs::steps::{StepAt, StepMedian};
 use crate::logs::{ACCEL_COLUMNS, GpsFix, LogError, LogProblem};
 use crate::state::BiasModel;
 
+pub use super::integration::{Integrated, Start, update_time_s};
 pub use super::units::NoiseUnits;
 
 /// Relative tolerance within which every step of a log must equal the configured Δt for the
@@ -26,48 +27,24 @@ pub const NOMINAL_TOLERANCE: f64 = 1e-9;
 /// Blocks parsed together, one per thread or more: a bound on the text held at once.
 const PARSE_GROUP: usize = 4;
 
-/// Integrated accelerometer (p_c, v_c), (m, m/s).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Integrated {
-    /// p_c, m.
-    pub pc_m: f64,
-    /// v_c, m/s.
-    pub vc_m_s: f64,
-}
-
-impl Integrated {
-    /// eq. (3) over a step of `dt` with `half_dt2` = Δt²/2, written as the simulation does.
-    #[inline]
-    fn advance(&mut self, a: f64, dt: f64, half_dt2: f64) {
-        self.pc_m += self.vc_m_s * dt + a * half_dt2;
-        self.vc_m_s += a * dt;
-    }
-
-    fn is_finite(&self) -> bool {
-        self.pc_m.is_finite() && self.vc_m_s.is_finite()
-    }
-}
-
-/// A GPS fix at the accelerometer sample nearest to it (the earlier one of a tie).
+/// A GPS fix placed in the step of the accelerometer sample at or before it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FixAt {
     /// Index of the fix in the GPS log.
     pub fix: usize,
-    /// Index of the sample.
+    /// Index of the sample whose step holds the fix (t_sample ≤ t_s < the next sample's).
     pub sample: u64,
-    /// Its time stamp, s.
+    /// The time the filter updates at, s: the fix's own ([`update_time_s`]).
     pub t_s: f64,
-    /// Its line in the accelerometer log.
+    /// How far into the sample's step that is, τ = t_s − t_sample, s (0 on the sample).
+    pub tau_s: f64,
+    /// The sample's line in the accelerometer log.
     pub line: u64,
-    /// |t_fix − t_sample|, s.
-    pub distance_s: f64,
-    /// The samples around the fix: the time stamp before it, and the sample after it.
-    pub before_s: f64,
-    /// Index and time stamp of the sample after the fix, if any.
-    pub after: Option<(u64, f64)>,
-    /// (p_c, v_c) at the sample with the nominal Δt and with each step's own.
+    /// (p_c, v_c) at `t_s` with the nominal Δt and with each step's own: the sample's, carried
+    /// over the fraction τ = t_s − t_sample of its step by eq. (3) with that sample's output.
     pub integrated: [Integrated; 2],
-    /// The per-step process noise since the previous fix's sample (the log's first).
+    /// The per-step process noise since the previous fix's time (the log's first sample), with
+    /// the pieces of the steps the two fixes cut ([`NoiseUnits::add_piece`]).
     pub units: NoiseUnits,
 }
 
@@ -80,11 +57,14 @@ pub struct Reduced {
     pub span_s: (f64, f64),
     /// Line of the first sample.
     pub first_line: u64,
+    /// The output of the first sample, m/s².
+    pub first_accel_m_s2: f64,
     /// The steps' histogram, with the first step of each key.
     pub median: StepMedian,
     /// The shortest and the longest step.
     pub step_range: (StepAt, StepAt),
-    /// Whether every step equals the nominal Δt within [`NOMINAL_TOLERANCE`].
+    /// Whether every step equals the nominal Δt within [`NOMINAL_TOLERANCE`] and every fix
+    /// lies on a sample (its time stamp that sample's, or beyond the log's ends).
     pub nominal: bool,
     /// Every fix at its sample, in the GPS log's order.
     pub fixes: Vec<FixAt>,
@@ -111,9 +91,9 @@ struct Stitch<'g> {
     bias: BiasModel,
     half_dt2_s2: f64,
     gps: &'g [GpsFix],
+    start: Start,
     k: u64,
     current: Option<Current>,
-    before_s: f64,
     integrated: [Integrated; 2],
     units: NoiseUnits,
     reduced: Reduced,
@@ -121,31 +101,54 @@ struct Stitch<'g> {
 }
 
 impl Stitch<'_> {
-    /// Assigns to the current sample every remaining fix nearer to it than to the next sample
-    /// at `next_s` (all of them at the last sample).
-    fn assign(&mut self, c: Current, next_s: Option<f64>) {
+    /// Places in the step from the current sample `c` every remaining fix before the next
+    /// sample at `next_s` (every one at the last sample), each at its own time: the units get the
+    /// fraction of the step up to it as a step of its own. Returns the part of the step already
+    /// in the units, s.
+    fn assign(&mut self, c: Current, next_s: Option<f64>) -> f64 {
+        let mut done_s = 0.0;
         while let Some(f) = self.gps.get(self.reduced.fixes.len()) {
-            let d = (f.t_s - c.t_s).abs();
-            if next_s.is_some_and(|n| d > (n - f.t_s).abs()) {
+            if next_s.is_some_and(|n| f.t_s >= n) {
                 break;
             }
-            let (before_s, after) = if f.t_s >= c.t_s {
-                (c.t_s, next_s.map(|n| (self.k + 1, n)))
-            } else {
-                (self.before_s, Some((self.k, c.t_s)))
-            };
+            let t_s = update_time_s(f.t_s, c.t_s, next_s.is_none());
+            let tau_s = t_s - c.t_s;
+            if tau_s > done_s {
+                self.reduced.nominal = false;
+                // A fix before the next sample: `next_s` is known.
+                let step_s = next_s.map_or(0.0, |n| n - c.t_s);
+                self.add_piece(tau_s - done_s, step_s);
+                done_s = tau_s;
+            }
             let fix = FixAt {
                 fix: self.reduced.fixes.len(),
                 sample: self.k,
-                t_s: c.t_s,
+                t_s,
+                tau_s,
                 line: c.line,
-                distance_s: d,
-                before_s,
-                after,
-                integrated: self.integrated,
+                integrated: self.integrated.map(|i| i.advanced(c.accel_m_s2, tau_s)),
                 units: std::mem::take(&mut self.units),
             };
             self.reduced.fixes.push(fix);
+        }
+        done_s
+    }
+
+    /// The process noise of a step of `tau_s`.
+    #[inline]
+    fn add_step(&mut self, tau_s: f64) {
+        self.units.add_step(tau_s);
+        if self.bias.drifts() {
+            self.units.add_bias_step(tau_s, self.bias);
+        }
+    }
+
+    /// The process noise of a piece of `tau_s` of a step of `step_s` cut by a fix
+    /// ([`NoiseUnits::add_piece`]).
+    fn add_piece(&mut self, tau_s: f64, step_s: f64) {
+        self.units.add_piece(tau_s, step_s);
+        if self.bias.drifts() {
+            self.units.add_bias_step(tau_s, self.bias);
         }
     }
 
@@ -159,7 +162,9 @@ impl Stitch<'_> {
         };
         let Some(c) = self.current else {
             self.current = Some(next);
-            (self.before_s, self.reduced.span_s, self.reduced.first_line) = (t_s, (t_s, t_s), line);
+            self.integrated = [self.start.at(t_s, accel_m_s2); 2];
+            (self.reduced.span_s, self.reduced.first_line) = ((t_s, t_s), line);
+            self.reduced.first_accel_m_s2 = accel_m_s2;
             return Ok(());
         };
         if t_s <= c.t_s {
@@ -185,15 +190,19 @@ impl Stitch<'_> {
             r.step_range.1 = at;
         }
         r.nominal &= (step - self.dt_s).abs() <= NOMINAL_TOLERANCE * self.dt_s;
-        if self.reduced.fixes.len() < self.gps.len() {
-            self.assign(c, Some(t_s));
-        }
+        let done_s = if self.reduced.fixes.len() < self.gps.len() {
+            self.assign(c, Some(t_s))
+        } else {
+            0.0
+        };
         let a = c.accel_m_s2;
         self.integrated[0].advance(a, self.dt_s, self.half_dt2_s2);
         self.integrated[1].advance(a, step, 0.5 * step * step);
-        self.units.add_step(step);
-        if self.bias.drifts() {
-            self.units.add_bias_step(step, self.bias);
+        // The rest of the step after its last fix, or all of it without one.
+        if done_s > 0.0 {
+            self.add_piece(step - done_s, step);
+        } else {
+            self.add_step(step);
         }
         let finite = [
             self.integrated[0].is_finite(),
@@ -204,7 +213,7 @@ impl Stitch<'_> {
                 *overflow = Some((self.k, c.line));
             }
         }
-        (self.before_s, self.current, self.k) = (c.t_s, Some(next), self.k + 1);
+        (self.current, self.k) = (Some(next), self.k + 1);
         Ok(())
     }
 
@@ -313,8 +322,8 @@ fn stitch_all(
 
 /// Streams the accelerometer log `source` once: every row checked (format, increasing time
 /// stamps), the steps counted, and the log reduced between the `gps` fixes for either Δt mode
-/// (`nominal_dt_s` the configured step, `bias` the filter's bias model for the per-step units).
-/// Starts eq. (3) from `start` = (p_c(0), v_c(0)).
+/// (`nominal_dt_s` the configured step, NaN when none is, `bias` the filter's bias model for the
+/// per-step units). Starts eq. (3) from `start` at the first sample.
 ///
 /// # Errors
 /// [`LogError`] naming the line of the first malformed row or time stamp not after the
@@ -323,7 +332,7 @@ pub fn reduce(
     source: &dyn LogSource,
     gps: &[GpsFix],
     (nominal_dt_s, bias): (f64, BiasModel),
-    start: Integrated,
+    start: Start,
 ) -> Result<Reduced, LogError> {
     let (layout, mut feed) = open_blocks(source, ACCEL_COLUMNS)?;
     let empty = StepAt {
@@ -336,15 +345,16 @@ pub fn reduce(
         bias,
         half_dt2_s2: 0.5 * nominal_dt_s * nominal_dt_s,
         gps,
+        start,
         k: 0,
         current: None,
-        before_s: 0.0,
-        integrated: [start; 2],
+        integrated: [Integrated::default(); 2],
         units: NoiseUnits::default(),
         reduced: Reduced {
             samples: 0,
             span_s: (0.0, 0.0),
             first_line: 0,
+            first_accel_m_s2: 0.0,
             median: StepMedian::new(),
             step_range: (empty, StepAt::default()),
             nominal: true,

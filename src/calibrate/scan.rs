@@ -1,11 +1,12 @@
 //! What the pass over the logs learned, and the rules it sets: the median step and the
-//! steps accepted around it, whether the nominal recursion applies, and which sample each GPS
-//! fix belongs to.
+//! steps accepted around it, whether the nominal recursion applies, and which step each GPS
+//! fix falls in.
 
 use crate::logs::steps::ACCEPTED_STEP_RATIO;
 use crate::logs::{AccelSample, GpsFix, LogError, LogProblem};
 
 use super::StepMode;
+use super::integration::update_time_s;
 use super::pass::Reduced;
 
 /// What the first pass learned.
@@ -28,7 +29,8 @@ pub struct Scan {
 }
 
 impl Scan {
-    /// Half the median step: how far from a sample a fix may lie, s.
+    /// Half the median step: how far before the first sample or after the last a fix may lie
+    /// (it is applied at that sample), s.
     pub fn tolerance_s(&self) -> f64 {
         0.5 * self.median_step_s
     }
@@ -111,75 +113,58 @@ impl Scan {
     }
 }
 
-/// Assigns each fix to the accelerometer sample nearest to it, as the samples stream past.
+/// Places each fix in the step of the sample at or before it, as the samples stream past.
 pub struct FixMatcher<'a> {
     scan: &'a Scan,
     next: usize,
-    previous_s: Option<f64>,
 }
 
 impl<'a> FixMatcher<'a> {
     /// Before the first sample.
     pub fn new(scan: &'a Scan) -> Self {
-        Self {
-            scan,
-            next: 0,
-            previous_s: None,
-        }
+        Self { scan, next: 0 }
     }
 
     fn error(&self, fix: &GpsFix, problem: LogProblem) -> LogError {
         LogError::at(&self.scan.gps_name, fix.line, problem)
     }
 
-    /// The index of the fix that belongs to the sample at `t_s` (followed by one at `next_s`, if
-    /// any): the next fix within half the median step of it and nearer to it than to the next.
+    /// The fixes in the step from the sample at `t_s` to the next one at `next_s` (all that
+    /// remain at the last sample, `next_s` = `None`), in order: the one at `t_s` first, if any.
     ///
     /// # Errors
-    /// [`LogProblem::FixBetweenSamples`] for a fix that no sample took, and
-    /// [`LogProblem::FixOnTakenSample`] for a second fix on one sample.
-    pub fn at_sample(&mut self, t_s: f64, next_s: Option<f64>) -> Result<Option<usize>, LogError> {
-        let tol = self.scan.tolerance_s();
-        let belongs = |f: &GpsFix| {
-            let d = (f.t_s - t_s).abs();
-            d <= tol && next_s.is_none_or(|n| d <= (n - f.t_s).abs())
-        };
-        let previous_s = self.previous_s.replace(t_s);
-        let Some(fix) = self.scan.gps.get(self.next) else {
-            return Ok(None);
-        };
-        if fix.t_s < t_s - tol {
-            return Err(self.error(
-                fix,
-                LogProblem::FixBetweenSamples {
-                    t_s: fix.t_s,
-                    before_s: previous_s.unwrap_or(t_s),
-                    after_s: t_s,
-                    tolerance_s: tol,
-                },
-            ));
+    /// [`LogProblem::FixOnTakenSample`] for a second fix that [`update_time_s`] puts at the time
+    /// of another (two fixes beyond one end of the log).
+    pub fn in_step(
+        &mut self,
+        t_s: f64,
+        next_s: Option<f64>,
+    ) -> Result<std::ops::Range<usize>, LogError> {
+        let first = self.next;
+        let at = |f: &GpsFix| update_time_s(f.t_s, t_s, next_s.is_none());
+        while let Some(fix) = self.scan.gps.get(self.next) {
+            if next_s.is_some_and(|n| fix.t_s >= n) {
+                break;
+            }
+            if self.next > first {
+                let before = &self.scan.gps[self.next - 1];
+                if at(before) == at(fix) {
+                    return Err(self.error(
+                        fix,
+                        LogProblem::FixOnTakenSample {
+                            t_s: fix.t_s,
+                            sample_s: at(fix),
+                            other_line: before.line,
+                        },
+                    ));
+                }
+            }
+            self.next += 1;
         }
-        if !belongs(fix) {
-            return Ok(None);
-        }
-        let index = self.next;
-        self.next += 1;
-        if let Some(second) = self.scan.gps.get(self.next)
-            && belongs(second)
-        {
-            return Err(self.error(
-                second,
-                LogProblem::FixOnTakenSample {
-                    t_s: second.t_s,
-                    sample_s: t_s,
-                    other_line: fix.line,
-                },
-            ));
-        }
-        Ok(Some(index))
+        Ok(first..self.next)
     }
 
-    /// Checks that every fix found its sample.
+    /// Checks that every fix found its step.
     ///
     /// # Errors
     /// [`LogProblem::FixOutsideSpan`] for the first fix left over.

@@ -56,6 +56,23 @@ impl NoiseUnits {
         ];
     }
 
+    /// Adds a piece of `tau_s` of a step of `step_s` that a fix cuts: the step's white noise
+    /// taken as white within the step (spectral density W·Δt_j), so that the pieces' velocity
+    /// variances W·Δt_j·τ add up to the step's W·Δt_j² and no piece borrows the noise of another.
+    ///
+    /// # Formula
+    /// U_W ← Φ(τ)·U_W·Φ(τ)ᵀ + Δt_j·[[τ³/3, τ²/2], [τ²/2, τ]].
+    #[inline]
+    pub fn add_piece(&mut self, tau_s: f64, step_s: f64) {
+        let [pp, pv, vv] = self.white;
+        let tau2 = tau_s * tau_s;
+        self.white = [
+            pp + 2.0 * tau_s * pv + tau2 * vv + step_s * tau2 * tau_s / 3.0,
+            pv + tau_s * vv + 0.5 * step_s * tau2,
+            vv + step_s * tau_s,
+        ];
+    }
+
     /// Adds the bias's part of one step of `tau_s` for a drifting `bias` model (nothing for a
     /// constant one).
     #[inline]

@@ -7,9 +7,11 @@ use std::path::Path;
 use std::io::Write as _;
 
 use super::{load_model, write};
-use crate::cli::{CalibrateArgs, CaseArgs, ModelArgs, SimulateArgs};
+use crate::cli::{CalibrateArgs, SimulateArgs};
 use accelcal::calibrate::CalibrateError;
 use accelcal::calibrate::{self, Settings};
+use accelcal::config::{Config, ConfigText};
+use accelcal::error::ConfigError;
 use accelcal::filter::FilterSchedule;
 use accelcal::format::{count, sig};
 use accelcal::likelihood::{Key, NoiseEstimate, Request};
@@ -98,15 +100,30 @@ const ESTIMATES_FILE: &str = "estimates.csv";
 const SUMMARY_FILE: &str = "summary.json";
 const PAGE_FILE: &str = "index.html";
 
-pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
-    let model_args = ModelArgs {
-        config: args.config.clone(),
-        seed: None,
-        quiet: args.quiet,
+/// The calibration's settings from `--config`, when given: only the keys a calibration uses are
+/// read and checked; without the file, or where it is silent, the log decides (the rate, the
+/// prior).
+fn calibrate_settings(args: &CalibrateArgs) -> Result<Settings, ConfigError> {
+    let text = args.config.as_deref().map(ConfigText::read).transpose()?;
+    let config = match &text {
+        Some(t) => t.parse()?,
+        None => Config::default(),
     };
-    let model = load_model(&model_args, &CaseArgs::default(), None)?;
+    let sets = |key: &str| text.as_ref().is_some_and(|t| t.sets(key));
+    Settings::from_config(
+        &config,
+        sets("accelerometer.sample_rate_hz"),
+        sets("initial"),
+    )
+    .map_err(|e| match &text {
+        Some(t) => t.locate(e),
+        None => e,
+    })
+}
+
+pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
+    let settings = calibrate_settings(args)?;
     check_directory(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE, PAGE_FILE])?;
-    let settings = Settings::from_model(&model);
     let note = |text: &str| {
         if !args.quiet && std::io::stderr().is_terminal() {
             eprintln!("{text}");

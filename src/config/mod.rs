@@ -6,6 +6,7 @@
 
 mod bias;
 mod case;
+mod keys;
 mod sensitivity;
 mod source;
 

@@ -7,6 +7,7 @@ mod validate;
 use crate::config::{AccelerometerOutput, BiasModelKind, Case, Config, TruthModel};
 use crate::error::ConfigError;
 pub use memory::{MemoryEstimate, Work};
+pub use validate::validate_calibration;
 use validate::{validate, whole};
 
 use crate::state::ErrorState;
@@ -148,19 +149,7 @@ impl Model {
                 a.bias_correlation_time_s,
             ),
         };
-        let filter_stats = NoiseStats {
-            accel_noise_var_m2_s4: config.filter_accel_noise_var_m2_s4(),
-            bias_var_m2_s4: config.filter_bias_var_m2_s4(),
-            gps_position_sigma_m: config.filter_gps_position_sigma_m(),
-            gps_velocity_sigma_m_s: config.filter_gps_velocity_sigma_m_s(),
-            initial_position_sigma_m: config.filter_initial_position_sigma_m(),
-            initial_velocity_sigma_m_s: config.filter_initial_velocity_sigma_m_s(),
-            bias_model: bias_model(
-                config.filter_bias_model_kind(),
-                config.filter_bias_random_walk_m_s2_per_sqrt_s(),
-                config.filter_bias_correlation_time_s(),
-            ),
-        };
+        let filter_stats = filter_stats(config);
         let residual_pair = match config.checks.residual_pair_s {
             Some(times) => times.map(|t| timeline.fix_index_at(t).expect("validated fix time")),
             None => {
@@ -247,6 +236,25 @@ impl Model {
     pub fn analytic_truth_at_fix(&self, i: usize, t_s: f64, p0_m: f64, v0_m_s: f64) -> (f64, f64) {
         let [dp, dv] = self.analytic_offsets_at_fix[i];
         (p0_m + v0_m_s * t_s + dp, v0_m_s + dv)
+    }
+}
+
+/// The statistics the filter assumes: each `[filter]` key, or the truth's value where it is left
+/// out (of a configuration whose filter keys are valid: [`Model::new`] or
+/// [`validate_calibration`]).
+pub fn filter_stats(config: &Config) -> NoiseStats {
+    NoiseStats {
+        accel_noise_var_m2_s4: config.filter_accel_noise_var_m2_s4(),
+        bias_var_m2_s4: config.filter_bias_var_m2_s4(),
+        gps_position_sigma_m: config.filter_gps_position_sigma_m(),
+        gps_velocity_sigma_m_s: config.filter_gps_velocity_sigma_m_s(),
+        initial_position_sigma_m: config.filter_initial_position_sigma_m(),
+        initial_velocity_sigma_m_s: config.filter_initial_velocity_sigma_m_s(),
+        bias_model: bias_model(
+            config.filter_bias_model_kind(),
+            config.filter_bias_random_walk_m_s2_per_sqrt_s(),
+            config.filter_bias_correlation_time_s(),
+        ),
     }
 }
 

@@ -11,6 +11,9 @@ use crate::error::ConfigError;
 use crate::stats::MIN_ACCURATE_RATE;
 
 mod bias;
+mod calibrate;
+
+pub use calibrate::validate_calibration;
 
 /// The smallest accepted `checks.false_alarm_rate` (see [`validate_false_alarm_rate`]).
 const MIN_FALSE_ALARM_RATE: f64 = 1e-6;

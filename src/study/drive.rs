@@ -8,8 +8,7 @@ use crate::calibrate::summary::Calibration;
 use crate::calibrate::{self, CalibrateError, Settings};
 use crate::config::Config;
 use crate::likelihood::{Key, NoiseEstimate, Request};
-use crate::logs::read::{LogText, read_gps};
-use crate::model::Model;
+use crate::logs::read::LogText;
 use crate::state::BiasModel;
 
 /// The shipped accelerometer log as recorded (gravity's component along the axis included).
@@ -88,29 +87,12 @@ pub const RUNS: [(Axis, &[Key]); 4] = [
     ),
 ];
 
-/// The settings of a calibration with no configuration: the default configuration's statistics
-/// and α, the accelerometer's median step, and the integration started from the first fix (its
-/// position carried back by its velocity to the first sample), its prior σ's the GPS σ's.
-///
-/// # Errors
-/// [`CalibrateError::Log`] when a log cannot be read.
-pub fn settings(accel: &LogText, gps: &LogText) -> Result<Settings, CalibrateError> {
-    let model = Model::new(&Config::default()).expect("the default configuration is valid");
-    let mut s = Settings::from_model(&model);
-    let fixes = read_gps(gps)?;
-    let mut reader = crate::logs::read::AccelReader::open(accel)?;
-    let first = reader.next_sample()?;
-    let second = reader.next_sample()?;
-    if let (Some(fix), Some(a), Some(b)) = (fixes.first(), first, second) {
-        s.position_mean_m = fix.position_m - fix.velocity_m_s * (fix.t_s - a.t_s);
-        s.velocity_mean_m_s = fix.velocity_m_s;
-        s.nominal_dt_s = b.t_s - a.t_s;
-    }
-    s.prior_from_first_fix = true;
-    let f = &mut s.filter_stats;
-    f.initial_position_sigma_m = f.gps_position_sigma_m;
-    f.initial_velocity_sigma_m_s = f.gps_velocity_sigma_m_s;
-    Ok(s)
+/// The settings of a calibration with no configuration, as `calibrate` runs without
+/// `--config`: the default statistics and α, the log's median step, the integration started from
+/// the first fix with the GPS σ's as its prior σ's.
+pub fn settings() -> Settings {
+    Settings::from_config(&Config::default(), false, false)
+        .expect("the default configuration is valid")
 }
 
 /// Calibrates the drive on `axis` with `keys` estimated.
@@ -120,7 +102,7 @@ pub fn settings(accel: &LogText, gps: &LogText) -> Result<Settings, CalibrateErr
 pub fn run_one(axis: Axis, keys: &[Key]) -> Result<DriveRun, CalibrateError> {
     let accel = LogText::new(&format!("{DRIVE_DIR}/{}", axis.file()), axis.text());
     let gps = LogText::new(&format!("{DRIVE_DIR}/gps.csv"), GPS);
-    let settings = settings(&accel, &gps)?;
+    let settings = settings();
     let request = Request {
         keys: keys.to_vec(),
         confidence: 0.95,

@@ -220,7 +220,7 @@ fn time_stamps_must_increase_without_gaps() {
 }
 
 #[test]
-fn fixes_outside_the_log_or_between_samples_are_refused() {
+fn fixes_outside_the_log_are_refused_and_between_samples_taken() {
     let accel = accel_with(|_| {});
     let late = gps_with(|r| r.push("2.5,200,100".into()));
     refused(
@@ -230,26 +230,29 @@ fn fixes_outside_the_log_or_between_samples_are_refused() {
     );
     let early = gps_with(|r| r.insert(0, "-0.1,0,100".into()));
     refused(Some(&accel), Some(&early), &["g.csv, line 2", "outside"]);
-    // A step of 1.4 median steps is accepted, but a fix in its middle is on no sample.
+    // A fix on the last sample and one after it (within half a step) are both applied at it.
+    let twice = gps_with(|r| r.push("2.001,200,100".into()));
+    refused(
+        Some(&accel),
+        Some(&twice),
+        &["g.csv, line 12", "line 11 already takes"],
+    );
+    // A fix in the middle of a step of 1.4 median steps, and two fixes in one step, are
+    // applied at their own times.
     let stretched = accel_with(|r| {
         for (j, row) in r.iter_mut().enumerate().skip(201) {
             *row = format!("{:.3},0.1", j as f64 * 0.005 + 0.002);
         }
     });
     let between = gps_with(|r| r[4] = "1.0035,100,100".into());
-    refused(
-        Some(&stretched),
-        Some(&between),
-        &[
-            "g.csv, line 6",
-            "between the accelerometer samples at 1 s and 1.007 s",
-            "half the median step",
-        ],
-    );
-    let twice = gps_with(|r| r.insert(5, "1.001,100,100".into()));
-    refused(
-        Some(&accel),
-        Some(&twice),
-        &["g.csv, line 7", "line 6 already takes"],
-    );
+    let two = gps_with(|r| r.insert(5, "1.001,100,100".into()));
+    for (a, g) in [(&stretched, &between), (&accel, &two)] {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("a.csv"), a).unwrap();
+        std::fs::write(d.join("g.csv"), g).unwrap();
+        let args = ["calibrate", "--accel", "a.csv", "--gps", "g.csv", "-q"];
+        let o = run(&args, d);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
 }

@@ -19,7 +19,7 @@ const TRUTH: &str = "[profile]\nduration_s = 60.0\n\n[accelerometer]\nbias_model
 
 /// Writes `name` = the truth with the `[filter]` section `filter`.
 fn config(dir: &Path, name: &str, filter: &str) {
-    std::fs::write(dir.join(name), format!("{TRUTH}\n[filter]\n{filter}")).unwrap();
+    crate::full_config(dir, name, &format!("{TRUTH}\n[filter]\n{filter}"));
 }
 
 /// Simulates realization `l` of the random-walk truth into `dir/logs-l`.

@@ -9,10 +9,13 @@ use std::time::{Duration, Instant};
 
 use crate::{column, common, read_csv, run, simulate_logs, stderr};
 
-/// Calibrates in `dir` with `extra` arguments after the logs; expects success.
+/// Calibrates in `dir` with `extra` arguments after the logs and the simulation's configuration
+/// in full; expects success.
 fn calibrate_with(dir: &Path, accel: &str, out: &str, extra: &[&str]) {
+    let config = crate::default_config(dir);
     let args = [
-        &["calibrate", "--accel", accel, "--gps", "logs/gps.csv"][..],
+        &["calibrate", "--config", config][..],
+        &["--accel", accel, "--gps", "logs/gps.csv"],
         &["--out", out, "--quiet"],
         extra,
     ]
@@ -113,7 +116,10 @@ fn gzip_and_pipes_read_to_the_same_bits() {
     ] {
         let o = bash(
             d,
-            &format!("\"$B\" calibrate --accel {pipe} --gps logs/gps.csv --out {name} -q"),
+            &format!(
+                "\"$B\" calibrate --config simulation.toml --accel {pipe} --gps logs/gps.csv \
+                 --out {name} -q"
+            ),
         );
         assert!(o.status.success(), "{name}: {}", stderr(&o));
         assert_eq!(summary(d, name), summary(d, "plain"), "{name}");

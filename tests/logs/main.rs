@@ -7,11 +7,14 @@
 mod common;
 
 mod bad_logs;
+mod between;
+mod configuration;
 mod diagnostics;
 mod drift;
 mod fast;
 mod prior;
 mod reader;
+mod recordings;
 mod reference;
 mod round_trip;
 mod smoother;
@@ -56,14 +59,28 @@ pub fn simulate_logs(dir: &Path) {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
-/// Calibrates `accel` and `gps` into `dir/out`, the estimates at every sample; returns the
-/// summary.
+/// Writes the configuration `partial` (TOML text) into `dir/name` in full, every key written out:
+/// the prior (`[initial]`) and the accelerometer rate of the simulation too, so that `calibrate`
+/// takes them from the file and not from the log.
+pub fn full_config(dir: &Path, name: &str, partial: &str) {
+    let config = accelcal::config::Config::from_toml_str(partial).unwrap();
+    std::fs::write(dir.join(name), config.to_toml_string()).unwrap();
+}
+
+/// The name of the default configuration in full, written into `dir`.
+pub fn default_config(dir: &Path) -> &'static str {
+    full_config(dir, "simulation.toml", "");
+    "simulation.toml"
+}
+
+/// Calibrates `accel` and `gps` into `dir/out`, the estimates at every sample, with the
+/// simulation's configuration in full; returns the summary.
 pub fn calibrate(dir: &Path, accel: &str, gps: &str, out: &str) -> serde_json::Value {
     calibrate_with(dir, &[], (accel, gps), out).0
 }
 
-/// [`calibrate`] with more arguments (`--config FILE`, say); returns the summary and the line
-/// the command printed.
+/// [`calibrate`] with more arguments (`--config FILE`, say; the default configuration in full
+/// when none is given); returns the summary and the line the command printed.
 pub fn calibrate_with(
     dir: &Path,
     more: &[&str],
@@ -71,8 +88,14 @@ pub fn calibrate_with(
     out: &str,
 ) -> (serde_json::Value, String) {
     let logs = ["--accel", accel, "--gps", gps, "--out", out];
+    let config = if more.contains(&"--config") {
+        vec![]
+    } else {
+        vec!["--config", default_config(dir)]
+    };
     let args = [
         &["calibrate"][..],
+        &config,
         more,
         &logs,
         &["--quiet", "--every-sample"],

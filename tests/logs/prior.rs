@@ -7,7 +7,7 @@ use super::{run, simulate_logs, stderr};
 /// returns the summary's warnings and standard error.
 fn warnings(dir: &std::path::Path, name: &str, config: &str) -> (Vec<String>, String) {
     let toml = format!("{name}.toml");
-    std::fs::write(dir.join(&toml), config).unwrap();
+    crate::full_config(dir, &toml, config);
     let o = run(
         &[
             "calibrate",

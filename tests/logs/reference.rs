@@ -98,17 +98,66 @@ fn inverse(a: &M3) -> M3 {
     inv
 }
 
-/// Processes an accelerometer log `(t, a_c)` and a GPS log `(t, z_p, z_v)`; each fix is applied
-/// at the sample nearest to it.
-pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> Processed {
+/// One time the filter stops at: a sample, or a fix between two samples.
+struct Node {
+    t: f64,
+    /// The output integrated from here to the next node: this sample's, or the sample's before
+    /// the fix.
+    a: f64,
+    fix: Option<(f64, f64)>,
+    sample: bool,
+    /// The step of the sample that starts or holds it, s (0 at the last sample).
+    step: f64,
+}
+
+/// The samples of `accel` and the fixes of `gps` in time order: a fix at a sample's time stamp
+/// (or before the first sample, or after the last) is applied at that sample, any other between
+/// its two samples at its own time.
+fn nodes(accel: &[(f64, f64)], gps: &[(f64, f64, f64)]) -> Vec<Node> {
     let n = accel.len();
-    let mut fix_at = vec![None; n];
-    for &(tf, zp, zv) in gps {
-        let k = (0..n)
-            .min_by(|&a, &b| (accel[a].0 - tf).abs().total_cmp(&(accel[b].0 - tf).abs()))
-            .unwrap();
-        fix_at[k] = Some((zp, zv));
+    let mut out = Vec::with_capacity(n + gps.len());
+    let mut fixes = gps.iter().peekable();
+    for k in 0..n {
+        let (t, a) = accel[k];
+        let end = accel.get(k + 1).map_or(f64::INFINITY, |s| s.0);
+        let step = accel.get(k + 1).map_or(0.0, |s| s.0 - t);
+        let mut sample = Node {
+            t,
+            a,
+            fix: None,
+            sample: true,
+            step,
+        };
+        let mut within = Vec::new();
+        while let Some(&&(tf, zp, zv)) = fixes.peek() {
+            if tf >= end {
+                break;
+            }
+            if tf <= t || k + 1 == n {
+                sample.fix = Some((zp, zv));
+            } else {
+                within.push(Node {
+                    t: tf,
+                    a,
+                    fix: Some((zp, zv)),
+                    sample: false,
+                    step,
+                });
+            }
+            fixes.next();
+        }
+        out.push(sample);
+        out.extend(within);
     }
+    out
+}
+
+/// Processes an accelerometer log `(t, a_c)` and a GPS log `(t, z_p, z_v)`; each fix is applied
+/// at its own time (at the sample whose time stamp it has, or between two samples, the step cut
+/// there), the smoother running over samples and fixes alike.
+pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> Processed {
+    let nodes = nodes(accel, gps);
+    let n = nodes.len();
     let (rp, rv) = (prior.gps_p_sigma_m.powi(2), prior.gps_v_sigma_m_s.powi(2));
     let mut x = [0.0; 3];
     let mut p = [
@@ -117,7 +166,7 @@ pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> 
         [0.0, 0.0, prior.bias_var],
     ];
     let (mut pc, mut vc) = (prior.p0_m, prior.v0_m_s);
-    let mut out = Processed {
+    let mut all = Processed {
         t: Vec::with_capacity(n),
         pc: Vec::with_capacity(n),
         x: Vec::with_capacity(n),
@@ -125,21 +174,21 @@ pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> 
         xs: vec![],
         ps: vec![],
     };
-    // Per step: the a priori estimate at the next sample and the transition, for the smoother.
+    // Per step: the a priori estimate at the next node and the transition, for the smoother.
     let mut x_prior_next = Vec::with_capacity(n);
     let mut p_prior_next = Vec::with_capacity(n);
     let mut f_step = Vec::with_capacity(n);
     for k in 0..n {
-        if let Some((zp, zv)) = fix_at[k] {
+        if let Some((zp, zv)) = nodes[k].fix {
             update(&mut x, &mut p, [zp - pc, zv - vc], [rp, rv]);
         }
-        out.t.push(accel[k].0);
-        out.pc.push(pc);
-        out.x.push(x);
-        out.p.push(p);
+        all.t.push(nodes[k].t);
+        all.pc.push(pc);
+        all.x.push(x);
+        all.p.push(p);
         if k + 1 < n {
-            let dt = accel[k + 1].0 - accel[k].0;
-            let a = accel[k].1;
+            let dt = nodes[k + 1].t - nodes[k].t;
+            let a = nodes[k].a;
             pc += vc * dt + a * dt * dt / 2.0;
             vc += a * dt;
             let (phi, q_b) = match prior.drift {
@@ -151,12 +200,12 @@ pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> 
                 }
             };
             let f = [[1.0, dt, -dt * dt / 2.0], [0.0, 1.0, -dt], [0.0, 0.0, phi]];
-            let g = [-dt * dt / 2.0, -dt, 0.0];
             x = mul_v(&f, &x);
             p = mul(&mul(&f, &p), &transpose(&f));
-            for i in 0..3 {
-                for j in 0..3 {
-                    p[i][j] += prior.accel_noise_var * g[i] * g[j];
+            let q = white_noise(&nodes[k], &nodes[k + 1], dt);
+            for i in 0..2 {
+                for j in 0..2 {
+                    p[i][j] += prior.accel_noise_var * q[i][j];
                 }
             }
             p[2][2] += q_b;
@@ -165,8 +214,59 @@ pub fn process(accel: &[(f64, f64)], gps: &[(f64, f64, f64)], prior: &Prior) -> 
             f_step.push(f);
         }
     }
-    smooth(&mut out, &f_step, &x_prior_next, &p_prior_next);
-    out
+    smooth(&mut all, &f_step, &x_prior_next, &p_prior_next);
+    samples_only(all, &nodes)
+}
+
+/// The rows of the samples of `all`, whose rows are `nodes`.
+fn samples_only(all: Processed, nodes: &[Node]) -> Processed {
+    let keep = |v: Vec<[f64; 3]>| -> Vec<[f64; 3]> {
+        v.into_iter()
+            .zip(nodes)
+            .filter(|(_, node)| node.sample)
+            .map(|(x, _)| x)
+            .collect()
+    };
+    Processed {
+        t: keep_f(&all.t, nodes),
+        pc: keep_f(&all.pc, nodes),
+        x: keep(all.x),
+        p: keep_m(all.p, nodes),
+        xs: keep(all.xs),
+        ps: keep_m(all.ps, nodes),
+    }
+}
+
+/// The white noise's (δp, δv) covariance per unit of W over `dt` from node `a` to node `b`: a
+/// whole step holds the sample's noise; a piece of a step cut by a fix takes it as white within
+/// the step, of density W·Δt_j.
+fn white_noise(a: &Node, b: &Node, dt: f64) -> [[f64; 2]; 2] {
+    if a.sample && b.sample {
+        let g = [-dt * dt / 2.0, -dt];
+        [[g[0] * g[0], g[0] * g[1]], [g[1] * g[0], g[1] * g[1]]]
+    } else {
+        let h = a.step;
+        [
+            [h * dt.powi(3) / 3.0, h * dt * dt / 2.0],
+            [h * dt * dt / 2.0, h * dt],
+        ]
+    }
+}
+
+fn keep_f(v: &[f64], nodes: &[Node]) -> Vec<f64> {
+    v.iter()
+        .zip(nodes)
+        .filter(|(_, n)| n.sample)
+        .map(|(x, _)| *x)
+        .collect()
+}
+
+fn keep_m(v: Vec<M3>, nodes: &[Node]) -> Vec<M3> {
+    v.into_iter()
+        .zip(nodes)
+        .filter(|(_, n)| n.sample)
+        .map(|(x, _)| x)
+        .collect()
 }
 
 /// The update of the estimate `x` and its covariance `p` by the fix whose difference from the

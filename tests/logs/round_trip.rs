@@ -82,7 +82,7 @@ fn drifting_bias_logs_calibrate_to_the_in_memory_filter_bit_for_bit() {
     for (keys, kind) in drifts {
         let dir = tempfile::tempdir().unwrap();
         let dir = dir.path();
-        std::fs::write(dir.join("c.toml"), format!("[accelerometer]\n{keys}")).unwrap();
+        crate::full_config(dir, "c.toml", &format!("[accelerometer]\n{keys}"));
         let args = [
             "simulate", "--config", "c.toml", "--truth", "euler", "--logs", "logs",
         ];
