@@ -1,7 +1,12 @@
 //! The shipped minute of a real drive (examples/comma2k19), calibrated as the report shows it:
 //! the gravity-compensated axis passes the NIS test once the white noise W is estimated with the
 //! GPS σ's and fails it with the GPS σ's alone; its bias is negative; the raw axis needs a
-//! drifting bias.
+//! drifting bias. From the command line with no configuration, the same log as a file, gzip and
+//! a pipe gives the same bits; a prior 900σ off warns; the first fix gives the bias's sign.
+
+mod common;
+
+use std::path::{Path, PathBuf};
 
 use accelcal::study::drive::{self, Axis, RUNS};
 
@@ -30,4 +35,113 @@ fn the_real_drive_calibrates_as_the_report_says() {
     // The raw axis with a random walk: K is identified (gravity's share moves with the pitch).
     let k = &runs[3].noise.keys[3];
     assert!(k.identifiable, "{k:?}");
+}
+
+fn example(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/comma2k19")
+        .join(name)
+}
+
+/// Runs `calibrate` on the shipped GPS log and `accel` (a path or a shell word) through bash,
+/// into `dir/out`; returns the printed output and the summary.
+fn calibrate_sh(dir: &Path, accel: &str, more: &str, out: &str) -> (String, serde_json::Value) {
+    let gps = example("gps.csv");
+    let script = format!(
+        "\"{}\" calibrate --accel {accel} --gps \"{}\" --out {out} -q {more}",
+        common::bin(),
+        gps.display()
+    );
+    let o = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(&script)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    let text =
+        String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{script}: {text}");
+    let summary = std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap();
+    (text, serde_json::from_str(&summary).unwrap())
+}
+
+#[test]
+fn the_shipped_drive_runs_without_configuration_from_a_file_gzip_and_a_pipe() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let plain = example("accel_gravcomp.csv");
+    let text = std::fs::read(&plain).unwrap();
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    std::io::Write::write_all(&mut gz, &text).unwrap();
+    std::fs::write(d.join("accel_gravcomp.csv.gz"), gz.finish().unwrap()).unwrap();
+    let keys = "--estimate-noise --estimate \
+                gps_position_sigma_m,gps_velocity_sigma_m_s,accel_noise_var_m2_s4";
+    let (said, s) = calibrate_sh(d, &format!("\"{}\"", plain.display()), keys, "plain");
+    assert!(said.contains("NIS test pass"), "{said}");
+    assert!(said.contains("95 % interval"), "{said}");
+    assert!(s["bias_m_s2"].as_f64().unwrap() < 0.0);
+    let estimates = std::fs::read(d.join("plain/estimates.csv")).unwrap();
+    for (accel, out) in [
+        ("accel_gravcomp.csv.gz", "gz"),
+        ("<(gzip -dc accel_gravcomp.csv.gz)", "pipe"),
+    ] {
+        let (_, t) = calibrate_sh(d, accel, keys, out);
+        // The same numbers bit for bit; only the log's name differs.
+        for key in [
+            "bias_m_s2",
+            "bias_sigma_m_s2",
+            "noise_estimate",
+            "nis",
+            "diagnostics",
+        ] {
+            assert_eq!(s[key], t[key], "{out}: {key}");
+        }
+        assert_eq!(
+            std::fs::read(d.join(out).join("estimates.csv")).unwrap(),
+            estimates,
+            "{out}"
+        );
+    }
+    // The GPS σ's alone leave the NIS test failing, and the diagnosis names the white noise.
+    let (said, s) = calibrate_sh(
+        d,
+        &format!("\"{}\"", plain.display()),
+        "--estimate-noise",
+        "sigmas",
+    );
+    assert!(said.contains("NIS test fail"), "{said}");
+    let findings = s["diagnostics"]["findings"].to_string();
+    assert!(findings.contains("accel_noise_var_m2_s4"), "{findings}");
+}
+
+#[test]
+fn a_prior_900_sigma_off_warns_and_the_first_fix_gives_the_right_sign() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let plain = format!("\"{}\"", example("accel_gravcomp.csv").display());
+    // The simulation's prior: 100 m/s with σ 0.1 m/s against a car at 8.2 m/s.
+    std::fs::write(
+        d.join("sim.toml"),
+        "[accelerometer]\nsample_rate_hz = 104.35668282688978\n\n[initial]\nvelocity_mean_m_s = 100.0\n",
+    )
+    .unwrap();
+    let (said, s) = calibrate_sh(d, &plain, "--config sim.toml", "sim");
+    assert!(
+        said.contains("warning: the prior disagrees with the first fix"),
+        "{said}"
+    );
+    assert!(
+        s["warnings"][0]
+            .as_str()
+            .unwrap()
+            .contains("initial.velocity_mean_m_s")
+    );
+    // No configuration: the first fix starts the integration and the bias is negative.
+    let (said, s) = calibrate_sh(d, &plain, "", "first");
+    assert!(!said.contains("warning"), "{said}");
+    let (b, sb) = (
+        s["bias_m_s2"].as_f64().unwrap(),
+        s["bias_sigma_m_s2"].as_f64().unwrap(),
+    );
+    assert!(b + 3.0 * sb < 0.0, "{b} ± {sb}");
 }

@@ -196,10 +196,12 @@ fn print_result(
         super::say(&noise_lines(e))?;
     }
     super::say(&format!(
-        "bias {} ± {} m/s² at t = {} s ({} samples, {} fixes, Δt mode {}{model}); NIS test {} \
-         (sum {} {} [{}, {}]); written to {}\n",
+        "bias {} ± {} m/s² (95 % interval [{}, {}]) at t = {} s ({} samples, {} fixes, Δt mode \
+         {}{model}); NIS test {} (sum {} {} [{}, {}]); written to {}\n",
         sig(s.bias_m_s2, 6),
         sig(s.bias_sigma_m_s2, 3),
+        sig(s.bias_m_s2 - 1.96 * s.bias_sigma_m_s2, 3),
+        sig(s.bias_m_s2 + 1.96 * s.bias_sigma_m_s2, 3),
         s.end_s,
         count(s.samples),
         count(s.fixes as u64),
