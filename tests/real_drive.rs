@@ -144,4 +144,8 @@ fn a_prior_900_sigma_off_warns_and_the_first_fix_gives_the_right_sign() {
         s["bias_sigma_m_s2"].as_f64().unwrap(),
     );
     assert!(b + 3.0 * sb < 0.0, "{b} ± {sb}");
+    // The GPS position errors are not white at 10 Hz: the whiteness test flags them.
+    let position = &s["diagnostics"]["measurements"][0];
+    assert_eq!(position["measurement"], "position");
+    assert_eq!(position["whiteness"]["verdict"], "fail", "{position}");
 }
