@@ -120,7 +120,7 @@ fn json(path: &Path) -> serde_json::Value {
 fn the_reduced_likelihood_is_the_per_sample_filter_s() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let config = "[profile]\nduration_s = 60.0\n\n[accelerometer]\nbias_model = \"random_walk\"\n\
+    let config = "[profile]\nduration_s = 60.0\n\n[accelerometer]\nsample_rate_hz = 200.0\nbias_model = \"random_walk\"\n\
                   bias_random_walk_m_s2_per_sqrt_s = 0.002\n";
     std::fs::write(d.join("c.toml"), config).unwrap();
     let o = run(

@@ -156,18 +156,22 @@ fn method(s: &Summary) -> Vec<String> {
         ),
     };
     vec![
-        rich(
-            "The accelerometer output a_{c} is integrated by eq. (3) of the study from the \
-             configured prior means, p_{c}(t_{0}) and v_{c}(t_{0}); the error-state filter \
-             propagates δx = (δp, δv, b) with Φ and Q, and at each GPS fix updates it with \
-             δz = z − (p_{c}, v_{c}).",
-        ),
+        rich(&format!(
+            "The accelerometer output a_{{c}} is integrated by eq. (3) of the study from \
+                 p_{{c}}(t_{{0}}) = {} m and v_{{c}}(t_{{0}}) = {} m/s (the configured prior \
+                 means, or the first fix carried back to the first sample when the configuration \
+                 gives none); the error-state filter propagates δx = (δp, δv, b) with Φ and Q, \
+                 and at each GPS fix updates it with δz = z − (p_{{c}}, v_{{c}}).",
+            crate::format::sig(s.filter.initial_position_mean_m, 4),
+            crate::format::sig(s.filter.initial_velocity_mean_m_s, 4)
+        )),
         format!("{}<code>{}</code>).", rich(&mode), s.dt_mode.name()),
         rich(&format!(
             "Steps between {} and {} (0.5 to 1.5 times the median step) are accepted; a longer \
              one is a gap and a shorter one an extra sample, and either refuses the log. Each \
-             GPS fix is applied at the accelerometer sample whose time stamp is within {} (half \
-             the median step) of its own.",
+             GPS fix is applied at its own time: between two samples the filter propagates over \
+             the fraction of the step and updates there; a fix more than {} (half the median \
+             step) outside the log's span is refused.",
             seconds(s.accepted_step_s[0]),
             seconds(s.accepted_step_s[1]),
             seconds(s.fix_tolerance_s)
