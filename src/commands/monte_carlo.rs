@@ -27,7 +27,8 @@ pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
     let mut bar = Bar::new(args.model.quiet);
     let study = Study::run(&model, &mut bar)?
         .with_sensitivity(&mut bar)?
-        .with_drift(&mut bar)?;
+        .with_drift(&mut bar)?
+        .with_noise(study::noise::NOISE_DRIVES, &mut bar)?;
     let static_noise = accelcal::allan::section::report_coverage()?;
     let command = reproduce_command(args);
     let page = report::render(&report::ReportInput {

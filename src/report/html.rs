@@ -84,6 +84,12 @@ struct DriftHtml<'a> {
 }
 
 #[derive(Template)]
+#[template(path = "sections/noise.html")]
+struct NoiseHtml<'a> {
+    n: &'a super::noise::NoiseView,
+}
+
+#[derive(Template)]
 #[template(path = "sections/conclusions.html")]
 struct ConclusionsHtml<'a> {
     v: &'a ConclusionsView,
@@ -117,6 +123,7 @@ pub fn section(node: &SectionNode, eq: &Equations) -> Result<String, askama::Err
         SectionView::Sensitivity(s) => SensitivityHtml { s }.render(),
         SectionView::StaticNoise(a) => StaticNoiseHtml { a }.render(),
         SectionView::Drift(d) => DriftHtml { d }.render(),
+        SectionView::Noise(n) => NoiseHtml { n }.render(),
         SectionView::Conclusions(v) => ConclusionsHtml { v }.render(),
         SectionView::Appendix(v) => AppendixHtml { v }.render(),
     }?;

@@ -15,6 +15,7 @@ pub mod equations;
 pub mod figures;
 pub mod html;
 pub mod math;
+pub mod noise;
 pub mod outline;
 pub mod page;
 pub mod params;
@@ -139,16 +140,21 @@ pub fn build(
 }
 
 /// The outline of the report of `input`: every case, the sensitivity section when the study ran
-/// it, the static-noise section when its coverage is given, the drifting-bias section when the
-/// study ran it.
+/// it, the static-noise section when its coverage is given, the drifting-bias section and the
+/// section on noise statistics from a drive when the study ran them.
 pub fn outline_of(input: &ReportInput) -> Outline {
     let outline = Outline::standard(
         input.study.cases.len(),
         input.study.sensitivity.is_some(),
         input.static_noise.is_some(),
     );
-    if input.study.drift.is_some() {
+    let outline = if input.study.drift.is_some() {
         outline.with_drift()
+    } else {
+        outline
+    };
+    if input.study.noise.is_some() {
+        outline.with_noise(input.study.white_noise.is_some())
     } else {
         outline
     }

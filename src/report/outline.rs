@@ -34,6 +34,9 @@ pub enum Section {
     StaticNoise,
     /// A drifting bias seen by a constant-bias and a random-walk filter.
     Drift,
+    /// Noise statistics from a drive: simulated drives through `--estimate-noise`; with the
+    /// white noise's identifiability on two drives when `true`.
+    Noise(bool),
     /// Conclusions.
     Conclusions,
     /// Configuration and reproduction.
@@ -66,6 +69,10 @@ pub enum Table {
     StaticNoiseCoverage,
     /// Two filters on a drifting bias: claims, errors and verdicts.
     Drift,
+    /// The coverage of the noise estimate's intervals over simulated drives.
+    NoiseCoverage,
+    /// The white noise's identifiability on two drives.
+    WhiteNoise,
 }
 
 /// A numbered figure.
@@ -87,6 +94,10 @@ pub enum Figure {
     AllanDeviation,
     /// Claimed against achieved σ of two filters on a drifting bias.
     Drift,
+    /// The noise estimates of simulated drives against the truth.
+    NoiseEstimates,
+    /// The likelihood profile of one drive.
+    NoiseProfile,
 }
 
 /// A numbered display equation.
@@ -175,6 +186,17 @@ impl Section {
                 T(Table::StaticNoiseCoverage),
             ],
             Section::Drift => vec![F(Figure::Drift), T(Table::Drift)],
+            Section::Noise(white_noise) => {
+                let mut labels = vec![
+                    T(Table::NoiseCoverage),
+                    F(Figure::NoiseEstimates),
+                    F(Figure::NoiseProfile),
+                ];
+                if white_noise {
+                    labels.push(T(Table::WhiteNoise));
+                }
+                labels
+            }
         }
     }
 }
@@ -242,6 +264,19 @@ impl Outline {
             .position(|n| n.section == Section::Conclusions)
             .unwrap_or(self.nodes.len());
         self.nodes.insert(at, Node::leaf(Section::Drift));
+        self
+    }
+
+    /// The same outline with the section on noise statistics from a drive before the
+    /// conclusions (after the drifting bias), with the white noise's identifiability when
+    /// `white_noise`.
+    pub fn with_noise(mut self, white_noise: bool) -> Self {
+        let at = self
+            .nodes
+            .iter()
+            .position(|n| n.section == Section::Conclusions)
+            .unwrap_or(self.nodes.len());
+        self.nodes.insert(at, Node::leaf(Section::Noise(white_noise)));
         self
     }
 

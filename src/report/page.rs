@@ -188,6 +188,8 @@ pub enum SectionView {
     StaticNoise(Box<crate::allan::section::AllanSection>),
     /// A drifting bias.
     Drift(Box<super::drift::DriftView>),
+    /// Noise statistics from a drive.
+    Noise(Box<super::noise::NoiseView>),
     /// Conclusions.
     Conclusions(ConclusionsView),
     /// Configuration and reproduction.
@@ -208,6 +210,7 @@ impl SectionView {
             SectionView::Sensitivity(_) => "sensitivity".to_string(),
             SectionView::StaticNoise(_) => "allan".to_string(),
             SectionView::Drift(_) => "drifting-bias".to_string(),
+            SectionView::Noise(_) => "noise-estimate".to_string(),
             SectionView::Conclusions(_) => "conclusions".to_string(),
             SectionView::Appendix(_) => "appendix".to_string(),
         }
@@ -226,6 +229,7 @@ impl SectionView {
             SectionView::Sensitivity(_) => "Sensitivity to the assumed statistics".to_string(),
             SectionView::StaticNoise(_) => "Noise statistics from a static log".to_string(),
             SectionView::Drift(_) => "A drifting bias".to_string(),
+            SectionView::Noise(_) => "Noise statistics from a drive".to_string(),
             SectionView::Conclusions(_) => "Conclusions".to_string(),
             SectionView::Appendix(_) => "Appendix: configuration and reproduction".to_string(),
         }

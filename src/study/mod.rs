@@ -7,6 +7,7 @@
 
 pub mod analysis;
 pub mod drift;
+pub mod identify;
 pub mod noise;
 
 use crate::checks::{self, Budget, Verdicts};
@@ -95,6 +96,11 @@ pub struct Study {
     pub sensitivity: Option<Sensitivity>,
     /// The drifting-bias study, when it was run ([`Study::with_drift`]).
     pub drift: Option<drift::DriftStudy>,
+    /// Noise statistics estimated from simulated drives, when they were run
+    /// ([`Study::with_noise`]).
+    pub noise: Option<noise::NoiseStudy>,
+    /// The white noise's identifiability on two drives, run with [`Study::with_noise`].
+    pub white_noise: Option<identify::WhiteNoiseDrives>,
 }
 
 impl Study {
@@ -139,6 +145,8 @@ impl Study {
             realization_case,
             sensitivity: None,
             drift: None,
+            noise: None,
+            white_noise: None,
         })
     }
 
@@ -162,6 +170,22 @@ impl Study {
     /// [`FilterError`] when a filter's covariance stops being positive definite.
     pub fn with_drift(mut self, progress: &mut dyn Progress) -> Result<Self, FilterError> {
         self.drift = drift::run(&self.model.config, progress)?;
+        Ok(self)
+    }
+
+    /// The study with its noise statistics from simulated drives ([`noise::run`], `drives`
+    /// drives of the configuration's rates and statistics) and the white noise's
+    /// identifiability on two drives ([`identify::run`]).
+    ///
+    /// # Errors
+    /// [`FilterError`] when a filter's covariance is not positive definite.
+    pub fn with_noise(
+        mut self,
+        drives: u64,
+        progress: &mut dyn Progress,
+    ) -> Result<Self, FilterError> {
+        self.noise = Some(noise::run(&self.model.config, drives, progress)?);
+        self.white_noise = identify::run(&self.model.config)?;
         Ok(self)
     }
 
