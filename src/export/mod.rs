@@ -433,7 +433,8 @@ pub fn report_data_json(study: &Study) -> String {
         ensembles,
         sensitivity: study.sensitivity.as_ref().map(sensitivity::record),
         drifting_bias: study.drift.as_ref().map(drift_record),
-        noise_statistics: (study.noise.as_ref()).map(|n| noise::record(n, study.white_noise.as_ref())),
+        noise_statistics: (study.noise.as_ref())
+            .map(|n| noise::record(n, study.white_noise.as_ref())),
     };
     // Indented for the default run, compact for long ones (a third of the size).
     if study.model.timeline.fixes() <= crate::model::ALL_PAIRS_MAX_FIXES {

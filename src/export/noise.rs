@@ -105,6 +105,11 @@ pub fn record<'a>(n: &'a NoiseStudy, white: Option<&'a WhiteNoiseDrives>) -> Noi
             .enumerate()
             .map(|(j, c)| key_record(n, j, c))
             .collect(),
-        white_noise: white.map(|d| [white_noise_record(&d.quiet), white_noise_record(&d.vibrating)]),
+        white_noise: white.map(|d| {
+            [
+                white_noise_record(&d.quiet),
+                white_noise_record(&d.vibrating),
+            ]
+        }),
     }
 }

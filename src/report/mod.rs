@@ -12,6 +12,7 @@ pub mod calibration;
 pub mod cases;
 pub mod drift;
 pub mod equations;
+pub mod estimate;
 pub mod figures;
 pub mod html;
 pub mod math;

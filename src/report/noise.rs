@@ -1,100 +1,26 @@
 //! The section "Noise statistics from a drive": `calibrate --estimate-noise` on simulated drives
 //! whose truth is known (the coverage of its intervals, its estimates against the truth, the
 //! likelihood profile of one drive), and whether the white noise is identifiable on two drives.
-//! Also the calibration page's part: a table of the estimates and their profiles
-//! ([`estimate_html`]).
+//! The calibration page's part, a table of the estimates and their profiles, is
+//! [`estimate_html`] (in [`super::estimate`]).
 
-use askama::Template;
 use serde::Serialize;
 
+pub use super::estimate::{estimate_html, estimate_words, profile_series};
+use super::estimate::{interval_words, search_words, symbol, with_unit};
 use super::figures::figure;
 use super::outline::{Figure, Numbers, Table};
-use super::view::{FigureView, VerdictView};
 use super::prose::and_list;
+use super::view::{FigureView, VerdictView};
 use super::{RenderError, rich};
-use crate::format::{count, fixed, percent, sig};
-use crate::likelihood::{Key, KeyEstimate, NoiseEstimate};
-use crate::plot::{self, ProfileSeries, RatioSeries};
+use crate::format::{count, fixed, percent};
+use crate::likelihood::Key;
+use crate::plot::{self, RatioSeries};
 use crate::study::identify::{WhiteNoiseDrive, WhiteNoiseDrives};
 use crate::study::noise::{KeyCoverage, NOISE_FALSE_ALARM_RATE, NOISE_START_FACTOR, NoiseStudy};
 
 /// The drive of the study whose likelihood profile the section shows.
 pub const PROFILE_DRIVE: usize = 0;
-
-/// A key's symbol in the report's notation, `σ_{p}`.
-fn symbol(key: Key) -> String {
-    match key.symbol().split_once('_') {
-        Some((a, b)) => format!("{a}_{{{b}}}"),
-        None => key.symbol().to_string(),
-    }
-}
-
-/// A value of `key` with its unit, three significant digits.
-fn with_unit(x: f64, key: Key) -> String {
-    format!("{} {}", sig(x, 3), key.unit())
-}
-
-/// What a drive says of a statistic, in words: its value and interval when identifiable, else
-/// the one bound it gives (never the bare value).
-pub fn estimate_words(k: &KeyEstimate) -> String {
-    match (k.identifiable, k.lower > 0.0, k.upper) {
-        (true, _, Some(u)) => format!(
-            "{} [{}, {}]",
-            with_unit(k.value, k.key),
-            sig(k.lower, 3),
-            with_unit(u, k.key)
-        ),
-        (_, false, Some(u)) => format!(
-            "not identifiable: only an upper bound, {} ≤ {}",
-            symbol(k.key),
-            with_unit(u, k.key)
-        ),
-        (_, true, None) => format!(
-            "not identifiable: only a lower bound, {} ≥ {}",
-            symbol(k.key),
-            with_unit(k.lower, k.key)
-        ),
-        _ => "not identifiable: the drive bounds it at neither end of the search".to_string(),
-    }
-}
-
-/// The interval as text, an open end written as 0 or ∞.
-fn interval_words(k: &KeyEstimate) -> String {
-    let lower = if k.lower > 0.0 {
-        sig(k.lower, 3)
-    } else {
-        "0".to_string()
-    };
-    let upper = k.upper.map_or_else(|| "∞".to_string(), |u| sig(u, 3));
-    format!("[{lower}, {upper}]")
-}
-
-/// The search's range as text.
-fn search_words(k: &KeyEstimate) -> String {
-    format!(
-        "[{}, {}]",
-        sig(k.search_bounds[0], 2),
-        sig(k.search_bounds[1], 2)
-    )
-}
-
-/// The profile figure's series of `e`, with the truth of each key when known.
-pub fn profile_series(e: &NoiseEstimate, truth: Option<&[f64]>) -> Vec<ProfileSeries> {
-    e.keys
-        .iter()
-        .enumerate()
-        .map(|(j, k)| ProfileSeries {
-            title: format!("{}, {}: profile likelihood", symbol(k.key), k.key.name()),
-            axis: format!("{} ({})", symbol(k.key), k.key.unit()),
-            points: k.profile.clone(),
-            value: k.value,
-            lower: (k.lower > 0.0).then_some(k.lower),
-            upper: k.upper,
-            bounds: (k.search_bounds[0], k.search_bounds[1]),
-            truth: truth.and_then(|t| t.get(j).copied()),
-        })
-        .collect()
-}
 
 /// One row of the coverage table.
 #[derive(Clone, Debug, Serialize)]
@@ -222,7 +148,7 @@ pub struct WhiteNoiseRow {
     pub interval: String,
     /// The search's range.
     pub search: String,
-    /// Pass when identifiable, else fail.
+    /// Pass when identifiable, else untestable (its word is the CSS class).
     pub identifiable: VerdictView,
     /// "identifiable" or "not identifiable".
     pub identifiable_words: String,
@@ -241,7 +167,7 @@ fn white_noise_row(name: &str, d: &WhiteNoiseDrive) -> WhiteNoiseRow {
         identifiable: if w.identifiable {
             VerdictView::Pass
         } else {
-            VerdictView::Fail
+            VerdictView::Untestable
         },
         identifiable_words: if w.identifiable {
             "identifiable".to_string()
@@ -255,7 +181,7 @@ fn white_noise_row(name: &str, d: &WhiteNoiseDrive) -> WhiteNoiseRow {
 fn white_noise_sentence(name: &str, d: &WhiteNoiseDrive) -> String {
     let w = d.w();
     let drive = format!(
-        "On {name} (W = {}, {} Hz GPS, {} s)",
+        "On {name} (W = {}, {} Hz GPS, {} s),",
         with_unit(d.truth_w_m2_s4, Key::AccelNoiseVar),
         fixed(d.gps_rate_hz, 0),
         fixed(d.duration_s, 0)
@@ -372,11 +298,14 @@ pub fn view(
         numbers.figure(Figure::NoiseProfile),
         "The likelihood profile of one drive",
         &format!(
-            "For drive {PROFILE_DRIVE} of the study, −2Δℓ against each statistic's value, every point the maximum of ℓ over the other statistics. The interval is where the profile lies below the χ²₁ quantile {} ({} confidence); an end that reaches the search's bound is open. Green: the truth.",
+            "For drive {PROFILE_DRIVE} of the study, −2Δℓ against each statistic's value, every point the maximum of ℓ over the other statistics: the points the interval's search evaluated (dots), joined by straight lines. The interval is where the profile lies below the χ²₁ quantile {} ({} confidence); an end that reaches the search's bound is open. Green: the truth.",
             fixed(drive.deviance_threshold, 2),
             percent(drive.confidence)
         ),
-        plot::likelihood_profile(&profile_series(drive, Some(&truths)), drive.deviance_threshold),
+        plot::likelihood_profile(
+            &profile_series(drive, Some(&truths)),
+            drive.deviance_threshold,
+        ),
     )?;
     let truth_html = rich::rich(
         &n.coverage
@@ -410,80 +339,126 @@ pub fn view(
     })
 }
 
-/// One estimated statistic on the calibration page.
-#[derive(Clone, Debug, Serialize)]
-pub struct EstimateRow {
-    /// The statistic's symbol, as HTML.
-    pub symbol_html: String,
-    /// Its `[filter]` key.
-    pub key: String,
-    /// The estimate with its interval, or the one bound a non-identifiable statistic has.
-    pub estimate_html: String,
-    /// The interval, an open end written 0 or ∞.
-    pub interval: String,
-    /// The search's range.
-    pub search: String,
-    /// Whether the drive determines it.
-    pub identifiable: bool,
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+    use crate::format::sig;
+    use crate::study::identify;
 
-/// The calibration page's part: the estimates, their intervals and profiles.
-#[derive(Clone, Debug, Serialize, Template)]
-#[template(path = "noise_estimate.html")]
-pub struct EstimateView {
-    /// The intervals' confidence.
-    pub confidence: String,
-    /// ℓ at the maximum.
-    pub log_likelihood: String,
-    /// Evaluations of ℓ.
-    pub evaluations: String,
-    /// One row per statistic.
-    pub rows: Vec<EstimateRow>,
-    /// The profiles.
-    pub profile: FigureView,
-}
+    /// The two drives of the default configuration, run once.
+    fn drives() -> &'static WhiteNoiseDrives {
+        static D: std::sync::OnceLock<WhiteNoiseDrives> = std::sync::OnceLock::new();
+        D.get_or_init(|| {
+            identify::run(&Config::default())
+                .unwrap()
+                .expect("both drives can be made")
+        })
+    }
 
-/// The calibration page's view of `e`, its profile figure numbered `figure_number`.
-///
-/// # Errors
-/// [`RenderError`] when the figure cannot be drawn.
-pub fn estimate_view(e: &NoiseEstimate, figure_number: usize) -> Result<EstimateView, RenderError> {
-    let profile = figure(
-        "fig-noise-profile",
-        figure_number,
-        "Likelihood profile of each estimated statistic",
-        &format!(
-            "−2Δℓ of the GPS innovations against each statistic's value, every point the maximum over the other statistics. The interval is where the profile lies below the χ²₁ quantile {} ({} confidence); an end that reaches the search's bound is open, and the statistic is then not identifiable from this drive.",
-            fixed(e.deviance_threshold, 2),
-            percent(e.confidence)
-        ),
-        plot::likelihood_profile(&profile_series(e, None), e.deviance_threshold),
-    )?;
-    Ok(EstimateView {
-        confidence: percent(e.confidence),
-        log_likelihood: fixed(e.log_likelihood, 3),
-        evaluations: count(e.evaluations),
-        rows: e
-            .keys
-            .iter()
-            .map(|k| EstimateRow {
-                symbol_html: rich::rich(&symbol(k.key)),
-                key: k.key.name().to_string(),
-                estimate_html: rich::rich(&estimate_words(k)),
-                interval: interval_words(k),
-                search: search_words(k),
-                identifiable: k.identifiable,
-            })
-            .collect(),
-        profile,
-    })
-}
+    fn coverage(covered: u64, half: u64) -> KeyCoverage {
+        KeyCoverage {
+            key: Key::GpsVelocity,
+            truth: 0.04,
+            identifiable: 200,
+            covered,
+            band: (181, 197),
+            half_width_covered: half,
+            median_ratio: 1.0,
+        }
+    }
 
-/// The calibration page's part for `e` as HTML: a table of the estimates and the profile
-/// figure (numbered `figure_number`), with the report's CSS classes.
-///
-/// # Errors
-/// [`RenderError`] when the figure cannot be drawn or the template filled.
-pub fn estimate_html(e: &NoiseEstimate, figure_number: usize) -> Result<String, RenderError> {
-    Ok(estimate_view(e, figure_number)?.render()?)
+    fn study(c: KeyCoverage) -> NoiseStudy {
+        NoiseStudy {
+            drives: 200,
+            duration_s: 120.0,
+            config: Config::default(),
+            estimates: Vec::new(),
+            coverage: vec![c],
+        }
+    }
+
+    #[test]
+    fn the_coverage_sentence_follows_the_counts() {
+        let good = coverage_words(&study(coverage(190, 130)));
+        assert!(good.contains("as often as their confidence says"), "{good}");
+        assert!(
+            good.contains("the test sees an interval of the wrong width"),
+            "{good}"
+        );
+        assert!(!good.contains("too rarely"), "{good}");
+        let low = coverage_words(&study(coverage(170, 130)));
+        assert!(
+            low.contains("cover the truth too rarely: 170 of 200"),
+            "{low}"
+        );
+        assert!(!low.contains("as often as"), "{low}");
+        let high = coverage_words(&study(coverage(199, 130)));
+        assert!(high.contains("too often"), "{high}");
+        // The negative control inside the band: the test could not see a wrong width.
+        let blind = coverage_words(&study(coverage(190, 185)));
+        assert!(blind.contains("cannot tell a wrong width"), "{blind}");
+        assert!(!blind.contains("sees an interval"), "{blind}");
+        let mut few = coverage(150, 100);
+        few.identifiable = 160;
+        let few = coverage_words(&study(few));
+        assert!(
+            few.contains("identifiable on 160 of 200 drives only"),
+            "{few}"
+        );
+    }
+
+    #[test]
+    fn the_white_noise_sentence_is_the_estimator_s_verdict() {
+        let d = drives();
+        // Measured: the default drive gives W only an upper bound, the vibrating car a value.
+        assert!(!d.quiet.w().identifiable && d.vibrating.w().identifiable);
+        let words = white_noise_words(d);
+        let upper = sig(d.quiet.w().upper.unwrap(), 3);
+        assert!(
+            words.contains(&format!(
+                "not identifiable: only an upper bound, W ≤ {upper}"
+            )),
+            "{words}"
+        );
+        assert!(words.contains("W is identified: "), "{words}");
+        assert!(words.contains("depends on the drive"), "{words}");
+        // The same sentence with the verdicts swapped.
+        let swapped = WhiteNoiseDrives {
+            quiet: d.vibrating.clone(),
+            vibrating: d.quiet.clone(),
+        };
+        let words = white_noise_words(&swapped);
+        assert!(words.contains("the vibrating one does not"), "{words}");
+        // A value is never given bare for a statistic the drive does not determine.
+        let w = d.quiet.w();
+        assert!(!estimate_words(w).contains(&sig(w.value, 3)));
+        let mut lower_only = w.clone();
+        (lower_only.lower, lower_only.upper) = (1e-4, None);
+        let words = estimate_words(&lower_only);
+        assert!(
+            words.contains(&format!("only a lower bound, W ≥ {}", sig(1e-4, 3))),
+            "{words}"
+        );
+    }
+
+    #[test]
+    fn the_calibration_part_shows_bounds_for_what_is_not_identifiable() {
+        let d = drives();
+        let html = estimate_html(&d.quiet.estimate, 5).unwrap();
+        let table = &html[..html.find("<figure").expect("the profile figure")];
+        let w = d.quiet.w();
+        assert!(
+            table.contains("not identifiable: only an upper bound"),
+            "{table}"
+        );
+        assert!(!table.contains(&sig(w.value, 3)), "{table}");
+        assert!(table.contains(&format!("[0, {}]", sig(w.upper.unwrap(), 3))));
+        // The identifiable σ's show their values and intervals.
+        let p = &d.quiet.estimate.keys[0];
+        assert!(p.identifiable);
+        assert!(table.contains(&estimate_words(p)), "{table}");
+        assert!(html.contains("Figure 5."));
+        assert_eq!(html.matches("<svg").count(), 1);
+    }
 }

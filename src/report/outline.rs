@@ -276,7 +276,8 @@ impl Outline {
             .iter()
             .position(|n| n.section == Section::Conclusions)
             .unwrap_or(self.nodes.len());
-        self.nodes.insert(at, Node::leaf(Section::Noise(white_noise)));
+        self.nodes
+            .insert(at, Node::leaf(Section::Noise(white_noise)));
         self
     }
 
