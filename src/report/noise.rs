@@ -19,8 +19,6 @@ use crate::plot::{self, RatioSeries};
 use crate::study::identify::{WhiteNoiseDrive, WhiteNoiseDrives};
 use crate::study::noise::{KeyCoverage, NOISE_FALSE_ALARM_RATE, NOISE_START_FACTOR, NoiseStudy};
 
-/// The drive of the study whose likelihood profile the section shows.
-pub const PROFILE_DRIVE: usize = 0;
 
 /// One row of the coverage table.
 #[derive(Clone, Debug, Serialize)]
@@ -292,13 +290,14 @@ pub fn view(
     numbers: &Numbers,
 ) -> Result<NoiseView, RenderError> {
     let truths: Vec<f64> = n.coverage.iter().map(|c| c.truth).collect();
-    let drive = &n.estimates[PROFILE_DRIVE.min(n.estimates.len() - 1)];
+    // The study keeps a section only when some drive was calibrated (`Study::with_noise`).
+    let drive = &n.estimates[0];
     let profile = figure(
         "fig-noise-profile",
         numbers.figure(Figure::NoiseProfile),
         "The likelihood profile of one drive",
         &format!(
-            "For drive {PROFILE_DRIVE} of the study, −2Δℓ against each statistic's value, every point the maximum of ℓ over the other statistics: the points the interval's search evaluated (dots), joined by straight lines. The interval is where the profile lies below the χ²₁ quantile {} ({} confidence); an end that reaches the search's bound is open. Green: the truth.",
+            "For the first drive of the study, −2Δℓ against each statistic's value, every point the maximum of ℓ over the other statistics: the points the interval's search evaluated (dots), joined by straight lines. The interval is where the profile lies below the χ²₁ quantile {} ({} confidence); an end that reaches the search's bound is open. Green: the truth.",
             fixed(drive.deviance_threshold, 2),
             percent(drive.confidence)
         ),
