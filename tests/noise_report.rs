@@ -1,12 +1,18 @@
 //! The report's section "Noise statistics from a drive": it follows the drifting bias, shows the
-//! study's counts and verdicts, and numbers its tables and figures with the rest of the page.
+//! study's counts and verdicts, and numbers its tables and figures with the rest of the page; its
+//! sentences follow the numbers; the calibration page's part gives a bound, never a bare value,
+//! for a statistic the drive does not determine.
 
 use accelcal::config::Config;
-use accelcal::format::count;
+use accelcal::format::{count, sig};
+use accelcal::likelihood::Key;
 use accelcal::model::Model;
+use accelcal::report::noise::{coverage_words, estimate_html, estimate_words, white_noise_words};
 use accelcal::report::outline::{Outline, Section};
 use accelcal::report::page::SectionView;
 use accelcal::report::{self, ReportInput};
+use accelcal::study::identify::{self, WhiteNoiseDrives};
+use accelcal::study::noise::{KeyCoverage, NoiseStudy};
 use accelcal::study::{Silent, Study};
 
 /// Drives of the small study: enough for every row, few enough to be quick.
@@ -124,4 +130,120 @@ fn the_section_comes_after_the_drifting_bias() {
     let drift = sections.iter().position(|s| *s == Section::Drift).unwrap();
     assert_eq!(sections[drift + 1], Section::Noise(true));
     assert_eq!(sections[drift + 2], Section::Conclusions);
+}
+
+/// The two drives of the default configuration, run once.
+fn drives() -> &'static WhiteNoiseDrives {
+    static D: std::sync::OnceLock<WhiteNoiseDrives> = std::sync::OnceLock::new();
+    D.get_or_init(|| {
+        identify::run(&Config::default())
+            .unwrap()
+            .expect("both drives can be made")
+    })
+}
+
+fn coverage(covered: u64, half: u64) -> KeyCoverage {
+    KeyCoverage {
+        key: Key::GpsVelocity,
+        truth: 0.04,
+        identifiable: 200,
+        covered,
+        band: (181, 197),
+        half_width_covered: half,
+        median_ratio: 1.0,
+    }
+}
+
+fn noise_study(c: KeyCoverage) -> NoiseStudy {
+    NoiseStudy {
+        drives: 200,
+        duration_s: 120.0,
+        config: Config::default(),
+        estimates: Vec::new(),
+        coverage: vec![c],
+    }
+}
+
+#[test]
+fn the_coverage_sentence_follows_the_counts() {
+    let good = coverage_words(&noise_study(coverage(190, 130)));
+    assert!(good.contains("as often as their confidence says"), "{good}");
+    assert!(
+        good.contains("the test sees an interval of the wrong width"),
+        "{good}"
+    );
+    assert!(!good.contains("too rarely"), "{good}");
+    let low = coverage_words(&noise_study(coverage(170, 130)));
+    assert!(
+        low.contains("cover the truth too rarely: 170 of 200"),
+        "{low}"
+    );
+    assert!(!low.contains("as often as"), "{low}");
+    let high = coverage_words(&noise_study(coverage(199, 130)));
+    assert!(high.contains("too often"), "{high}");
+    // The negative control inside the band: the test could not see a wrong width.
+    let blind = coverage_words(&noise_study(coverage(190, 185)));
+    assert!(blind.contains("cannot tell a wrong width"), "{blind}");
+    assert!(!blind.contains("sees an interval"), "{blind}");
+    let mut few = coverage(150, 100);
+    few.identifiable = 160;
+    let few = coverage_words(&noise_study(few));
+    assert!(
+        few.contains("identifiable on 160 of 200 drives only"),
+        "{few}"
+    );
+}
+
+#[test]
+fn the_white_noise_sentence_is_the_estimator_s_verdict() {
+    let d = drives();
+    // Measured: the default drive gives W only an upper bound, the vibrating car a value.
+    assert!(!d.quiet.w().identifiable && d.vibrating.w().identifiable);
+    let words = white_noise_words(d);
+    let upper = sig(d.quiet.w().upper.unwrap(), 3);
+    assert!(
+        words.contains(&format!(
+            "not identifiable: only an upper bound, W ≤ {upper}"
+        )),
+        "{words}"
+    );
+    assert!(words.contains("W is identified: "), "{words}");
+    assert!(words.contains("depends on the drive"), "{words}");
+    // The same sentence with the verdicts swapped.
+    let swapped = WhiteNoiseDrives {
+        quiet: d.vibrating.clone(),
+        vibrating: d.quiet.clone(),
+    };
+    let words = white_noise_words(&swapped);
+    assert!(words.contains("the vibrating one does not"), "{words}");
+    // A value is never given bare for a statistic the drive does not determine.
+    let w = d.quiet.w();
+    assert!(!estimate_words(w).contains(&sig(w.value, 3)));
+    let mut lower_only = w.clone();
+    (lower_only.lower, lower_only.upper) = (1e-4, None);
+    let words = estimate_words(&lower_only);
+    assert!(
+        words.contains(&format!("only a lower bound, W ≥ {}", sig(1e-4, 3))),
+        "{words}"
+    );
+}
+
+#[test]
+fn the_calibration_part_shows_bounds_for_what_is_not_identifiable() {
+    let d = drives();
+    let html = estimate_html(&d.quiet.estimate, 5).unwrap();
+    let table = &html[..html.find("<figure").expect("the profile figure")];
+    let w = d.quiet.w();
+    assert!(
+        table.contains("not identifiable: only an upper bound"),
+        "{table}"
+    );
+    assert!(!table.contains(&sig(w.value, 3)), "{table}");
+    assert!(table.contains(&format!("[0, {}]", sig(w.upper.unwrap(), 3))));
+    // The identifiable σ's show their values and intervals.
+    let p = &d.quiet.estimate.keys[0];
+    assert!(p.identifiable);
+    assert!(table.contains(&estimate_words(p)), "{table}");
+    assert!(html.contains("Figure 5."));
+    assert_eq!(html.matches("<svg").count(), 1);
 }
