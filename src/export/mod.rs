@@ -3,6 +3,7 @@
 //! is an edge of the library: the typed verdicts become the stable field names of the data
 //! contract.
 
+pub mod noise;
 pub mod sensitivity;
 
 use serde::Serialize;
@@ -357,6 +358,9 @@ struct ReportData<'a> {
     /// The drifting-bias study, when the study ran it.
     #[serde(skip_serializing_if = "Option::is_none")]
     drifting_bias: Option<DriftRecord<'a>>,
+    /// Noise statistics estimated from simulated drives, when the study ran them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    noise_statistics: Option<noise::NoiseRecord<'a>>,
 }
 
 /// One filter of the drifting-bias study.
@@ -429,6 +433,8 @@ pub fn report_data_json(study: &Study) -> String {
         ensembles,
         sensitivity: study.sensitivity.as_ref().map(sensitivity::record),
         drifting_bias: study.drift.as_ref().map(drift_record),
+        noise_statistics: (study.noise.as_ref())
+            .map(|n| noise::record(n, study.white_noise.as_ref())),
     };
     // Indented for the default run, compact for long ones (a third of the size).
     if study.model.timeline.fixes() <= crate::model::ALL_PAIRS_MAX_FIXES {

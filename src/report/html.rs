@@ -90,6 +90,12 @@ struct RealDriveHtml<'a> {
 }
 
 #[derive(Template)]
+#[template(path = "sections/noise.html")]
+struct NoiseHtml<'a> {
+    n: &'a super::noise::NoiseView,
+}
+
+#[derive(Template)]
 #[template(path = "sections/conclusions.html")]
 struct ConclusionsHtml<'a> {
     v: &'a ConclusionsView,
@@ -124,6 +130,7 @@ pub fn section(node: &SectionNode, eq: &Equations) -> Result<String, askama::Err
         SectionView::StaticNoise(a) => StaticNoiseHtml { a }.render(),
         SectionView::Drift(d) => DriftHtml { d }.render(),
         SectionView::RealDrive(d) => RealDriveHtml { d }.render(),
+        SectionView::Noise(n) => NoiseHtml { n }.render(),
         SectionView::Conclusions(v) => ConclusionsHtml { v }.render(),
         SectionView::Appendix(v) => AppendixHtml { v }.render(),
     }?;

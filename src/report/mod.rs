@@ -10,12 +10,15 @@
 
 pub mod calibration;
 pub mod calibration_diagnosis;
+mod calibration_figures;
 pub mod cases;
 pub mod drift;
 pub mod equations;
+pub mod estimate;
 pub mod figures;
 pub mod html;
 pub mod math;
+pub mod noise;
 pub mod outline;
 pub mod page;
 pub mod params;
@@ -141,8 +144,8 @@ pub fn build(
 }
 
 /// The outline of the report of `input`: every case, the sensitivity section when the study ran
-/// it, the static-noise section when its coverage is given, the drifting-bias section when the
-/// study ran it.
+/// it, the static-noise section when its coverage is given, the drifting-bias section and the
+/// section on noise statistics from a drive and the real drive's when the study ran them.
 pub fn outline_of(input: &ReportInput) -> Outline {
     let outline = Outline::standard(
         input.study.cases.len(),
@@ -151,6 +154,11 @@ pub fn outline_of(input: &ReportInput) -> Outline {
     );
     let outline = if input.study.drift.is_some() {
         outline.with_drift()
+    } else {
+        outline
+    };
+    let outline = if input.study.noise.is_some() {
+        outline.with_noise(input.study.white_noise.is_some())
     } else {
         outline
     };

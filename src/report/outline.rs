@@ -36,6 +36,9 @@ pub enum Section {
     Drift,
     /// The shipped real drive calibrated with noise statistics estimated from it.
     RealDrive,
+    /// Noise statistics from a drive: simulated drives through `--estimate-noise`; with the
+    /// white noise's identifiability on two drives when `true`.
+    Noise(bool),
     /// Conclusions.
     Conclusions,
     /// Configuration and reproduction.
@@ -70,6 +73,10 @@ pub enum Table {
     Drift,
     /// The real drive's calibrations.
     RealDrive,
+    /// The coverage of the noise estimate's intervals over simulated drives.
+    NoiseCoverage,
+    /// The white noise's identifiability on two drives.
+    WhiteNoise,
 }
 
 /// A numbered figure.
@@ -95,6 +102,10 @@ pub enum Figure {
     RealDriveGravityCompensated,
     /// The real drive's bias, raw axis with a random walk.
     RealDriveRaw,
+    /// The noise estimates of simulated drives against the truth.
+    NoiseEstimates,
+    /// The likelihood profile of one drive.
+    NoiseProfile,
 }
 
 /// A numbered display equation.
@@ -188,6 +199,17 @@ impl Section {
                 F(Figure::RealDriveGravityCompensated),
                 F(Figure::RealDriveRaw),
             ],
+            Section::Noise(white_noise) => {
+                let mut labels = vec![
+                    T(Table::NoiseCoverage),
+                    F(Figure::NoiseEstimates),
+                    F(Figure::NoiseProfile),
+                ];
+                if white_noise {
+                    labels.push(T(Table::WhiteNoise));
+                }
+                labels
+            }
         }
     }
 }
@@ -266,6 +288,20 @@ impl Outline {
             .position(|n| n.section == Section::Conclusions)
             .unwrap_or(self.nodes.len());
         self.nodes.insert(at, Node::leaf(Section::RealDrive));
+        self
+    }
+
+    /// The same outline with the section on noise statistics from a drive before the
+    /// conclusions (after the drifting bias), with the white noise's identifiability when
+    /// `white_noise`.
+    pub fn with_noise(mut self, white_noise: bool) -> Self {
+        let at = self
+            .nodes
+            .iter()
+            .position(|n| n.section == Section::Conclusions)
+            .unwrap_or(self.nodes.len());
+        self.nodes
+            .insert(at, Node::leaf(Section::Noise(white_noise)));
         self
     }
 

@@ -190,6 +190,8 @@ pub enum SectionView {
     Drift(Box<super::drift::DriftView>),
     /// A real drive.
     RealDrive(Box<super::real_drive::RealDriveView>),
+    /// Noise statistics from a drive.
+    Noise(Box<super::noise::NoiseView>),
     /// Conclusions.
     Conclusions(ConclusionsView),
     /// Configuration and reproduction.
@@ -211,6 +213,7 @@ impl SectionView {
             SectionView::StaticNoise(_) => "allan".to_string(),
             SectionView::Drift(_) => "drifting-bias".to_string(),
             SectionView::RealDrive(_) => "real-drive".to_string(),
+            SectionView::Noise(_) => "noise-estimate".to_string(),
             SectionView::Conclusions(_) => "conclusions".to_string(),
             SectionView::Appendix(_) => "appendix".to_string(),
         }
@@ -230,6 +233,7 @@ impl SectionView {
             SectionView::StaticNoise(_) => "Noise statistics from a static log".to_string(),
             SectionView::Drift(_) => "A drifting bias".to_string(),
             SectionView::RealDrive(_) => "A real drive".to_string(),
+            SectionView::Noise(_) => "Noise statistics from a drive".to_string(),
             SectionView::Conclusions(_) => "Conclusions".to_string(),
             SectionView::Appendix(_) => "Appendix: configuration and reproduction".to_string(),
         }

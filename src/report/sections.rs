@@ -104,6 +104,14 @@ impl Context<'_> {
                     .expect("the outline shows the real drive only when the study ran it"),
                 self.numbers,
             )?)),
+            Section::Noise(_) => SectionView::Noise(Box::new(super::noise::view(
+                study
+                    .noise
+                    .as_ref()
+                    .expect("the outline shows the noise estimate only when the study ran it"),
+                study.white_noise.as_ref(),
+                self.numbers,
+            )?)),
             Section::Conclusions => SectionView::Conclusions(self.conclusions()),
             Section::Appendix => SectionView::Appendix(AppendixView {
                 command: self.input.command.to_string(),

@@ -8,6 +8,7 @@
 pub mod analysis;
 pub mod drift;
 pub mod drive;
+pub mod identify;
 pub mod noise;
 
 use crate::checks::{self, Budget, Verdicts};
@@ -98,6 +99,11 @@ pub struct Study {
     pub drift: Option<drift::DriftStudy>,
     /// The real drive's calibrations, when they were run ([`Study::with_real_drive`]).
     pub real_drive: Option<Vec<drive::DriveRun>>,
+    /// Noise statistics estimated from simulated drives, when they were run
+    /// ([`Study::with_noise`]).
+    pub noise: Option<noise::NoiseStudy>,
+    /// The white noise's identifiability on two drives, run with [`Study::with_noise`].
+    pub white_noise: Option<identify::WhiteNoiseDrives>,
 }
 
 impl Study {
@@ -143,6 +149,8 @@ impl Study {
             sensitivity: None,
             drift: None,
             real_drive: None,
+            noise: None,
+            white_noise: None,
         })
     }
 
@@ -175,6 +183,24 @@ impl Study {
     /// [`crate::calibrate::CalibrateError`] only if the shipped files did not calibrate.
     pub fn with_real_drive(mut self) -> Result<Self, crate::calibrate::CalibrateError> {
         self.real_drive = Some(drive::run()?);
+        Ok(self)
+    }
+
+    /// The study with its noise statistics from simulated drives ([`noise::run`], `drives`
+    /// drives of the configuration's rates and statistics) and the white noise's
+    /// identifiability on two drives ([`identify::run`]).
+    ///
+    /// # Errors
+    /// [`FilterError`] when a filter's covariance is not positive definite.
+    pub fn with_noise(
+        mut self,
+        drives: u64,
+        progress: &mut dyn Progress,
+    ) -> Result<Self, FilterError> {
+        let study = noise::run(&self.model.config, drives, progress)?;
+        // A study in which no drive could be calibrated has nothing to show.
+        self.noise = (!study.estimates.is_empty()).then_some(study);
+        self.white_noise = identify::run(&self.model.config)?;
         Ok(self)
     }
 
