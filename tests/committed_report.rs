@@ -47,6 +47,8 @@ fn default_study() -> &'static Study {
             .unwrap()
             .with_noise(accelcal::study::noise::NOISE_DRIVES, &mut Silent)
             .unwrap()
+            .with_real_drive()
+            .unwrap()
     })
 }
 

@@ -112,6 +112,26 @@ pub fn interval_end(
         // Out of points: the closest bracketing point stands for the end.
         end.at = above.map(|(d, _)| u0 + side * d);
     }
+    // A few more points for the profile's figure: inside the interval and just beyond its end
+    // (towards the bound when the end is open), where the search left gaps.
+    let span = end.at.map_or(room, |t| (t - u0).abs());
+    for fraction in [0.4, 0.75, 1.3] {
+        let d = fraction * span;
+        let near = |p: &ProfilePoint| ((p.u - u0).abs() - d).abs() < 0.1 * span;
+        if d > room || end.points.iter().any(near) {
+            continue;
+        }
+        let t = u0 + side * d;
+        let start: Vec<f64> = best
+            .u
+            .iter()
+            .zip(&ridge)
+            .map(|(w, r)| w + (t - u0) * r)
+            .collect();
+        let m = profile_at(&objective, free, j, t, &start);
+        let deviance = (2.0 * (best.value - m.value)).max(0.0);
+        end.points.push(ProfilePoint { u: t, deviance });
+    }
     end.evaluations = objective.evaluations();
     end
 }
