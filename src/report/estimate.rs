@@ -132,7 +132,7 @@ pub fn estimate_view(e: &NoiseEstimate, figure_number: usize) -> Result<Estimate
         figure_number,
         "Likelihood profile of each estimated statistic",
         &format!(
-            "−2Δℓ of the GPS innovations against each statistic's value, every point the maximum over the other statistics: the points the interval's search evaluated (dots), joined by straight lines. The interval is where the profile lies below the χ²₁ quantile {} ({} confidence); an end that reaches the search's bound is open, and the statistic is then not identifiable from this drive.",
+            "−2Δℓ of the GPS innovations against each statistic's value, every point the maximum over the other statistics: the points the interval's search evaluated and three more on each side, inside the interval and beyond its end (dots), joined by straight lines. The interval is where the profile lies below the χ²₁ quantile {} ({} confidence); an end that reaches the search's bound is open, and the statistic is then not identifiable from this drive.",
             fixed(e.deviance_threshold, 2),
             percent(e.confidence)
         ),

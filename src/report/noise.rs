@@ -296,7 +296,7 @@ pub fn view(
         numbers.figure(Figure::NoiseProfile),
         "The likelihood profile of one drive",
         &format!(
-            "For the first drive of the study, −2Δℓ against each statistic's value, every point the maximum of ℓ over the other statistics: the points the interval's search evaluated (dots), joined by straight lines. The interval is where the profile lies below the χ²₁ quantile {} ({} confidence); an end that reaches the search's bound is open. Green: the truth.",
+            "For the first drive of the study, −2Δℓ against each statistic's value, every point the maximum of ℓ over the other statistics: the points the interval's search evaluated and three more on each side, inside the interval and beyond its end (dots), joined by straight lines. The interval is where the profile lies below the χ²₁ quantile {} ({} confidence); an end that reaches the search's bound is open. Green: the truth.",
             fixed(drive.deviance_threshold, 2),
             percent(drive.confidence)
         ),
