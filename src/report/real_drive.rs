@@ -19,8 +19,10 @@ pub struct DriveRow {
     pub run: String,
     /// The statistics estimated, each with its interval or what the drive leaves open.
     pub estimates: Vec<String>,
-    /// The bias at the end ± σ, m/s², and its 95 % interval.
+    /// The bias at the end ± σ, m/s².
     pub bias: String,
+    /// Its 95 % interval.
+    pub bias_interval: String,
     /// The smoothed bias at the start ± σ.
     pub bias_start: String,
     /// The NIS sum against its band.
@@ -28,7 +30,7 @@ pub struct DriveRow {
     /// `pass` or `fail`.
     pub verdict: String,
     /// The innovations' whiteness per measurement, in words.
-    pub whiteness: String,
+    pub whiteness: Vec<String>,
 }
 
 /// The section's view.
@@ -87,10 +89,9 @@ fn row(r: &DriveRun) -> DriveRow {
     DriveRow {
         run: run_words(r),
         estimates: r.noise.keys.iter().map(estimate_words).collect(),
-        bias: format!(
-            "{} ± {} [{}, {}]",
-            sig(b.0, 3),
-            sig(b.1, 2),
+        bias: format!("{} ± {}", sig(b.0, 3), sig(b.1, 2)),
+        bias_interval: format!(
+            "[{}, {}]",
             sig(b.0 - 1.96 * b.1, 3),
             sig(b.0 + 1.96 * b.1, 3)
         ),
@@ -111,8 +112,7 @@ fn row(r: &DriveRun) -> DriveRow {
             .measurements
             .iter()
             .map(|m| format!("{}: {}", m.measurement, m.whiteness.verdict))
-            .collect::<Vec<_>>()
-            .join("; "),
+            .collect(),
     }
 }
 
