@@ -1,6 +1,6 @@
 //! Diagnosis of a calibration: what the innovations, the NIS of every fix and the bias's path
 //! say beyond the NIS verdict, as numbers (`summary.json`'s `diagnostics`) and as sentences the
-//! numbers choose ([`sentences`]).
+//! numbers choose (`sentences`).
 //!
 //! For a consistent filter the innovations r_i = δz_i − H·δx̂⁻_i are independent N(0, S_i)
 //! (the innovation property of the Kalman filter), so each measured component normalized by its
