@@ -270,38 +270,30 @@ impl Outline {
     }
 
     /// The same outline with the drifting-bias section before the conclusions.
-    pub fn with_drift(mut self) -> Self {
-        let at = self
-            .nodes
-            .iter()
-            .position(|n| n.section == Section::Conclusions)
-            .unwrap_or(self.nodes.len());
-        self.nodes.insert(at, Node::leaf(Section::Drift));
-        self
+    pub fn with_drift(self) -> Self {
+        self.before_conclusions(Section::Drift)
     }
 
     /// The same outline with the real drive's section before the conclusions.
-    pub fn with_real_drive(mut self) -> Self {
-        let at = self
-            .nodes
-            .iter()
-            .position(|n| n.section == Section::Conclusions)
-            .unwrap_or(self.nodes.len());
-        self.nodes.insert(at, Node::leaf(Section::RealDrive));
-        self
+    pub fn with_real_drive(self) -> Self {
+        self.before_conclusions(Section::RealDrive)
     }
 
     /// The same outline with the section on noise statistics from a drive before the
     /// conclusions (after the drifting bias), with the white noise's identifiability when
     /// `white_noise`.
-    pub fn with_noise(mut self, white_noise: bool) -> Self {
+    pub fn with_noise(self, white_noise: bool) -> Self {
+        self.before_conclusions(Section::Noise(white_noise))
+    }
+
+    /// The same outline with `section` inserted before the conclusions (at the end without them).
+    fn before_conclusions(mut self, section: Section) -> Self {
         let at = self
             .nodes
             .iter()
             .position(|n| n.section == Section::Conclusions)
             .unwrap_or(self.nodes.len());
-        self.nodes
-            .insert(at, Node::leaf(Section::Noise(white_noise)));
+        self.nodes.insert(at, Node::leaf(section));
         self
     }
 
