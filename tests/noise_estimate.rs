@@ -31,7 +31,8 @@ fn intervals_cover_the_truth_over_many_drives_and_half_intervals_do_not() {
         NOISE_DRIVES,
         &mut accelcal::study::Silent,
     )
-    .expect("the default filter is positive definite");
+    .expect("the default filter is positive definite")
+    .expect("the default rates fit a 120 s drive");
     assert_eq!(
         study.estimates.len() as u64,
         NOISE_DRIVES,

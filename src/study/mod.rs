@@ -197,9 +197,9 @@ impl Study {
         drives: u64,
         progress: &mut dyn Progress,
     ) -> Result<Self, FilterError> {
-        let study = noise::run(&self.model.config, drives, progress)?;
         // A study in which no drive could be calibrated has nothing to show.
-        self.noise = (!study.estimates.is_empty()).then_some(study);
+        self.noise =
+            noise::run(&self.model.config, drives, progress)?.filter(|s| !s.estimates.is_empty());
         self.white_noise = identify::run(&self.model.config)?;
         Ok(self)
     }

@@ -141,6 +141,9 @@ pub fn run_drive(
 /// Runs the study: [`NOISE_DRIVES`] (or `drives`) drives of [`drive_config`]`(config)`, on all
 /// threads, the same numbers on any number of them.
 ///
+/// `None` when the configuration cannot run a drive of [`NOISE_DURATION_S`] (its rates do not
+/// fit that length), as the drifting-bias study does.
+///
 /// # Errors
 /// [`FilterError`] when the configuration's filter is not positive definite; a drive that
 /// cannot be calibrated counts as one whose statistics are not identifiable.
@@ -148,10 +151,11 @@ pub fn run(
     config: &Config,
     drives: u64,
     progress: &mut dyn Progress,
-) -> Result<NoiseStudy, FilterError> {
+) -> Result<Option<NoiseStudy>, FilterError> {
     let config = drive_config(config);
-    let model = Model::new(&config)
-        .map_err(|_| FilterError::InnovationNotPositiveDefinite { time_s: 0.0 })?;
+    let Ok(model) = Model::new(&config) else {
+        return Ok(None);
+    };
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
     let request = Request {
         keys: NOISE_KEYS.to_vec(),
@@ -171,13 +175,13 @@ pub fn run(
         .enumerate()
         .map(|(j, &key)| key_coverage(key, truth[j], &estimates, j))
         .collect();
-    Ok(NoiseStudy {
+    Ok(Some(NoiseStudy {
         drives,
         duration_s: NOISE_DURATION_S,
         config,
         estimates,
         coverage,
-    })
+    }))
 }
 
 /// The true values of [`NOISE_KEYS`] in the drives of `model`.
