@@ -268,6 +268,12 @@ pub fn prepare_with<'a>(
             time_s: scan.span_s.0,
         })?;
         settings.filter_stats = found.stats;
+        // A prior from the first fix takes the estimated GPS σ's.
+        let (p, v) = (
+            found.stats.gps_position_sigma_m,
+            found.stats.gps_velocity_sigma_m_s,
+        );
+        settings = settings.with_gps_sigmas(p, v);
         noise = Some(found);
     }
     let (model, (fixes, end)) = run(&settings.filter_stats)?;

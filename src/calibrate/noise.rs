@@ -97,11 +97,5 @@ pub fn estimate(
     (request, prior_from_first_fix, duration_s): (&Request, bool, f64),
 ) -> Option<NoiseEstimate> {
     let drive = drive(filtered, reduced, prior_from_first_fix);
-    let mut estimate = likelihood::estimate(&drive, stats, request, duration_s)?;
-    if prior_from_first_fix {
-        let s = &mut estimate.stats;
-        s.initial_position_sigma_m = s.gps_position_sigma_m;
-        s.initial_velocity_sigma_m_s = s.gps_velocity_sigma_m_s;
-    }
-    Some(estimate)
+    likelihood::estimate(&drive, stats, request, duration_s)
 }

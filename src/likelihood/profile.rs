@@ -30,16 +30,18 @@ pub struct End {
 }
 
 /// The profile of variable `j` at `u_j` = `t`: the maximum over the other variables of
-/// `free`, from `warm`.
+/// `free`, started on the ridge (du_o/du_j = `ridge`) through `warm`.
 fn profile_at(
     objective: &Objective<'_>,
-    free: &[usize],
-    j: usize,
+    (free, j, ridge): (&[usize], usize, &[f64]),
     t: f64,
     warm: &[f64],
 ) -> Maximum {
-    let mut u = warm.to_vec();
-    u[j] = t;
+    let u: Vec<f64> = warm
+        .iter()
+        .zip(ridge)
+        .map(|(w, r)| w + (t - warm[j]) * r)
+        .collect();
     let others: Vec<usize> = free.iter().copied().filter(|&i| i != j).collect();
     if others.is_empty() {
         let value = objective.value(&u);
@@ -85,12 +87,7 @@ pub fn interval_end(
     for _ in 0..MAX_POINTS {
         let t = u0 + side * delta;
         // The others start on the ridge of the quadratic model through the last point below.
-        let start: Vec<f64> = warm
-            .iter()
-            .zip(&ridge)
-            .map(|(w, r)| w + (t - warm[j]) * r)
-            .collect();
-        let m = profile_at(&objective, free, j, t, &start);
+        let m = profile_at(&objective, (free, j, &ridge), t, &warm);
         let deviance = (2.0 * (best.value - m.value)).max(0.0);
         end.points.push(ProfilePoint { u: t, deviance });
         if (deviance - q).abs() <= DEVIANCE_TOLERANCE {
@@ -122,13 +119,7 @@ pub fn interval_end(
             continue;
         }
         let t = u0 + side * d;
-        let start: Vec<f64> = best
-            .u
-            .iter()
-            .zip(&ridge)
-            .map(|(w, r)| w + (t - u0) * r)
-            .collect();
-        let m = profile_at(&objective, free, j, t, &start);
+        let m = profile_at(&objective, (free, j, &ridge), t, &best.u);
         let deviance = (2.0 * (best.value - m.value)).max(0.0);
         end.points.push(ProfilePoint { u: t, deviance });
     }

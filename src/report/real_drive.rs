@@ -17,7 +17,7 @@ use crate::study::drive::{Axis, DRIVE_DIR, DriveRun};
 pub struct DriveRow {
     /// The accelerometer log and the filter's bias model, in words.
     pub run: String,
-    /// The statistics estimated, each with its interval or what the drive leaves open.
+    /// The statistics estimated, each with its interval or what the drive leaves open, as HTML.
     pub estimates: Vec<String>,
     /// The bias at the end ± σ, m/s².
     pub bias: String,
@@ -51,24 +51,15 @@ pub struct RealDriveView {
     pub findings_html: Vec<String>,
 }
 
-/// An estimate in words: value and interval, or what the drive leaves open.
-pub fn estimate_words(k: &KeyEstimate) -> String {
-    let name = k.key.symbol();
-    let unit = k.key.unit();
-    if k.identifiable {
-        format!(
-            "{name} = {} [{}, {}] {unit}",
-            sig(k.value, 3),
-            sig(k.lower, 3),
-            sig(k.upper.unwrap_or(f64::NAN), 3)
-        )
+/// A statistic's estimate as HTML: named, with the shared words (its value and interval, or the
+/// one bound a drive that does not determine it gives).
+fn named_estimate(k: &KeyEstimate) -> String {
+    let words = super::estimate::estimate_words(k);
+    rich::rich(&if k.identifiable {
+        format!("{} = {words}", super::estimate::symbol(k.key))
     } else {
-        match (k.lower > 0.0, k.upper) {
-            (false, Some(u)) => format!("{name} not identifiable: ≤ {} {unit}", sig(u, 3)),
-            (true, None) => format!("{name} not identifiable: ≥ {} {unit}", sig(k.lower, 3)),
-            _ => format!("{name} not identifiable"),
-        }
-    }
+        words
+    })
 }
 
 fn run_words(r: &DriveRun) -> String {
@@ -78,7 +69,7 @@ fn run_words(r: &DriveRun) -> String {
     };
     format!(
         "{axis} axis, {} bias",
-        r.bias_model.name().replace('_', " ")
+        r.noise.stats.bias_model.name().replace('_', " ")
     )
 }
 
@@ -88,7 +79,7 @@ fn row(r: &DriveRun) -> DriveRow {
     let start = &s.start_smoothed;
     DriveRow {
         run: run_words(r),
-        estimates: r.noise.keys.iter().map(estimate_words).collect(),
+        estimates: r.noise.keys.iter().map(named_estimate).collect(),
         bias: format!("{} ± {}", sig(b.0, 3), sig(b.1, 2)),
         bias_interval: format!(
             "[{}, {}]",

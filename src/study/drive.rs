@@ -9,7 +9,6 @@ use crate::calibrate::{self, CalibrateError, Settings};
 use crate::config::Config;
 use crate::likelihood::{Key, NoiseEstimate, Request};
 use crate::logs::read::LogText;
-use crate::state::BiasModel;
 
 /// The shipped accelerometer log as recorded (gravity's component along the axis included).
 pub const ACCEL_RAW: &[u8] = include_bytes!("../../examples/comma2k19/accel_raw.csv");
@@ -51,13 +50,10 @@ impl Axis {
 pub struct DriveRun {
     /// The accelerometer log.
     pub axis: Axis,
-    /// The statistics estimated.
-    pub keys: Vec<Key>,
-    /// The filter's bias model.
-    pub bias_model: BiasModel,
     /// The calibration's summary and per-fix series.
     pub calibration: Calibration,
-    /// The estimate of the statistics.
+    /// The estimate of the statistics (with the filter's statistics, its bias model among
+    /// them).
     pub noise: NoiseEstimate,
 }
 
@@ -114,8 +110,6 @@ pub fn run_one(axis: Axis, keys: &[Key]) -> Result<DriveRun, CalibrateError> {
         .expect("an estimate was asked for");
     Ok(DriveRun {
         axis,
-        keys: keys.to_vec(),
-        bias_model: noise.stats.bias_model,
         calibration: prepared.calibration(),
         noise,
     })
