@@ -10,6 +10,7 @@
 //! many fixes fall outside the per-fix NIS band, and whether the filtered bias strays from the
 //! smoothed one by more than their covariances allow.
 
+mod bias;
 mod sentences;
 mod whiteness;
 
@@ -17,12 +18,13 @@ use serde::Serialize;
 use statrs::distribution::{Binomial, DiscreteCDF};
 
 use crate::state::{BiasModel, ErrorState, NoiseStats};
-use crate::stats::{chi_squared_band, normal_bound};
+use crate::stats::chi_squared_band;
 
 use super::forward::FilteredFix;
 use super::nis::NisTest;
 use super::smoother::SmoothedFix;
 
+pub use bias::bias_departure;
 pub use sentences::{findings, lag_runs};
 pub use whiteness::{
     FIXES_PER_LAG, MAX_LAGS, Whiteness, autocorrelation, lag_band, max_lag, whiteness,
@@ -32,10 +34,6 @@ pub use whiteness::{
 const M: usize = ErrorState::MEAS;
 /// At most this many fixes outside the per-fix NIS band are listed by time.
 pub const MAX_LISTED: usize = 100;
-/// A fix enters the bias steadiness test when the smoother has removed at least this fraction of
-/// its filtered variance: near the end of the log the difference of the two estimates and of
-/// their variances is rounding.
-const MIN_VARIANCE_GAIN: f64 = 1e-6;
 
 /// What the innovations of one measured component say.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -255,7 +253,7 @@ pub fn of(
         fix_rate_hz,
         measurements,
         nis_per_fix: nis_per_fix(series, false_alarm_rate),
-        bias: bias(series, bias_model, false_alarm_rate),
+        bias: bias::bias(series, bias_model, false_alarm_rate),
         findings: Vec::new(),
     };
     d.findings = findings(&d, nis);
@@ -367,64 +365,6 @@ pub fn binomial_bound(trials: u64, p: f64, rate: f64) -> u64 {
         return trials;
     };
     (0..trials).find(|&u| b.sf(u) <= rate).unwrap_or(trials)
-}
-
-/// d = (b̂ − b̂^s) / √(P_bb − P^s_bb) of a fix's `filtered` and `smoothed` (estimate, variance)
-/// of the bias ([`BiasDiagnostics`]); none where the smoother removed less than 10⁻⁶ of the
-/// filtered variance.
-pub fn bias_departure(filtered: [f64; 2], smoothed: [f64; 2]) -> Option<f64> {
-    let gain = filtered[1] - smoothed[1];
-    (gain > MIN_VARIANCE_GAIN * filtered[1]).then(|| (filtered[0] - smoothed[0]) / gain.sqrt())
-}
-
-/// The bias's path through `series` for a filter assuming `model`, tested at α.
-fn bias(series: &[FixSeries], model: BiasModel, alpha: f64) -> BiasDiagnostics {
-    // A constant bias's smoothed estimate is one number, the last fix's: the others differ from
-    // it by rounding alone, which is no range.
-    let path: Vec<f64> = match model {
-        BiasModel::Constant => series
-            .last()
-            .map(|f| f.bias_smoothed[0])
-            .into_iter()
-            .collect(),
-        _ => series.iter().map(|f| f.bias_smoothed[0]).collect(),
-    };
-    let lo = path.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = path.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let mut sigmas: Vec<f64> = series.iter().map(|f| f.bias_smoothed[1].sqrt()).collect();
-    sigmas.sort_by(f64::total_cmp);
-    let median_sigma = sigmas.get(sigmas.len() / 2).copied().unwrap_or(f64::NAN);
-    let departures: Vec<(f64, f64)> = series
-        .iter()
-        .filter_map(|f| Some((f.t_s, bias_departure(f.bias_filtered, f.bias_smoothed)?)))
-        .collect();
-    let (t_s, worst) = departures
-        .iter()
-        .fold((f64::NAN, 0.0f64), |(t, m), &(ti, d)| {
-            if d.abs() > m { (ti, d.abs()) } else { (t, m) }
-        });
-    let n_d = departures.len();
-    let bound = normal_bound(alpha / n_d.max(1) as f64);
-    let range = if series.is_empty() { 0.0 } else { hi - lo };
-    BiasDiagnostics {
-        bias_model: model.name(),
-        smoothed_min_m_s2: if series.is_empty() { 0.0 } else { lo },
-        smoothed_max_m_s2: if series.is_empty() { 0.0 } else { hi },
-        smoothed_range_sigmas: if median_sigma > 0.0 {
-            range / median_sigma
-        } else {
-            0.0
-        },
-        departure_max_sigmas: worst,
-        departure_t_s: if n_d == 0 { 0.0 } else { t_s },
-        departure_fixes: n_d,
-        departure_bound_sigmas: bound,
-        verdict: match n_d {
-            0 => "untestable",
-            _ if worst > bound => "fail",
-            _ => "pass",
-        },
-    }
 }
 
 #[cfg(test)]
