@@ -76,7 +76,7 @@ pub struct ReportArgs {
     /// Number of realizations of each ensemble, overriding ensemble.realizations.
     #[arg(long, value_name = "N")]
     pub realizations: Option<u64>,
-    /// Directory that receives index.html and data.json.
+    /// Directory that receives index.html, data.json and view.json.
     #[arg(long, value_name = "DIR", default_value = DEFAULT_REPORT_DIR)]
     pub out: PathBuf,
 }
@@ -316,7 +316,7 @@ impl From<OutputArg> for AccelerometerOutput {
 enum EngineArg {
     /// Every accelerometer sample drawn and integrated, as the problem statement describes it.
     Sample,
-    /// One exact draw of the accelerometer noise's effect per GPS interval (see [`epoch`]): the
+    /// One exact draw of the accelerometer noise's effect per GPS interval: the
     /// same distribution at the fixes with about a tenth of the random numbers.
     Epoch,
 }
