@@ -66,6 +66,7 @@ pub fn tell_stale_temporaries_removed() {
         let size = match t.bytes {
             b if b >= 1_000_000 => format!("{:.1} MB", b as f64 / 1e6),
             b if b >= 1_000 => format!("{:.1} kB", b as f64 / 1e3),
+            1 => "1 byte".to_string(),
             b => format!("{b} bytes"),
         };
         eprintln!(
