@@ -205,3 +205,32 @@ fn simulate_and_calibrate_remove_stale_temporaries_only() {
     let stderr = run_ok(d, &["simulate", "--logs", "logs", "-q"]);
     assert!(!stderr.contains("removed"), "{stderr}");
 }
+
+/// The library only removes its temporaries on a signal and hands the signal to its caller: a
+/// program that does not end then keeps running, its temporary is gone, and writing a file fails
+/// with an error that names the signal instead of leaving a temporary behind.
+#[test]
+fn the_library_hands_the_signal_to_its_caller_and_does_not_end_the_process() {
+    use accelcal::output::{AtomicFile, remove_temporaries_on_signals};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (tx, rx) = std::sync::mpsc::channel();
+    remove_temporaries_on_signals(move |signal| tx.send(signal).unwrap()).unwrap();
+    let mut file = AtomicFile::create(&d.join("out.csv")).unwrap();
+    file.write(b"t_s\n").unwrap();
+    let pid = std::process::id();
+    assert_eq!(entries(d), [format!(".out.csv.{pid}.tmp")]);
+
+    signal_hook::low_level::raise(signal_hook::consts::SIGTERM).unwrap();
+    let signal = rx.recv_timeout(Duration::from_secs(10)).unwrap();
+    assert_eq!(signal, signal_hook::consts::SIGTERM);
+    assert!(entries(d).is_empty(), "{:?}", entries(d));
+    let err = file.commit().unwrap_err().to_string();
+    assert!(err.contains("interrupted by signal 15"), "{err}");
+    let err = AtomicFile::create(&d.join("other.csv")).err().unwrap();
+    assert!(
+        err.to_string().contains("interrupted by signal 15"),
+        "{err}"
+    );
+    assert!(entries(d).is_empty(), "{:?}", entries(d));
+}
