@@ -50,6 +50,33 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
     if bad_input || output { 2 } else { 1 }
 }
 
+/// Ends the process as the signal `signal` (SIGINT, SIGTERM, SIGHUP) would have, once the
+/// output layer removed the temporaries: killed by it, so that a shell shows 128 + `signal`
+/// (130 after Ctrl-C, 143 after SIGTERM); exit code 128 + `signal` should that fail.
+pub fn end_as_signal(signal: i32) {
+    let _ = signal_hook::low_level::emulate_default_handler(signal);
+    std::process::exit(128 + signal);
+}
+
+/// One line on standard error for each temporary left by a run that no longer runs (killed by
+/// SIGKILL) that this run's output layer removed, with its size: the user sees where the space
+/// came back from.
+pub fn tell_stale_temporaries_removed() {
+    for t in accelcal::output::take_removed_stale_temporaries() {
+        let size = match t.bytes {
+            b if b >= 1_000_000 => format!("{:.1} MB", b as f64 / 1e6),
+            b if b >= 1_000 => format!("{:.1} kB", b as f64 / 1e3),
+            1 => "1 byte".to_string(),
+            b => format!("{b} bytes"),
+        };
+        eprintln!(
+            "removed {} ({size}), a temporary left by process {}, which no longer runs",
+            t.path.display(),
+            t.pid
+        );
+    }
+}
+
 /// Standard output could not take what a command printed (`/dev/full`, a closed pipe).
 #[derive(Debug, thiserror::Error)]
 #[error("cannot write to standard output: {0}")]

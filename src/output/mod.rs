@@ -1,7 +1,10 @@
 //! Writing results without clobbering: every file is written beside its destination under a
 //! hidden temporary name and renamed into place, so a run that fails leaves earlier files
 //! untouched, and leaves no temporary behind (removed on an error, and on SIGINT or SIGTERM once
-//! [`remove_temporaries_on_signals`] is called).
+//! [`remove_temporaries_on_signals`] is called). A run killed by SIGKILL cannot remove its own: the
+//! next run that checks or stages the same destination removes those of processes that no
+//! longer run, and lists them in [`take_removed_stale_temporaries`] (the `stale` module says
+//! which files qualify).
 //!
 //! A destination that exists and is neither a regular file nor a directory (a character device
 //! such as `/dev/null`, `/dev/stdout` or `/dev/full`, a FIFO) is written in place: renaming onto
@@ -19,12 +22,14 @@ use thiserror::Error;
 
 mod atomic;
 mod staged;
+mod stale;
 mod temporaries;
 #[cfg(test)]
 mod tests;
 
 pub use atomic::{AtomicFile, write_atomic};
 pub use staged::{StagedFiles, write_all_atomic};
+pub use stale::{StaleTemporary, take_removed_stale_temporaries};
 pub use temporaries::{ScratchFile, remove_temporaries_on_signals};
 
 /// A result file that could not be written. Nothing was replaced.
@@ -91,8 +96,9 @@ fn open_in_place(path: &Path) -> std::io::Result<std::fs::File> {
 }
 
 /// How to write the destination `path`, once it is checked: not a directory, in a directory
-/// that exists and where a file can be created (a temporary is created there and removed), or a
-/// device that opens for writing (a FIFO is not opened: that waits for its reader).
+/// that exists and where a file can be created (a temporary is created there and removed, and
+/// the stale temporaries of `path` there too), or a device that opens for writing (a FIFO is not
+/// opened: that waits for its reader).
 fn target(path: &Path) -> Result<Target, OutputError> {
     use std::io::ErrorKind;
     use std::os::unix::fs::FileTypeExt;
@@ -133,11 +139,13 @@ fn target(path: &Path) -> Result<Target, OutputError> {
         }
         Err(e) => return Err(io(path)(e)),
     }
+    stale::remove_stale(&real, "tmp");
     temporaries::try_creating(&temporaries::beside(&real, "tmp")).map_err(io(path))?;
     Ok(Target::Replace(real))
 }
 
-/// Checks that the file `path` can be written, before the work that fills it.
+/// Checks that the file `path` can be written, before the work that fills it; removes the
+/// temporaries of `path` left beside it by processes that no longer run.
 ///
 /// # Errors
 /// [`OutputError`] when `path` is a directory, its directory does not exist or is not one, or
@@ -179,6 +187,7 @@ pub fn check_directory(dir: &Path, names: &[&str]) -> Result<(), OutputError> {
             dir: ancestor,
         });
     }
-    temporaries::try_creating(&temporaries::beside(&ancestor.join("accelcal"), "tmp"))
-        .map_err(io(&first))
+    let probe = ancestor.join("accelcal");
+    stale::remove_stale(&probe, "tmp");
+    temporaries::try_creating(&temporaries::beside(&probe, "tmp")).map_err(io(&first))
 }

@@ -271,3 +271,116 @@ fn a_scratch_file_is_removed_when_dropped() {
     drop(scratch);
     assert!(entries(dir.path()).is_empty());
 }
+
+/// The temporary names of a destination are told apart from names that merely look like them.
+#[test]
+fn only_the_exact_temporary_name_carries_a_process_id() {
+    use std::ffi::OsStr;
+    let pid = |name: &str| stale::pid_in(OsStr::new(name), OsStr::new("estimates.csv"), "tmp");
+    assert_eq!(pid(".estimates.csv.4242.tmp"), Some(4242));
+    assert_eq!(pid(".estimates.csv.4294967295.tmp"), Some(u32::MAX));
+    for name in [
+        "estimates.csv.4242.tmp",
+        ".estimates.csv.4242.tmp~",
+        ".estimates.csv.4242.tmp.bak",
+        ".estimates.csv.4242.blocks",
+        ".estimates.csv.04242.tmp",
+        ".estimates.csv.0.tmp",
+        ".estimates.csv..tmp",
+        ".estimates.csv.42a.tmp",
+        ".estimates.csv.+42.tmp",
+        ".estimates.csv.4294967296.tmp",
+        ".estimates.csv.5.4242.tmp",
+        ".other.csv.4242.tmp",
+        ".Estimates.csv.4242.tmp",
+    ] {
+        assert_eq!(pid(name), None, "{name}");
+    }
+}
+
+/// A process id that no process has: a child's, once it ended and was reaped.
+fn dead_pid() -> u32 {
+    let mut child = std::process::Command::new("true").spawn().unwrap();
+    child.wait().unwrap();
+    let pid = child.id();
+    assert!(!Path::new(&format!("/proc/{pid}")).exists(), "{pid} reused");
+    pid
+}
+
+/// Checking or staging a destination removes its temporaries whose process no longer runs, and
+/// nothing else: not a running process's, not a name that only looks like one, not a link or a
+/// directory under that name. A scratch file clears those of its own suffix.
+#[test]
+fn stale_temporaries_of_dead_processes_are_removed_and_nothing_else() {
+    use std::os::unix::fs::symlink;
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let dead = dead_pid();
+    let beyond = std::fs::read_to_string("/proc/sys/kernel/pid_max")
+        .map_or(4_194_304, |s| s.trim().parse::<u32>().unwrap())
+        + 1;
+    let mut sleeper = std::process::Command::new("sleep")
+        .arg("60")
+        .spawn()
+        .unwrap();
+    let live = sleeper.id();
+    let stale = [
+        format!(".estimates.csv.{dead}.tmp"),
+        format!(".estimates.csv.{beyond}.tmp"),
+        format!(".part-1.bin.{dead}.blocks"),
+    ];
+    let kept = [
+        format!(".estimates.csv.{live}.tmp"),
+        format!(".estimates.csv.{dead}.tmp~"),
+        format!(".estimates.csv.0{dead}.tmp"),
+        format!("estimates.csv.{dead}.tmp"),
+        format!(".estimates.csv.{dead}.blocks"),
+        format!(".summary.json.{dead}.tmp"),
+        format!(".part-1.bin.{live}.blocks"),
+    ];
+    for name in stale.iter().chain(&kept) {
+        std::fs::write(d.join(name), name).unwrap();
+    }
+    let dead_2 = dead_pid();
+    std::fs::create_dir(d.join(format!(".estimates.csv.{dead_2}.tmp"))).unwrap();
+    symlink(
+        "estimates.csv",
+        d.join(format!(".estimates.csv.{beyond}1.tmp")),
+    )
+    .unwrap();
+    let before = entries(d);
+    for name in &stale {
+        assert!(before.contains(name), "{name} was not made");
+    }
+
+    check_file(&d.join("estimates.csv")).unwrap();
+    drop(ScratchFile::beside(&d.join("part-1.bin"), "blocks").unwrap());
+    sleeper.kill().unwrap();
+    sleeper.wait().unwrap();
+
+    let after = entries(d);
+    let gone: Vec<&String> = before.iter().filter(|n| !after.contains(n)).collect();
+    let mut expected: Vec<&String> = stale.iter().collect();
+    expected.sort();
+    assert_eq!(gone, expected, "left: {after:?}");
+    assert_eq!(after.len(), before.len() - stale.len(), "{after:?}");
+    let mut told: Vec<(String, u32, u64)> = take_removed_stale_temporaries()
+        .into_iter()
+        .filter(|t| t.path.starts_with(d))
+        .map(|t| {
+            let name = t.path.file_name().unwrap().to_string_lossy().into_owned();
+            (name, t.pid, t.bytes)
+        })
+        .collect();
+    told.sort();
+    let mut expected: Vec<(String, u32, u64)> = [dead, beyond, dead]
+        .iter()
+        .zip(&stale)
+        .map(|(&pid, name)| (name.clone(), pid, name.len() as u64))
+        .collect();
+    expected.sort();
+    assert_eq!(told, expected);
+}
