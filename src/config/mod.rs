@@ -3,6 +3,10 @@
 //! Parsing ([`Config::from_toml_str`]) rejects unknown fields; a missing field takes its default.
 //! Validation happens once, when a [`crate::model::Model`] is built from the parsed configuration,
 //! and names the offending field with its accepted range.
+//!
+//! The noise statistics (the truth's and the `[filter]` keys that fall back to them) are the rows
+//! of [`STATISTICS`] ([`statistics`]): the fallback, the default file ([`DEFAULT_TOML`]) and
+//! everything else that lists them read that table.
 
 mod bias;
 mod case;
