@@ -10,22 +10,6 @@ impl Config {
             .unwrap_or(self.accelerometer.bias_model)
     }
 
-    /// The filter's assumed K of a random-walk bias: `filter.bias_random_walk_m_s2_per_sqrt_s`, or
-    /// the truth's (`None` when neither is set).
-    pub fn filter_bias_random_walk_m_s2_per_sqrt_s(&self) -> Option<f64> {
-        self.filter
-            .bias_random_walk_m_s2_per_sqrt_s
-            .or(self.accelerometer.bias_random_walk_m_s2_per_sqrt_s)
-    }
-
-    /// The filter's assumed τ_b of a Gauss–Markov bias: `filter.bias_correlation_time_s`, or the
-    /// truth's (`None` when neither is set).
-    pub fn filter_bias_correlation_time_s(&self) -> Option<f64> {
-        self.filter
-            .bias_correlation_time_s
-            .or(self.accelerometer.bias_correlation_time_s)
-    }
-
     /// True when the filter assumes the truth's bias model and its parameter.
     pub(super) fn filter_bias_matches_truth(&self) -> bool {
         let a = &self.accelerometer;

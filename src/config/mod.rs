@@ -3,12 +3,18 @@
 //! Parsing ([`Config::from_toml_str`]) rejects unknown fields; a missing field takes its default.
 //! Validation happens once, when a [`crate::model::Model`] is built from the parsed configuration,
 //! and names the offending field with its accepted range.
+//!
+//! The noise statistics (the truth's and the `[filter]` keys that fall back to them) are the rows
+//! of [`STATISTICS`] ([`statistics`]): the fallback, the default file ([`DEFAULT_TOML`]) and
+//! everything else that lists them read that table.
 
 mod bias;
 mod case;
+mod default_toml;
 mod keys;
 mod sensitivity;
 mod source;
+pub mod statistics;
 
 use std::f64::consts::PI;
 
@@ -16,8 +22,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{ConfigError, Position};
 pub use case::{AccelerometerOutput, BiasModelKind, Case, TruthModel};
+pub use default_toml::DEFAULT_TOML;
 pub use sensitivity::SensitivityConfig;
 pub use source::{ConfigText, MAX_CONFIG_BYTES};
+pub use statistics::{FILTER_FLOOR, STATISTICS, Statistic};
 
 /// Every parameter of the study.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -94,8 +102,8 @@ impl Default for AccelerometerConfig {
     fn default() -> Self {
         Self {
             sample_rate_hz: 200.0,
-            noise_var_m2_s4: 0.0004,
-            bias_var_m2_s4: 0.01,
+            noise_var_m2_s4: Statistic::ACCEL_NOISE_VAR.default,
+            bias_var_m2_s4: Statistic::BIAS_VAR.default,
             output: AccelerometerOutput::Sample,
             bias_model: BiasModelKind::Constant,
             bias_random_walk_m_s2_per_sqrt_s: None,
@@ -116,15 +124,20 @@ pub struct GpsConfig {
     pub velocity_sigma_m_s: f64,
     /// Take a fix at t = 0 too; by default the first fix is one GPS period after the start.
     pub fix_at_start: bool,
+    /// The throwaway statistic of the registry's test ([`Statistic::THROWAWAY`]), m.
+    #[cfg(feature = "throwaway-statistic")]
+    pub throwaway_sigma_m: f64,
 }
 
 impl Default for GpsConfig {
     fn default() -> Self {
         Self {
             sample_rate_hz: 5.0,
-            position_sigma_m: 1.0,
-            velocity_sigma_m_s: 0.04,
+            position_sigma_m: Statistic::GPS_POSITION_SIGMA.default,
+            velocity_sigma_m_s: Statistic::GPS_VELOCITY_SIGMA.default,
             fix_at_start: false,
+            #[cfg(feature = "throwaway-statistic")]
+            throwaway_sigma_m: Statistic::THROWAWAY.default,
         }
     }
 }
@@ -147,9 +160,9 @@ impl Default for InitialConfig {
     fn default() -> Self {
         Self {
             position_mean_m: 0.0,
-            position_sigma_m: 10.0,
+            position_sigma_m: Statistic::INITIAL_POSITION_SIGMA.default,
             velocity_mean_m_s: 100.0,
-            velocity_sigma_m_s: 1.0,
+            velocity_sigma_m_s: Statistic::INITIAL_VELOCITY_SIGMA.default,
         }
     }
 }
@@ -186,6 +199,10 @@ pub struct FilterConfig {
     /// Assumed τ_b of a Gauss–Markov bias, s.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bias_correlation_time_s: Option<f64>,
+    /// The throwaway statistic of the registry's test ([`Statistic::THROWAWAY`]), m.
+    #[cfg(feature = "throwaway-statistic")]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub throwaway_sigma_m: Option<f64>,
 }
 
 /// The Monte Carlo ensemble.
@@ -248,9 +265,6 @@ pub fn show(x: f64) -> String {
     }
 }
 
-/// The default configuration as an annotated TOML file (what `accelcal config` prints).
-pub const DEFAULT_TOML: &str = include_str!("default_config.toml");
-
 impl Config {
     /// Parses a TOML document. Missing fields take their defaults; unknown fields are an error.
     ///
@@ -278,65 +292,12 @@ impl Config {
         toml::to_string(self).expect("a Config always serializes to TOML")
     }
 
-    /// The filter's assumed accelerometer noise variance, (m/s²)².
-    pub fn filter_accel_noise_var_m2_s4(&self) -> f64 {
-        self.filter
-            .accel_noise_var_m2_s4
-            .unwrap_or(self.accelerometer.noise_var_m2_s4)
-    }
-
-    /// The filter's assumed bias prior variance, (m/s²)².
-    pub fn filter_bias_var_m2_s4(&self) -> f64 {
-        self.filter
-            .bias_var_m2_s4
-            .unwrap_or(self.accelerometer.bias_var_m2_s4)
-    }
-
-    /// The filter's assumed GPS position noise σ, m.
-    pub fn filter_gps_position_sigma_m(&self) -> f64 {
-        self.filter
-            .gps_position_sigma_m
-            .unwrap_or(self.gps.position_sigma_m)
-    }
-
-    /// The filter's assumed GPS velocity noise σ, m/s.
-    pub fn filter_gps_velocity_sigma_m_s(&self) -> f64 {
-        self.filter
-            .gps_velocity_sigma_m_s
-            .unwrap_or(self.gps.velocity_sigma_m_s)
-    }
-
-    /// The filter's assumed initial position σ, m.
-    pub fn filter_initial_position_sigma_m(&self) -> f64 {
-        self.filter
-            .initial_position_sigma_m
-            .unwrap_or(self.initial.position_sigma_m)
-    }
-
-    /// The filter's assumed initial velocity σ, m/s.
-    pub fn filter_initial_velocity_sigma_m_s(&self) -> f64 {
-        self.filter
-            .initial_velocity_sigma_m_s
-            .unwrap_or(self.initial.velocity_sigma_m_s)
-    }
-
     /// The simulated case: `ensemble.truth` and `accelerometer.output`.
     pub fn case(&self) -> Case {
         Case {
             truth: self.ensemble.truth,
             output: self.accelerometer.output,
         }
-    }
-
-    /// True when the filter assumes exactly the truth's statistics.
-    pub fn filter_matches_truth(&self) -> bool {
-        self.filter_accel_noise_var_m2_s4() == self.accelerometer.noise_var_m2_s4
-            && self.filter_bias_var_m2_s4() == self.accelerometer.bias_var_m2_s4
-            && self.filter_gps_position_sigma_m() == self.gps.position_sigma_m
-            && self.filter_gps_velocity_sigma_m_s() == self.gps.velocity_sigma_m_s
-            && self.filter_initial_position_sigma_m() == self.initial.position_sigma_m
-            && self.filter_initial_velocity_sigma_m_s() == self.initial.velocity_sigma_m_s
-            && self.filter_bias_matches_truth()
     }
 }
 

@@ -22,59 +22,73 @@ pub use evaluate::{Drive, Interval};
 pub use profile::ProfilePoint;
 use search::Objective;
 
-use crate::state::{BiasModel, NoiseStats};
+use crate::config::statistics::{Kind, Scales};
+use crate::config::{STATISTICS, Statistic};
+use crate::state::NoiseStats;
 use crate::stats::{Tail, chi_squared_quantile};
 
-/// A statistic the search can estimate: its `[filter]` key.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Key {
-    /// `gps_position_sigma_m`, σ_p.
-    GpsPosition,
-    /// `gps_velocity_sigma_m_s`, σ_v.
-    GpsVelocity,
-    /// `accel_noise_var_m2_s4`, W.
-    AccelNoiseVar,
-    /// `bias_random_walk_m_s2_per_sqrt_s`, K.
-    BiasRandomWalk,
-}
+/// A statistic the search can estimate: a searchable row of [`STATISTICS`] (a variance, σ or K
+/// of the process or measurement noise), named by its `[filter]` key.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Key(pub &'static Statistic);
 
+/// The number of searchable statistics.
+const SEARCHABLE: usize = {
+    let mut n = 0;
+    let mut i = 0;
+    while i < STATISTICS.len() {
+        n += STATISTICS[i].searchable() as usize;
+        i += 1;
+    }
+    n
+};
+
+#[allow(non_upper_case_globals)]
 impl Key {
-    /// Every key, in the order of `summary.json`.
-    pub const ALL: [Key; 4] = [
-        Key::GpsPosition,
-        Key::GpsVelocity,
-        Key::AccelNoiseVar,
-        Key::BiasRandomWalk,
-    ];
+    /// Every key, in the order of `summary.json`: the measurement noise's, then the process
+    /// noise's, each in the table's order.
+    pub const ALL: [Key; SEARCHABLE] = {
+        let mut all = [Key(&STATISTICS[0]); SEARCHABLE];
+        let mut n = 0;
+        let mut pass = 0;
+        while pass < 2 {
+            let mut i = 0;
+            while i < STATISTICS.len() {
+                let s = &STATISTICS[i];
+                let measured = matches!(s.scales, Scales::MeasurementNoise);
+                if s.searchable() && measured == (pass == 0) {
+                    all[n] = Key(s);
+                    n += 1;
+                }
+                i += 1;
+            }
+            pass += 1;
+        }
+        all
+    };
+
+    /// `gps_position_sigma_m`, σ_p.
+    pub const GpsPosition: Key = Key(&Statistic::GPS_POSITION_SIGMA);
+    /// `gps_velocity_sigma_m_s`, σ_v.
+    pub const GpsVelocity: Key = Key(&Statistic::GPS_VELOCITY_SIGMA);
+    /// `accel_noise_var_m2_s4`, W.
+    pub const AccelNoiseVar: Key = Key(&Statistic::ACCEL_NOISE_VAR);
+    /// `bias_random_walk_m_s2_per_sqrt_s`, K.
+    pub const BiasRandomWalk: Key = Key(&Statistic::BIAS_RANDOM_WALK);
 
     /// The `[filter]` key.
     pub fn name(self) -> &'static str {
-        match self {
-            Key::GpsPosition => "gps_position_sigma_m",
-            Key::GpsVelocity => "gps_velocity_sigma_m_s",
-            Key::AccelNoiseVar => "accel_noise_var_m2_s4",
-            Key::BiasRandomWalk => "bias_random_walk_m_s2_per_sqrt_s",
-        }
+        self.0.key()
     }
 
     /// The symbol in the report's notation.
     pub fn symbol(self) -> &'static str {
-        match self {
-            Key::GpsPosition => "σ_p",
-            Key::GpsVelocity => "σ_v",
-            Key::AccelNoiseVar => "W",
-            Key::BiasRandomWalk => "K",
-        }
+        self.0.symbol
     }
 
     /// The SI unit.
     pub fn unit(self) -> &'static str {
-        match self {
-            Key::GpsPosition => "m",
-            Key::GpsVelocity => "m/s",
-            Key::AccelNoiseVar => "(m/s²)²",
-            Key::BiasRandomWalk => "m/s²/√s",
-        }
+        self.0.unit
     }
 
     /// The key of a `[filter]` name.
@@ -82,50 +96,51 @@ impl Key {
         Key::ALL.into_iter().find(|k| k.name() == name.trim())
     }
 
-    /// The search's half-width in decades around the configured value: 3 for a σ or K, 6 for
-    /// the variance W (3 decades of its σ).
+    /// The search's half-width in decades around the configured value (by the statistic's
+    /// kind): 3 for a σ or K, 6 for a variance (3 decades of its σ).
     pub fn decades(self) -> f64 {
-        match self {
-            Key::AccelNoiseVar => 6.0,
-            _ => 3.0,
-        }
+        self.0.kind.decades()
     }
 
     /// The statistic's value in `stats` (K: 0 unless the bias is a random walk).
     pub fn get(self, stats: &NoiseStats) -> f64 {
-        match self {
-            Key::GpsPosition => stats.gps_position_sigma_m,
-            Key::GpsVelocity => stats.gps_velocity_sigma_m_s,
-            Key::AccelNoiseVar => stats.accel_noise_var_m2_s4,
-            Key::BiasRandomWalk => match stats.bias_model {
-                BiasModel::RandomWalk { k_m_s2_per_sqrt_s } => k_m_s2_per_sqrt_s,
-                _ => 0.0,
-            },
-        }
+        self.0.stats_value(stats).unwrap_or(0.0)
     }
 
     /// `stats` with the statistic set to `value` (K makes the bias a random walk).
     pub fn set(self, stats: &mut NoiseStats, value: f64) {
-        match self {
-            Key::GpsPosition => stats.gps_position_sigma_m = value,
-            Key::GpsVelocity => stats.gps_velocity_sigma_m_s = value,
-            Key::AccelNoiseVar => stats.accel_noise_var_m2_s4 = value,
-            Key::BiasRandomWalk => {
-                stats.bias_model = BiasModel::RandomWalk {
-                    k_m_s2_per_sqrt_s: value,
-                }
-            }
-        }
+        (self.0.set_stats)(stats, value);
     }
 
-    /// The keys estimated when none are named: the two GPS σ's, and K when the filter's bias
-    /// is a random walk.
+    /// The keys estimated when none are named: the measurement noise's σ's (the two GPS σ's),
+    /// and the parameter of the filter's bias model when it is searchable (K of a random walk).
     pub fn defaults(stats: &NoiseStats) -> Vec<Key> {
-        let mut keys = vec![Key::GpsPosition, Key::GpsVelocity];
-        if matches!(stats.bias_model, BiasModel::RandomWalk { .. }) {
-            keys.push(Key::BiasRandomWalk);
-        }
-        keys
+        Key::ALL
+            .into_iter()
+            .filter(|k| matches!(k.0.scales, Scales::MeasurementNoise) || k.0.bias_model.is_some())
+            .filter(|k| k.0.stats_value(stats).is_some())
+            .collect()
+    }
+
+    /// The position in [`Key::ALL`].
+    fn rank(self) -> usize {
+        Key::ALL
+            .iter()
+            .position(|k| *k == self)
+            .unwrap_or(usize::MAX)
+    }
+}
+
+impl PartialOrd for Key {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Key {
+    /// In [`Key::ALL`]'s order.
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.rank().cmp(&other.rank())
     }
 }
 
@@ -143,7 +158,7 @@ pub struct Request {
 /// drive) times 10^±decades.
 pub fn search_bounds(key: Key, stats: &NoiseStats, duration_s: f64) -> (f64, f64) {
     let mut center = key.get(stats);
-    if key == Key::BiasRandomWalk && center <= 0.0 {
+    if key.0.kind == Kind::RandomWalk && center <= 0.0 {
         center = (stats.bias_var_m2_s4 / duration_s.max(f64::MIN_POSITIVE)).sqrt();
     }
     let f = 10f64.powf(key.decades());

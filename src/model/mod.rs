@@ -4,7 +4,7 @@
 mod memory;
 mod validate;
 
-use crate::config::{AccelerometerOutput, BiasModelKind, Case, Config, TruthModel};
+use crate::config::{AccelerometerOutput, Case, Config, TruthModel};
 use crate::error::ConfigError;
 pub use memory::{MemoryEstimate, Work};
 pub use validate::validate_calibration;
@@ -44,7 +44,7 @@ pub const DEFAULT_MAX_LAG: usize = 50;
 pub const MAX_REALIZATIONS: u64 = 100_000_000;
 
 /// Smallest variance or standard deviation the filter may assume.
-pub const FILTER_FLOOR: f64 = 1e-12;
+pub use crate::config::FILTER_FLOOR;
 
 /// Relative tolerance used to decide that a ratio of rates or times is a whole number.
 const WHOLE_TOL: f64 = 1e-9;
@@ -136,19 +136,7 @@ impl Model {
             fix_steps,
         };
         let accel_m_s2 = accelerometer_input(config, &timeline, config.accelerometer.output);
-        let truth_stats = NoiseStats {
-            accel_noise_var_m2_s4: a.noise_var_m2_s4,
-            bias_var_m2_s4: a.bias_var_m2_s4,
-            gps_position_sigma_m: g.position_sigma_m,
-            gps_velocity_sigma_m_s: g.velocity_sigma_m_s,
-            initial_position_sigma_m: config.initial.position_sigma_m,
-            initial_velocity_sigma_m_s: config.initial.velocity_sigma_m_s,
-            bias_model: bias_model(
-                a.bias_model,
-                a.bias_random_walk_m_s2_per_sqrt_s,
-                a.bias_correlation_time_s,
-            ),
-        };
+        let truth_stats = config.truth_stats();
         let filter_stats = filter_stats(config);
         let residual_pair = match config.checks.residual_pair_s {
             Some(times) => times.map(|t| timeline.fix_index_at(t).expect("validated fix time")),
@@ -243,32 +231,7 @@ impl Model {
 /// out (of a configuration whose filter keys are valid: [`Model::new`] or
 /// [`validate_calibration`]).
 pub fn filter_stats(config: &Config) -> NoiseStats {
-    NoiseStats {
-        accel_noise_var_m2_s4: config.filter_accel_noise_var_m2_s4(),
-        bias_var_m2_s4: config.filter_bias_var_m2_s4(),
-        gps_position_sigma_m: config.filter_gps_position_sigma_m(),
-        gps_velocity_sigma_m_s: config.filter_gps_velocity_sigma_m_s(),
-        initial_position_sigma_m: config.filter_initial_position_sigma_m(),
-        initial_velocity_sigma_m_s: config.filter_initial_velocity_sigma_m_s(),
-        bias_model: bias_model(
-            config.filter_bias_model_kind(),
-            config.filter_bias_random_walk_m_s2_per_sqrt_s(),
-            config.filter_bias_correlation_time_s(),
-        ),
-    }
-}
-
-/// The bias model of `kind` with its parameter (validated: the one `kind` uses is set).
-fn bias_model(kind: BiasModelKind, k: Option<f64>, tau_b: Option<f64>) -> BiasModel {
-    match kind {
-        BiasModelKind::Constant => BiasModel::Constant,
-        BiasModelKind::RandomWalk => BiasModel::RandomWalk {
-            k_m_s2_per_sqrt_s: k.expect("validated"),
-        },
-        BiasModelKind::GaussMarkov => BiasModel::GaussMarkov {
-            correlation_time_s: tau_b.expect("validated"),
-        },
-    }
+    config.filter_stats()
 }
 
 /// The deterministic accelerometer input at every sample (see [`Model::accel_m_s2`]).

@@ -3,10 +3,11 @@
 
 use super::memory::sums_bytes;
 use super::{
-    FILTER_FLOOR, MAX_FIXES, MAX_REALIZATIONS, MAX_STEPS, MAX_SUMS_BYTES, RESIDUAL_WIDTH,
-    SUM_FLOATS_PER_FIX, WHOLE_TOL,
+    MAX_FIXES, MAX_REALIZATIONS, MAX_STEPS, MAX_SUMS_BYTES, RESIDUAL_WIDTH, SUM_FLOATS_PER_FIX,
+    WHOLE_TOL,
 };
-use crate::config::{Config, show};
+use crate::config::statistics::Range;
+use crate::config::{Config, STATISTICS, show};
 use crate::error::ConfigError;
 use crate::stats::MIN_ACCURATE_RATE;
 
@@ -46,6 +47,25 @@ fn finite_in(
             ),
         ))
     }
+}
+
+/// `x` in `range`, or an error naming `field` with the range.
+fn within(field: &'static str, x: f64, range: Range) -> Result<(), ConfigError> {
+    finite_in(field, x, range.lo, range.hi, range.lo_open)
+}
+
+/// The truth's noise statistics of `section` (but a bias model's parameters, which
+/// [`bias::validate_bias`] checks with the model), each in its accepted range, in the table's
+/// order.
+fn truth_statistics(c: &Config, section: &str) -> Result<(), ConfigError> {
+    let rows = STATISTICS.iter().filter(|s| s.bias_model.is_none());
+    for s in rows.filter(|s| s.truth_section() == section) {
+        let x = c
+            .truth_value(s)
+            .expect("the truth sets every statistic but a bias model's");
+        within(s.truth_path, x, s.truth_range)?;
+    }
+    Ok(())
 }
 
 fn positive(field: &'static str, x: f64, hi: f64) -> Result<(), ConfigError> {
@@ -134,8 +154,7 @@ fn validate_grid(c: &Config) -> Result<Grid, ConfigError> {
 
     let a = &c.accelerometer;
     positive("accelerometer.sample_rate_hz", a.sample_rate_hz, 1e6)?;
-    non_negative("accelerometer.noise_var_m2_s4", a.noise_var_m2_s4, 1e6)?;
-    non_negative("accelerometer.bias_var_m2_s4", a.bias_var_m2_s4, 1e6)?;
+    truth_statistics(c, "accelerometer")?;
     let Some(steps) =
         whole(p.duration_s * a.sample_rate_hz).filter(|&n| n >= 1 && n as usize <= MAX_STEPS)
     else {
@@ -178,8 +197,7 @@ fn validate_grid(c: &Config) -> Result<Grid, ConfigError> {
             ),
         ));
     };
-    positive("gps.position_sigma_m", g.position_sigma_m, 1e6)?;
-    positive("gps.velocity_sigma_m_s", g.velocity_sigma_m_s, 1e6)?;
+    truth_statistics(c, "gps")?;
     let fixes = steps / per_fix + u64::from(g.fix_at_start);
     if !(2..=MAX_FIXES as u64).contains(&fixes) {
         return Err(ConfigError::invalid(
@@ -199,7 +217,7 @@ fn validate_grid(c: &Config) -> Result<Grid, ConfigError> {
     })
 }
 
-/// The prior of the initial position and velocity.
+/// The prior of the initial position and velocity: the means, then the σ's.
 fn validate_initial(c: &Config) -> Result<(), ConfigError> {
     let i = &c.initial;
     finite_in(
@@ -209,7 +227,6 @@ fn validate_initial(c: &Config) -> Result<(), ConfigError> {
         1e9,
         false,
     )?;
-    non_negative("initial.position_sigma_m", i.position_sigma_m, 1e6)?;
     finite_in(
         "initial.velocity_mean_m_s",
         i.velocity_mean_m_s,
@@ -217,69 +234,42 @@ fn validate_initial(c: &Config) -> Result<(), ConfigError> {
         1e6,
         false,
     )?;
-    non_negative("initial.velocity_sigma_m_s", i.velocity_sigma_m_s, 1e6)
+    truth_statistics(c, "initial")
 }
 
-/// The filter's statistics must keep its covariance positive definite: all strictly positive.
+/// The filter's statistics must keep its covariance positive definite: each `[filter]` key
+/// set in its range (at least [`crate::config::FILTER_FLOOR`]), and each left out whose
+/// truth's value, which it takes, may lie below that range (the truth's range includes its
+/// lower end).
 fn validate_filter(c: &Config) -> Result<(), ConfigError> {
-    let f = &c.filter;
-    let filter_fields: [(&'static str, Option<f64>); 6] = [
-        ("filter.accel_noise_var_m2_s4", f.accel_noise_var_m2_s4),
-        ("filter.bias_var_m2_s4", f.bias_var_m2_s4),
-        ("filter.gps_position_sigma_m", f.gps_position_sigma_m),
-        ("filter.gps_velocity_sigma_m_s", f.gps_velocity_sigma_m_s),
-        (
-            "filter.initial_position_sigma_m",
-            f.initial_position_sigma_m,
-        ),
-        (
-            "filter.initial_velocity_sigma_m_s",
-            f.initial_velocity_sigma_m_s,
-        ),
-    ];
+    let rows = || STATISTICS.iter().filter(|s| s.bias_model.is_none());
     // Floors keep S and P well inside double precision; below them the covariance recursion
     // cannot stay positive definite.
-    for (field, value) in filter_fields {
-        if let Some(x) = value {
-            finite_in(field, x, FILTER_FLOOR, 1e6, false)?;
+    for s in rows() {
+        if let Some(x) = c.filter_key(s) {
+            within(s.filter_path, x, s.filter_range)?;
         }
     }
     // A [filter] key left out takes the truth's value: one below the floor is the truth's key's
     // to name, at its line.
-    let resolved: [(&'static str, &'static str, f64); 4] = [
-        (
-            "accel_noise_var_m2_s4",
-            "accelerometer.noise_var_m2_s4",
-            c.filter_accel_noise_var_m2_s4(),
-        ),
-        (
-            "bias_var_m2_s4",
-            "accelerometer.bias_var_m2_s4",
-            c.filter_bias_var_m2_s4(),
-        ),
-        (
-            "initial_position_sigma_m",
-            "initial.position_sigma_m",
-            c.filter_initial_position_sigma_m(),
-        ),
-        (
-            "initial_velocity_sigma_m_s",
-            "initial.velocity_sigma_m_s",
-            c.filter_initial_velocity_sigma_m_s(),
-        ),
-    ];
-    match resolved.iter().find(|(_, _, x)| *x < FILTER_FLOOR) {
-        Some(&(name, truth, x)) => Err(ConfigError::invalid(
-            truth,
-            show(x),
-            format!(
-                "the filter takes its {name} from this key (filter.{name} is not set) and needs \
-                 at least {}: set filter.{name} to a value in [{}, {}]",
-                show(FILTER_FLOOR),
-                show(FILTER_FLOOR),
-                show(1e6)
-            ),
-        )),
+    let resolved = rows()
+        .filter(|s| !s.truth_range.lo_open && s.truth_range.lo < s.filter_range.lo)
+        .map(|s| (s, c.filter_value(s).expect("the truth's value")));
+    match resolved.into_iter().find(|(s, x)| *x < s.filter_range.lo) {
+        Some((s, x)) => {
+            let (name, r) = (s.key(), s.filter_range);
+            Err(ConfigError::invalid(
+                s.truth_path,
+                show(x),
+                format!(
+                    "the filter takes its {name} from this key (filter.{name} is not set) and \
+                     needs at least {}: set filter.{name} to a value in [{}, {}]",
+                    show(r.lo),
+                    show(r.lo),
+                    show(r.hi)
+                ),
+            ))
+        }
         None => Ok(()),
     }
 }

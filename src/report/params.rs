@@ -3,6 +3,8 @@
 use super::prose::{checks_run, share_words};
 use super::rich::rich;
 use super::view::ParamRow;
+use crate::config::STATISTICS;
+use crate::config::statistics::ParamRow as StatisticRow;
 use crate::format::{count, fixed, percent, sig};
 use crate::study::Study;
 
@@ -26,7 +28,7 @@ pub fn params(study: &Study) -> Vec<ParamRow> {
 /// The rows of the acceleration profile and the accelerometer.
 fn motion_and_accelerometer(study: &Study) -> Vec<ParamRow> {
     let c = &study.model.config;
-    vec![
+    let mut rows = vec![
         row(
             "acceleration amplitude A",
             sig(c.profile.accel_amplitude_m_s2, 3),
@@ -62,52 +64,31 @@ fn motion_and_accelerometer(study: &Study) -> Vec<ParamRow> {
             "Hz",
             "accelerometer.sample_rate_hz",
         ),
-        row(
-            "accelerometer noise variance W",
-            sig(c.accelerometer.noise_var_m2_s4, 3),
-            "(m/s²)²",
-            "accelerometer.noise_var_m2_s4",
+    ];
+    rows.extend(statistic_rows(study, "accelerometer"));
+    rows.extend([row(
+        "accelerometer output",
+        format!(
+            "{} (the report runs both sample and interval_mean)",
+            c.accelerometer.output
         ),
-        row(
-            "bias prior variance M_{b}",
-            sig(c.accelerometer.bias_var_m2_s4, 3),
-            "(m/s²)²",
-            "accelerometer.bias_var_m2_s4",
-        ),
-        row(
-            "accelerometer output",
-            format!(
-                "{} (the report runs both sample and interval_mean)",
-                c.accelerometer.output
-            ),
-            "",
-            "accelerometer.output",
-        ),
-    ]
+        "",
+        "accelerometer.output",
+    )]);
+    rows
 }
 
 /// The rows of the GPS, the prior and the run.
 fn gps_prior_and_run(study: &Study) -> Vec<ParamRow> {
     let c = &study.model.config;
-    vec![
-        row(
-            "GPS rate",
-            sig(c.gps.sample_rate_hz, 3),
-            "Hz",
-            "gps.sample_rate_hz",
-        ),
-        row(
-            "GPS position noise σ_{p}",
-            sig(c.gps.position_sigma_m, 3),
-            "m",
-            "gps.position_sigma_m",
-        ),
-        row(
-            "GPS velocity noise σ_{v}",
-            sig(c.gps.velocity_sigma_m_s, 3),
-            "m/s",
-            "gps.velocity_sigma_m_s",
-        ),
+    let mut rows = vec![row(
+        "GPS rate",
+        sig(c.gps.sample_rate_hz, 3),
+        "Hz",
+        "gps.sample_rate_hz",
+    )];
+    rows.extend(statistic_rows(study, "gps"));
+    rows.extend([
         row(
             "initial position p(0)",
             format!(
@@ -128,6 +109,9 @@ fn gps_prior_and_run(study: &Study) -> Vec<ParamRow> {
             "m/s",
             "initial.velocity_*",
         ),
+    ]);
+    rows.extend(statistic_rows(study, "initial"));
+    rows.extend([
         row(
             "realizations per ensemble N",
             count(c.ensemble.realizations),
@@ -145,59 +129,42 @@ fn gps_prior_and_run(study: &Study) -> Vec<ParamRow> {
             "",
             "checks.false_alarm_rate",
         ),
-    ]
+    ]);
+    rows
 }
 
-/// One sentence per statistic the filter assumes differently from the truth.
-pub fn filter_differences(study: &Study) -> Vec<String> {
-    let t = &study.model.truth_stats;
-    let f = &study.model.filter_stats;
-    let pairs = [
-        (
-            "accelerometer noise variance",
-            t.accel_noise_var_m2_s4,
-            f.accel_noise_var_m2_s4,
-            "(m/s²)²",
-        ),
-        (
-            "bias prior variance",
-            t.bias_var_m2_s4,
-            f.bias_var_m2_s4,
-            "(m/s²)²",
-        ),
-        (
-            "GPS position σ",
-            t.gps_position_sigma_m,
-            f.gps_position_sigma_m,
-            "m",
-        ),
-        (
-            "GPS velocity σ",
-            t.gps_velocity_sigma_m_s,
-            f.gps_velocity_sigma_m_s,
-            "m/s",
-        ),
-        (
-            "initial position σ",
-            t.initial_position_sigma_m,
-            f.initial_position_sigma_m,
-            "m",
-        ),
-        (
-            "initial velocity σ",
-            t.initial_velocity_sigma_m_s,
-            f.initial_velocity_sigma_m_s,
-            "m/s",
-        ),
-    ];
-    pairs
+/// The rows of the noise statistics of the truth's `section` that have one of their own (see
+/// [`crate::config::statistics::ParamRow`]), in the table's order.
+fn statistic_rows(study: &Study, section: &str) -> Vec<ParamRow> {
+    let c = &study.model.config;
+    STATISTICS
         .iter()
-        .filter(|(_, a, b, _)| a != b)
-        .map(|(name, a, b, unit)| {
+        .filter(|s| s.truth_section() == section)
+        .filter_map(|s| match (s.param_row, c.truth_value(s)) {
+            (StatisticRow::Own(quantity), Some(x)) => {
+                Some(row(quantity, sig(x, 3), s.unit, s.truth_path))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// One sentence per statistic the filter assumes differently from the truth (a bias model's
+/// parameters aside, which the bias model's own sentences give).
+pub fn filter_differences(study: &Study) -> Vec<String> {
+    let c = &study.model.config;
+    STATISTICS
+        .iter()
+        .filter(|s| s.bias_model.is_none())
+        .filter_map(|s| Some((s, c.truth_value(s)?, c.filter_value(s)?)))
+        .filter(|(_, a, b)| a != b)
+        .map(|(s, a, b)| {
             format!(
-                "{name}: the filter assumes {} {unit}, the truth has {} {unit}",
-                sig(*b, 3),
-                sig(*a, 3)
+                "{}: the filter assumes {} {unit}, the truth has {} {unit}",
+                s.words,
+                sig(b, 3),
+                sig(a, 3),
+                unit = s.unit
             )
         })
         .collect()

@@ -1,13 +1,13 @@
 //! The bias model's keys: each model takes only its own parameter, in its accepted range.
 
 use super::{finite_in, positive, show};
-use crate::config::{BiasModelKind, Config};
+use crate::config::{BiasModelKind, Config, Statistic};
 use crate::error::ConfigError;
 
 /// Largest accepted K of a random-walk bias, m/s² per √s.
-const MAX_RANDOM_WALK_M_S2_PER_SQRT_S: f64 = 1e3;
+const MAX_RANDOM_WALK_M_S2_PER_SQRT_S: f64 = Statistic::BIAS_RANDOM_WALK.truth_range.hi;
 /// Largest accepted τ_b of a Gauss–Markov bias, s.
-const MAX_CORRELATION_TIME_S: f64 = 1e9;
+const MAX_CORRELATION_TIME_S: f64 = Statistic::BIAS_CORRELATION_TIME.truth_range.hi;
 
 /// The keys of one side (the accelerometer's truth or the filter's assumption).
 struct BiasKeys {

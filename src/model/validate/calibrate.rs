@@ -4,7 +4,7 @@
 //! needs.
 
 use super::{positive, validate_false_alarm_rate, validate_filter, validate_initial};
-use crate::config::Config;
+use crate::config::{Config, STATISTICS};
 use crate::error::ConfigError;
 
 /// Largest accepted `accelerometer.sample_rate_hz`, Hz (as the study's).
@@ -33,26 +33,16 @@ pub fn validate_calibration(
             MAX_SAMPLE_RATE_HZ,
         )?;
     }
-    super::non_negative("accelerometer.noise_var_m2_s4", a.noise_var_m2_s4, 1e6)?;
-    super::non_negative("accelerometer.bias_var_m2_s4", a.bias_var_m2_s4, 1e6)?;
-    let g = &c.gps;
-    positive("gps.position_sigma_m", g.position_sigma_m, 1e6)?;
-    positive("gps.velocity_sigma_m_s", g.velocity_sigma_m_s, 1e6)?;
+    super::truth_statistics(c, "accelerometer")?;
+    super::truth_statistics(c, "gps")?;
     if initial_set {
         validate_initial(c)?;
     } else {
-        let f = &c.filter;
-        let alone = [
-            (
-                "filter.initial_position_sigma_m",
-                f.initial_position_sigma_m,
-            ),
-            (
-                "filter.initial_velocity_sigma_m_s",
-                f.initial_velocity_sigma_m_s,
-            ),
-        ];
-        if let Some((field, Some(x))) = alone.into_iter().find(|(_, x)| x.is_some()) {
+        let alone = STATISTICS
+            .iter()
+            .filter(|s| s.truth_section() == "initial")
+            .find_map(|s| c.filter_key(s).map(|x| (s.filter_path, x)));
+        if let Some((field, x)) = alone {
             return Err(ConfigError::invalid(
                 field,
                 crate::config::show(x),
