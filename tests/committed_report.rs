@@ -123,7 +123,13 @@ fn committed_data_matches_the_code() {
     )
     .unwrap();
     let study = default_study();
-    let now: Value = serde_json::from_str(&accelcal::export::report_data_json(study)).unwrap();
+    let input = accelcal::report::ReportInput {
+        study,
+        command: "accelcal report",
+        threads: 1,
+        static_noise: None,
+    };
+    let now: Value = serde_json::from_str(&accelcal::report::data_json(&input)).unwrap();
     if let Some(d) = diff(&committed, &now, "data") {
         panic!("report/data.json is stale (run `cargo run --release`): first difference at {d}");
     }

@@ -468,7 +468,7 @@ fn the_report_shows_what_a_drifting_bias_costs() {
     assert!(page.html.contains("times worse than it claims"));
     assert!(page.html.contains("its claim holds (every check passes)"));
     let data: serde_json::Value =
-        serde_json::from_str(&accelcal::export::report_data_json(&study)).unwrap();
+        serde_json::from_str(&accelcal::report::data_json(&input(&study))).unwrap();
     let filters = &data["drifting_bias"]["filters"];
     assert_eq!(filters[0]["bias_model"], "constant");
     assert_eq!(filters[0]["verdicts"]["nees"], "fail");

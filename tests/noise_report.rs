@@ -7,9 +7,8 @@ use accelcal::config::Config;
 use accelcal::format::{count, sig};
 use accelcal::likelihood::Key;
 use accelcal::model::Model;
+use accelcal::report::noise::NoiseView;
 use accelcal::report::noise::{coverage_words, estimate_html, estimate_words, white_noise_words};
-use accelcal::report::outline::{Outline, Section};
-use accelcal::report::page::SectionView;
 use accelcal::report::{self, ReportInput};
 use accelcal::study::identify::{self, WhiteNoiseDrives};
 use accelcal::study::noise::{KeyCoverage, NoiseStudy};
@@ -60,15 +59,7 @@ fn the_section_shows_the_study_s_numbers() {
         .position(|a| *a == "noise-estimate")
         .expect("in the contents");
     assert_eq!(toc[at + 1], "conclusions", "{toc:?}");
-    let n = page
-        .view
-        .sections
-        .iter()
-        .find_map(|s| match &s.view {
-            SectionView::Noise(n) => Some(n),
-            _ => None,
-        })
-        .expect("the section's view");
+    let n = page.view.find::<NoiseView>().expect("the section's view");
     let noise = study.noise.as_ref().unwrap();
     assert_eq!(n.drives, count(DRIVES));
     assert_eq!(n.rows.len(), noise.coverage.len());
@@ -123,13 +114,10 @@ fn the_section_shows_the_study_s_numbers() {
 
 #[test]
 fn the_section_comes_after_the_drifting_bias() {
-    let outline = Outline::standard(3, true, true)
-        .with_drift()
-        .with_noise(true);
-    let sections: Vec<Section> = outline.sections().collect();
-    let drift = sections.iter().position(|s| *s == Section::Drift).unwrap();
-    assert_eq!(sections[drift + 1], Section::Noise(true));
-    assert_eq!(sections[drift + 2], Section::Conclusions);
+    let keys: Vec<&str> = report::registry::SECTIONS.iter().map(|k| k.key()).collect();
+    let drift = keys.iter().position(|k| *k == "drift").unwrap();
+    assert_eq!(keys[drift + 1], "noise");
+    assert_eq!(keys[drift + 3], "conclusions");
 }
 
 /// The two drives of the default configuration, run once.

@@ -9,8 +9,11 @@ use accelcal::config::Config;
 use accelcal::ensemble::Statistics;
 use accelcal::filter::Stage;
 use accelcal::model::Model;
-use accelcal::report::outline::{Node, Outline, Section};
-use accelcal::report::page::{ReportView, SectionView};
+use accelcal::report::kind::{Built, Context, JsonRecord, Record, SectionKind};
+use accelcal::report::outline::{Equation, Figure, Label, Node, Outline, Table};
+use accelcal::report::page::{AbstractView, ReportView, ResultsView, TheoryView};
+use accelcal::report::registry::SECTIONS;
+use accelcal::report::view::CaseView;
 use accelcal::report::{self, Page, ReportInput};
 use accelcal::study::{Silent, Study};
 
@@ -86,23 +89,15 @@ fn assert_contents_follow(page: &Page) {
 }
 
 fn theory_eq(view: &ReportView) -> usize {
-    view.sections
-        .iter()
-        .find_map(|n| match &n.view {
-            SectionView::Theory(t) => Some(t.eqn.accelerometer),
-            _ => None,
-        })
-        .unwrap()
+    view.find::<TheoryView>().unwrap().eqn.accelerometer
 }
 
 fn case_tables(view: &ReportView) -> Vec<(String, usize)> {
     view.sections
         .iter()
         .flat_map(|n| &n.children)
-        .filter_map(|n| match &n.view {
-            SectionView::Case(c) => Some((c.letter.clone(), c.table_number)),
-            _ => None,
-        })
+        .filter_map(|n| n.get::<CaseView>())
+        .map(|c| (c.letter.clone(), c.table_number))
         .collect()
 }
 
@@ -122,14 +117,14 @@ fn moving_a_section_renumbers_the_page_and_the_contents_follow() {
     let theory = moved
         .nodes
         .iter()
-        .position(|n| n.section == Section::Theory)
+        .position(|n| n.section.key() == "theory")
         .unwrap();
     let node = moved.nodes.remove(theory);
     moved.nodes.insert(2, node);
     let results = moved
         .nodes
         .iter_mut()
-        .find(|n| n.section == Section::Results)
+        .find(|n| n.section.key() == "results")
         .unwrap();
     let cases = study.cases.len();
     results.children[..cases].reverse();
@@ -149,13 +144,13 @@ fn moving_a_section_renumbers_the_page_and_the_contents_follow() {
     let results = flat
         .nodes
         .iter_mut()
-        .find(|n| n.section == Section::Results)
+        .find(|n| n.section.key() == "results")
         .unwrap();
     let first_case = results.children.remove(0);
     flat.nodes.push(Node::leaf(first_case));
     let page = render(study, &flat);
     assert_numbered_in_reading_order(&page.html);
-    let Some(SectionView::Case(a)) = page.view.sections.last().map(|n| &n.view) else {
+    let Some(a) = page.view.sections.last().and_then(|n| n.get::<CaseView>()) else {
         panic!("case A is the last section");
     };
     let others = case_tables(&page.view);
@@ -211,34 +206,26 @@ fn a_check_added_to_the_catalogue_shows_up_in_every_table_and_count() {
     let n = catalogue.len().to_string();
     let id = POSTERIOR_NEES.id;
     let mut seen = 0;
-    for node in page
-        .view
-        .sections
-        .iter()
-        .flat_map(|n| std::iter::once(n).chain(&n.children))
-    {
-        match &node.view {
-            SectionView::Abstract(a) => {
-                assert_eq!(a.check_count, n);
-                assert!(a.check_titles.ends_with("NIS and a posteriori NEES"));
-                seen += 1;
-            }
-            SectionView::Theory(t) => {
-                assert_eq!(t.check_count, n);
-                assert!(t.catalogue.iter().any(|c| c.id == id.name()));
-                seen += 1;
-            }
-            SectionView::Results(r) => {
-                assert!(r.summary.iter().any(|row| row.id == id.name()));
-                seen += 1;
-            }
-            SectionView::Case(c) => {
-                assert_eq!(c.checks.len(), catalogue.len());
-                assert!(c.checks.iter().any(|row| row.id == id.name()));
-                assert!(c.passed_count.ends_with(&format!("of {n}")));
-                seen += 1;
-            }
-            _ => {}
+    for node in page.view.all() {
+        if let Some(a) = node.get::<AbstractView>() {
+            assert_eq!(a.check_count, n);
+            assert!(a.check_titles.ends_with("NIS and a posteriori NEES"));
+            seen += 1;
+        }
+        if let Some(t) = node.get::<TheoryView>() {
+            assert_eq!(t.check_count, n);
+            assert!(t.catalogue.iter().any(|c| c.id == id.name()));
+            seen += 1;
+        }
+        if let Some(r) = node.get::<ResultsView>() {
+            assert!(r.summary.iter().any(|row| row.id == id.name()));
+            seen += 1;
+        }
+        if let Some(c) = node.get::<CaseView>() {
+            assert_eq!(c.checks.len(), catalogue.len());
+            assert!(c.checks.iter().any(|row| row.id == id.name()));
+            assert!(c.passed_count.ends_with(&format!("of {n}")));
+            seen += 1;
         }
     }
     assert_eq!(seen, 3 + study.cases.len());
@@ -247,4 +234,168 @@ fn a_check_added_to_the_catalogue_shows_up_in_every_table_and_count() {
     // The registered catalogue itself is untouched.
     assert_eq!(CheckId::ALL.len(), CATALOGUE.len());
     assert!(CheckId::from_name("posterior_nees").is_none());
+}
+
+/// A section defined only here, in the one file a section takes (its kind, its view, its
+/// template) plus its line in a list of sections: a table, a figure and an equation of its own, a
+/// record in data.json, shown when `shown`.
+struct Margin {
+    shown: bool,
+}
+
+/// The throwaway section's view.
+#[derive(Debug, serde::Serialize)]
+struct MarginView {
+    table: usize,
+    figure: usize,
+    equation: usize,
+    cases: String,
+}
+
+/// Its record in data.json.
+#[derive(serde::Serialize)]
+struct MarginRecord {
+    cases: usize,
+    note: &'static str,
+}
+
+const MARGIN_TABLE: Table = Table::Named("margin");
+const MARGIN_FIGURE: Figure = Figure::Named("margin");
+const MARGIN_EQUATION: Equation = Equation::Named("margin");
+
+impl SectionKind for Margin {
+    fn key(&self) -> &'static str {
+        "margin"
+    }
+    fn instances(&self, _: &ReportInput) -> Vec<usize> {
+        if self.shown { vec![0] } else { Vec::new() }
+    }
+    fn labels(&self, _: usize) -> Vec<Label> {
+        vec![
+            Label::Table(MARGIN_TABLE),
+            Label::Figure(MARGIN_FIGURE),
+            Label::Equation(MARGIN_EQUATION),
+        ]
+    }
+    fn build(&self, ctx: &Context, _: usize) -> Built {
+        if !self.shown {
+            return None;
+        }
+        let n = ctx.numbers;
+        Some(Ok(Box::new(MarginView {
+            table: n.table(MARGIN_TABLE),
+            figure: n.figure(MARGIN_FIGURE),
+            equation: n.equation(MARGIN_EQUATION),
+            cases: ctx.study().cases.len().to_string(),
+        })))
+    }
+    fn record<'a>(&self, input: &ReportInput<'a>) -> Option<Record<'a>> {
+        self.shown.then(|| {
+            let record = MarginRecord {
+                cases: input.study.cases.len(),
+                note: "a throwaway section",
+            };
+            ("margin", Box::new(record) as Box<dyn JsonRecord>)
+        })
+    }
+}
+
+#[derive(askama::Template)]
+#[template(
+    ext = "html",
+    source = "<section id=\"margin\">\n<h2>A margin</h2>\n<p>{{ m.cases }} cases.</p>\n<div class=\"eq\"><span class=\"eqno\">({{ m.equation }})</span></div>\n<figure><figcaption><span class=\"fignum\">Figure {{ m.figure }}.</span> A margin.</figcaption></figure>\n<table><caption>Table {{ m.table }}. A margin.</caption></table>\n</section>"
+)]
+struct MarginHtml<'a> {
+    m: &'a MarginView,
+}
+
+accelcal::section_view!(MarginView, MarginHtml { m }, anchor: |_| "margin".to_string(), title: |_| "A margin".to_string());
+
+static SHOWN: Margin = Margin { shown: true };
+static HIDDEN: Margin = Margin { shown: false };
+
+/// The registry with `margin` right after the theory.
+fn with_margin(margin: &'static Margin) -> Vec<&'static dyn SectionKind> {
+    let mut kinds = SECTIONS.to_vec();
+    let theory = kinds.iter().position(|k| k.key() == "theory").unwrap();
+    kinds.insert(theory + 1, margin);
+    kinds
+}
+
+#[test]
+fn a_section_added_to_the_registry_appears_everywhere_it_should() {
+    let study = study();
+    let input = input(study);
+    let standard = render(study, &report::outline_of(&input));
+    let kinds = with_margin(&SHOWN);
+    let outline = Outline::of(&input, &kinds);
+
+    // The outline: right after the theory, at the top level.
+    let keys: Vec<&str> = outline.nodes.iter().map(|n| n.section.key()).collect();
+    let theory = keys.iter().position(|k| *k == "theory").unwrap();
+    assert_eq!(keys[theory + 1], "margin", "{keys:?}");
+
+    // The page: its section and its contents entry in reading order, every number in order.
+    let page = render(study, &outline);
+    assert_numbered_in_reading_order(&page.html);
+    assert_contents_follow(&page);
+    assert_eq!(page.view.toc[theory + 1].anchor, "margin");
+    assert!(
+        page.html
+            .contains("<li><a href=\"#margin\">A margin</a></li>")
+    );
+    assert!(
+        page.html
+            .contains(&format!("<p>{} cases.</p>", study.cases.len()))
+    );
+
+    // Its numbers follow the problem's and the theory's, and everything after moves on by one.
+    let m = page.view.find::<MarginView>().expect("the margin's view");
+    assert_eq!(
+        (m.table, m.figure),
+        (2, 2),
+        "after the problem's table 1 and figure 1"
+    );
+    assert_eq!(
+        m.equation,
+        theory_eq(&page.view) + 9,
+        "after the theory's nine"
+    );
+    let (before, after) = (case_tables(&standard.view), case_tables(&page.view));
+    assert_eq!(before.len(), after.len());
+    for ((a, t0), (b, t1)) in before.iter().zip(&after) {
+        assert_eq!((a, t0 + 1), (b, *t1));
+    }
+    let figures = |html: &str| numbers_after(html, "<span class=\"fignum\">Figure ").len();
+    assert_eq!(figures(&page.html), figures(&standard.html) + 1);
+
+    // view.json holds its view; data.json its record, after the study's own fields.
+    assert!(page.view_json.contains("\"section\": \"margin\""));
+    let view: serde_json::Value = serde_json::from_str(&page.view_json).unwrap();
+    let shown = &view["sections"][theory + 1];
+    assert_eq!(shown["section"], "margin");
+    assert_eq!(shown["table"], 2);
+    let text = report::data_json_of(&input, &kinds);
+    let data: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(data["margin"]["cases"], study.cases.len());
+    assert_eq!(data["margin"]["note"], "a throwaway section");
+    assert!(text.find("\"ensembles\"").unwrap() < text.find("\"margin\"").unwrap());
+    let plain: serde_json::Value = serde_json::from_str(&report::data_json(&input)).unwrap();
+    assert!(plain.get("margin").is_none());
+    let mut without = data.clone();
+    without.as_object_mut().unwrap().remove("margin");
+    assert_eq!(without, plain, "nothing else in data.json changes");
+
+    // Optional: a study without its value shows it nowhere, and nothing else changes.
+    let hidden = with_margin(&HIDDEN);
+    let outline = Outline::of(&input, &hidden);
+    assert_eq!(outline, report::outline_of(&input));
+    let page = render(study, &outline);
+    assert!(!page.html.contains("id=\"margin\"") && !page.html.contains("#margin"));
+    assert_eq!(page.html, standard.html);
+    assert_eq!(page.view_json, standard.view_json);
+    assert_eq!(
+        report::data_json_of(&input, &hidden),
+        report::data_json(&input)
+    );
 }

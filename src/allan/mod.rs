@@ -11,17 +11,17 @@
 //!    covariance of the estimates across τ ([`covariance`]).
 //!
 //! [`simulate`] draws synthetic static logs with known terms (for the tests, the report and the
-//! benchmarks); [`export`] writes `allan.json`, `noise.toml` and `imu.yaml`; [`page`] the page.
+//! benchmarks); [`export`] writes `allan.json`, `noise.toml` and `imu.yaml`; [`section`] measures
+//! the coverage of the intervals the report shows. The page and its figure are drawn above this
+//! module, by `report::allan` through `plot`.
 
 pub mod covariance;
 pub mod deviation;
 pub mod edf;
 pub mod export;
-pub mod figure;
 pub mod fit;
 pub mod log;
 pub mod noise_id;
-pub mod page;
 pub mod section;
 pub mod simulate;
 

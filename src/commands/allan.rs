@@ -5,10 +5,11 @@ use std::io::{IsTerminal, Write as _};
 use anyhow::{Context, Result};
 
 use crate::cli::AllanArgs;
-use accelcal::allan::{self, Term, export, log::read_static_log, page};
+use accelcal::allan::{self, Term, export, log::read_static_log};
 use accelcal::format::{count, sig};
 use accelcal::logs::read::LogFile;
 use accelcal::output::StagedFiles;
+use accelcal::report::allan as page;
 
 const JSON_FILE: &str = "allan.json";
 const TOML_FILE: &str = "noise.toml";

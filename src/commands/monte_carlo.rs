@@ -32,13 +32,14 @@ pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
         .with_real_drive()?;
     let static_noise = accelcal::allan::section::report_coverage()?;
     let command = reproduce_command(args);
-    let page = report::render(&report::ReportInput {
+    let input = report::ReportInput {
         study: &study,
         command: &command,
         threads: rayon::current_num_threads(),
         static_noise: Some(&static_noise),
-    })?;
-    let data = export::report_data_json(&study);
+    };
+    let page = report::render(&input)?;
+    let data = report::data_json(&input);
     write_all_atomic(
         &args.out,
         &[

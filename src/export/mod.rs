@@ -352,70 +352,12 @@ struct ReportData<'a> {
     realization: &'a Realization,
     /// One per case, in the report's order.
     ensembles: Vec<EnsembleDoc<'a>>,
-    /// The sensitivity to the assumed statistics, when the study ran it.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    sensitivity: Option<sensitivity::SensitivityRecord>,
-    /// The drifting-bias study, when the study ran it.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    drifting_bias: Option<DriftRecord<'a>>,
-    /// Noise statistics estimated from simulated drives, when the study ran them.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    noise_statistics: Option<noise::NoiseRecord<'a>>,
 }
 
-/// One filter of the drifting-bias study.
-#[derive(Serialize)]
-struct DriftFilterRecord<'a> {
-    /// The bias model the filter assumes.
-    bias_model: &'static str,
-    /// Fix times of the series, s.
-    time_s: &'a [f64],
-    /// The filter's a posteriori σ at those fixes: [position m, velocity m/s, bias m/s²].
-    claimed_sigma: &'a [[f64; ErrorState::DIM]],
-    /// The actual RMS error there (exact), same order and units.
-    achieved_rms: &'a [[f64; ErrorState::DIM]],
-    /// Each check's verdict on the filter's ensemble.
-    verdicts: std::collections::BTreeMap<&'static str, &'static str>,
-}
-
-/// The drifting-bias study: a constant-bias and a random-walk filter on one random-walk truth.
-#[derive(Serialize)]
-struct DriftRecord<'a> {
-    /// K of the truth's random walk, m/s²/√s.
-    bias_random_walk_m_s2_per_sqrt_s: f64,
-    /// Length of the run, s.
-    duration_s: f64,
-    /// Realizations of each ensemble.
-    realizations: u64,
-    /// The constant-bias filter, then the random-walk filter.
-    filters: [DriftFilterRecord<'a>; 2],
-}
-
-fn drift_record(d: &crate::study::drift::DriftStudy) -> DriftRecord<'_> {
-    fn filter(f: &crate::study::drift::DriftFilter) -> DriftFilterRecord<'_> {
-        DriftFilterRecord {
-            bias_model: f.bias_model.name(),
-            time_s: &f.time_s,
-            claimed_sigma: &f.claimed_sigma,
-            achieved_rms: &f.achieved_rms,
-            verdicts: f
-                .verdicts
-                .checks
-                .iter()
-                .map(|c| (c.id.name(), c.verdict.name()))
-                .collect(),
-        }
-    }
-    DriftRecord {
-        bias_random_walk_m_s2_per_sqrt_s: d.k_m_s2_per_sqrt_s,
-        duration_s: d.duration_s,
-        realizations: d.realizations,
-        filters: [filter(&d.constant), filter(&d.random_walk)],
-    }
-}
-
-/// Serializes the report's data file.
-pub fn report_data_json(study: &Study) -> String {
+/// The report's data file without the records of its sections, and whether it is indented:
+/// the default run's is, a long run's is compact (a third of the size). The report appends each
+/// section's record (`report::data_json`).
+pub fn report_data_head(study: &Study) -> (String, bool) {
     let ensembles = study
         .cases
         .iter()
@@ -431,16 +373,13 @@ pub fn report_data_json(study: &Study) -> String {
         },
         realization: &study.realization,
         ensembles,
-        sensitivity: study.sensitivity.as_ref().map(sensitivity::record),
-        drifting_bias: study.drift.as_ref().map(drift_record),
-        noise_statistics: (study.noise.as_ref())
-            .map(|n| noise::record(n, study.white_noise.as_ref())),
     };
-    // Indented for the default run, compact for long ones (a third of the size).
-    if study.model.timeline.fixes() <= crate::model::ALL_PAIRS_MAX_FIXES {
+    let pretty = study.model.timeline.fixes() <= crate::model::ALL_PAIRS_MAX_FIXES;
+    if pretty {
         serde_json::to_string_pretty(&data)
     } else {
         serde_json::to_string(&data)
     }
+    .map(|text| (text, pretty))
     .expect("finite numbers serialize")
 }

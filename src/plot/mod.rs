@@ -23,6 +23,7 @@ use plotters::style::{FontDesc, RGBColor, TextStyle};
 
 use crate::state::ErrorState;
 
+mod allan;
 mod axis;
 mod calibration;
 mod cases;
@@ -42,6 +43,7 @@ mod residuals;
 mod sensitivity;
 mod trajectory;
 
+pub use allan::{AllanMark, AllanSeries, TERM_COLOURS, TermCurve, allan_deviation};
 pub use calibration::{
     calibration_bias, calibration_nis, calibration_residuals, calibration_trajectory,
 };

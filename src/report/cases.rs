@@ -1,12 +1,12 @@
 //! The view of each case: its verdict table, residual pair, accuracy and prediction, and the
 //! verdict summary across cases.
 
-use super::prose::{and_list, case_title, failure_sentence, letter};
 use super::rich::rich;
 use super::view::{
     AccuracyCell, AccuracyRow, CaseView, CheckRow, FigureView, PairView, PerformanceRow,
     PredictionRow, SummaryCell, SummaryRow, VerdictView,
 };
+use super::words::{and_list, case_title, failure_sentence, letter};
 use crate::checks::{Check, CheckId, Untestable, Verdict, Verdicts};
 use crate::format::{count, fixed, sig};
 use crate::state::{ErrorState, StateModel, Variable};

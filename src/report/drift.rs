@@ -1,12 +1,16 @@
 //! The section "A drifting bias": the same random-walk truth seen by a filter that believes the
 //! bias constant and by one that models the walk.
 
+use askama::Template;
 use serde::Serialize;
 
+use super::equations::Equations;
 use super::figures::figure;
-use super::outline::{Figure, Numbers, Table};
+use super::kind::{Built, Context, Record, SectionKind, SectionView};
+use super::outline::{Figure, Label, Numbers, Table};
+
 use super::view::FigureView;
-use super::{RenderError, rich};
+use super::{RenderError, ReportInput, rich};
 use crate::checks::{CheckId, Verdict};
 use crate::format::{count, fixed, short, sig};
 use crate::plot::{self, DriftSeries};
@@ -182,3 +186,87 @@ pub fn view(d: &DriftStudy, numbers: &Numbers) -> Result<DriftView, RenderError>
         conclusion_html: rich::rich(&conclusion(d, quote_s)),
     })
 }
+
+/// One filter of the drifting-bias study in data.json.
+#[derive(Serialize)]
+pub struct DriftFilterRecord<'a> {
+    /// The bias model the filter assumes.
+    pub bias_model: &'static str,
+    /// Fix times of the series, s.
+    pub time_s: &'a [f64],
+    /// The filter's a posteriori σ at those fixes: [position m, velocity m/s, bias m/s²].
+    pub claimed_sigma: &'a [[f64; ErrorState::DIM]],
+    /// The actual RMS error there (exact), same order and units.
+    pub achieved_rms: &'a [[f64; ErrorState::DIM]],
+    /// Each check's verdict on the filter's ensemble.
+    pub verdicts: std::collections::BTreeMap<&'static str, &'static str>,
+}
+
+/// data.json's `drifting_bias`: a constant-bias and a random-walk filter on one random-walk truth.
+#[derive(Serialize)]
+pub struct DriftRecord<'a> {
+    /// K of the truth's random walk, m/s²/√s.
+    bias_random_walk_m_s2_per_sqrt_s: f64,
+    /// Length of the run, s.
+    pub duration_s: f64,
+    /// Realizations of each ensemble.
+    pub realizations: u64,
+    /// The constant-bias filter, then the random-walk filter.
+    pub filters: [DriftFilterRecord<'a>; 2],
+}
+
+/// The study's record in data.json.
+pub fn record(d: &DriftStudy) -> DriftRecord<'_> {
+    fn filter(f: &DriftFilter) -> DriftFilterRecord<'_> {
+        DriftFilterRecord {
+            bias_model: f.bias_model.name(),
+            time_s: &f.time_s,
+            claimed_sigma: &f.claimed_sigma,
+            achieved_rms: &f.achieved_rms,
+            verdicts: f
+                .verdicts
+                .checks
+                .iter()
+                .map(|c| (c.id.name(), c.verdict.name()))
+                .collect(),
+        }
+    }
+    DriftRecord {
+        bias_random_walk_m_s2_per_sqrt_s: d.k_m_s2_per_sqrt_s,
+        duration_s: d.duration_s,
+        realizations: d.realizations,
+        filters: [filter(&d.constant), filter(&d.random_walk)],
+    }
+}
+
+/// The section "A drifting bias", when the study ran it.
+pub struct Drift;
+
+impl SectionKind for Drift {
+    fn key(&self) -> &'static str {
+        "drift"
+    }
+    fn instances(&self, input: &ReportInput) -> Vec<usize> {
+        input.study.drift.iter().map(|_| 0).collect()
+    }
+    fn labels(&self, _: usize) -> Vec<Label> {
+        vec![Label::Figure(Figure::Drift), Label::Table(Table::Drift)]
+    }
+    fn build(&self, ctx: &Context, _: usize) -> Built {
+        let d = ctx.study().drift.as_ref()?;
+        Some(view(d, ctx.numbers).map(|v| Box::new(v) as Box<dyn SectionView>))
+    }
+    fn record<'a>(&self, input: &ReportInput<'a>) -> Option<Record<'a>> {
+        let d = input.study.drift.as_ref()?;
+        Some(("drifting_bias", Box::new(record(d))))
+    }
+}
+
+#[derive(Template)]
+#[template(path = "sections/drift.html")]
+struct DriftHtml<'a> {
+    d: &'a DriftView,
+    eq: &'a Equations,
+}
+
+crate::section_view!(DriftView, DriftHtml { d, eq }, anchor: |_| "drifting-bias".to_string(), title: |_| "A drifting bias".to_string());

@@ -42,6 +42,7 @@ equations! {
     w: inline => r"w",
     big_w: inline => r"W",
     eta: inline => r"\eta",
+    q_b_step: inline => r"q_b = K^2 \cdot \Delta t",
     p_c: inline => r"p_c",
     v_c: inline => r"v_c",
     p_prior: inline => r"P(t_i^-)",

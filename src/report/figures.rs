@@ -3,9 +3,9 @@
 
 use super::RenderError;
 use super::outline::{CheckFigure, Figure, Numbers};
-use super::prose::{case_title, letter};
 use super::rich::rich;
 use super::view::FigureView;
+use super::words::{case_title, letter};
 use crate::checks::{CheckId, Verdicts};
 use crate::format::{count, fixed, percent, sig};
 use crate::plot;
@@ -13,7 +13,7 @@ use crate::study::{CaseOutcome, Study};
 
 /// Removes the SVG namespace declaration: inline SVG in HTML needs none, and the report then
 /// holds no address at all.
-fn inline_svg(svg: String) -> String {
+pub fn inline_svg(svg: String) -> String {
     svg.replacen(" xmlns=\"http://www.w3.org/2000/svg\"", "", 1)
 }
 

@@ -5,8 +5,8 @@ use askama::Template;
 
 use super::equations::Equations;
 use super::page::{
-    AbstractView, AppendixView, ConclusionsView, PerformanceView, ProblemView, ReportView,
-    ResultsView, SectionNode, SectionView, TheoryView,
+    AbstractView, AppendixView, ConclusionsView, IntroductionView, PerformanceView, ProblemView,
+    ReportView, ResultsView, SectionNode, TheoryView,
 };
 use super::view::{CaseView, SensitivityView};
 
@@ -30,7 +30,10 @@ struct AbstractHtml<'a> {
 
 #[derive(Template)]
 #[template(path = "sections/introduction.html")]
-struct IntroductionHtml;
+struct IntroductionHtml<'a> {
+    #[allow(dead_code)]
+    v: &'a IntroductionView,
+}
 
 #[derive(Template)]
 #[template(path = "sections/problem.html")]
@@ -72,30 +75,6 @@ struct SensitivityHtml<'a> {
 }
 
 #[derive(Template)]
-#[template(path = "sections/allan.html")]
-struct StaticNoiseHtml<'a> {
-    a: &'a crate::allan::section::AllanSection,
-}
-
-#[derive(Template)]
-#[template(path = "sections/drift.html")]
-struct DriftHtml<'a> {
-    d: &'a super::drift::DriftView,
-}
-
-#[derive(Template)]
-#[template(path = "sections/real_drive.html")]
-struct RealDriveHtml<'a> {
-    d: &'a super::real_drive::RealDriveView,
-}
-
-#[derive(Template)]
-#[template(path = "sections/noise.html")]
-struct NoiseHtml<'a> {
-    n: &'a super::noise::NoiseView,
-}
-
-#[derive(Template)]
 #[template(path = "sections/conclusions.html")]
 struct ConclusionsHtml<'a> {
     v: &'a ConclusionsView,
@@ -117,30 +96,26 @@ pub fn section(node: &SectionNode, eq: &Equations) -> Result<String, askama::Err
         .iter()
         .map(|c| section(c, eq))
         .collect::<Result<_, _>>()?;
-    let children_html = children.as_slice();
-    let own = match &node.view {
-        SectionView::Abstract(v) => AbstractHtml { v }.render(),
-        SectionView::Introduction(_) => IntroductionHtml.render(),
-        SectionView::Problem(v) => ProblemHtml { v, eq }.render(),
-        SectionView::Theory(v) => TheoryHtml { v, eq }.render(),
-        SectionView::Results(v) => ResultsHtml { v, children_html }.render(),
-        SectionView::Case(c) => CaseHtml { c }.render(),
-        SectionView::Performance(v) => PerformanceHtml { v }.render(),
-        SectionView::Sensitivity(s) => SensitivityHtml { s }.render(),
-        SectionView::StaticNoise(a) => StaticNoiseHtml { a }.render(),
-        SectionView::Drift(d) => DriftHtml { d }.render(),
-        SectionView::RealDrive(d) => RealDriveHtml { d }.render(),
-        SectionView::Noise(n) => NoiseHtml { n }.render(),
-        SectionView::Conclusions(v) => ConclusionsHtml { v }.render(),
-        SectionView::Appendix(v) => AppendixHtml { v }.render(),
-    }?;
+    let own = node.view.html(eq, &children)?;
     // The results place their subsections; any other section is followed by its own.
-    Ok(match node.view {
-        SectionView::Results(_) => own,
-        _ => [own]
+    Ok(if node.view.places_children() {
+        own
+    } else {
+        [own]
             .into_iter()
             .chain(children)
             .collect::<Vec<_>>()
-            .join("\n"),
+            .join("\n")
     })
 }
+
+crate::section_view!(AbstractView, AbstractHtml { v }, anchor: |_| "abstract".to_string(), title: |_| "Abstract".to_string());
+crate::section_view!(IntroductionView, IntroductionHtml { v }, anchor: |_| "introduction".to_string(), title: |_| "Introduction".to_string());
+crate::section_view!(ProblemView, ProblemHtml { v, eq }, anchor: |_| "problem".to_string(), title: |_| "The problem and its parameters".to_string());
+crate::section_view!(TheoryView, TheoryHtml { v, eq }, anchor: |_| "theory".to_string(), title: |_| "Theory and algorithm".to_string());
+crate::section_view!(ResultsView, ResultsHtml { v, children }, anchor: |_| "results".to_string(), title: |_| "Results and performance".to_string(), places_children: true);
+crate::section_view!(CaseView, CaseHtml { c }, anchor: |c| format!("case-{}", c.id), title: |c| format!("Case {}: {}", c.letter, c.title));
+crate::section_view!(PerformanceView, PerformanceHtml { v }, anchor: |_| "performance".to_string(), title: |_| "Performance".to_string());
+crate::section_view!(SensitivityView, SensitivityHtml { s }, anchor: |_| "sensitivity".to_string(), title: |_| "Sensitivity to the assumed statistics".to_string());
+crate::section_view!(ConclusionsView, ConclusionsHtml { v }, anchor: |_| "conclusions".to_string(), title: |_| "Conclusions".to_string());
+crate::section_view!(AppendixView, AppendixHtml { v }, anchor: |_| "appendix".to_string(), title: |_| "Appendix: configuration and reproduction".to_string());

@@ -1,13 +1,20 @@
 //! The HTML report of a [`Study`]: draws the figures, builds the view, fills the templates. Pure:
 //! it returns the page and its view as text, and the caller writes them.
 //!
-//! Layers: [`outline`] orders the sections and numbers every table, figure and equation;
-//! [`sections`] builds each section's view ([`page`], with the rows and cells of [`view`]) from
-//! the study, with [`prose`] and
-//! [`params`] for the words and the parameter table, [`cases`] for the per-case tables,
-//! [`figures`] for the figures and [`equations`] for every formula as MathML; [`html`] fills one
-//! template per section, and the templates under `templates/` only place that text.
+//! Layers: [`registry`] lists the sections ([`registry::SECTIONS`]), each a
+//! [`kind::SectionKind`] (its place, what it numbers, its view, its data.json record);
+//! [`outline`] orders the sections the study holds and numbers every table, figure and equation;
+//! each section's file builds its view from the study ([`sections`] the core sections, with the
+//! view structs of [`page`] and the rows and cells of [`view`]; [`drift`], [`noise`],
+//! [`real_drive`], [`static_noise`] one optional section each), with [`words`], [`quantities`],
+//! [`findings`] and [`prose`] for the words, [`params`] for the parameter table, [`cases`] for the
+//! per-case tables, [`figures`] for the figures and [`equations`] for every formula as MathML;
+//! [`html`] fills one template per section, and the templates under `templates/` only place that
+//! text. [`json`] assembles view.json and data.json from the sections' parts. [`allan`] is the
+//! page of `accelcal allan`, on the same base template, stylesheet and math; [`calibration`] the
+//! page of a calibration.
 
+pub mod allan;
 pub mod calibration;
 pub mod calibration_diagnosis;
 mod calibration_figures;
@@ -16,27 +23,38 @@ pub mod drift;
 pub mod equations;
 pub mod estimate;
 pub mod figures;
+pub mod findings;
 pub mod html;
+pub mod json;
+pub mod kind;
+pub mod labels;
 pub mod math;
 pub mod noise;
 pub mod outline;
 pub mod page;
 pub mod params;
 pub mod prose;
+pub mod quantities;
 pub mod real_drive;
+pub mod registry;
 pub mod rich;
 pub mod sections;
 pub mod sensitivity;
+pub mod standard;
+pub mod static_noise;
 pub mod view;
+pub mod words;
 
 use askama::Template;
 use base64::Engine;
 
 use crate::study::Study;
 use equations::Equations;
+use kind::SectionKind;
 use math::Math;
-use outline::Outline;
+use outline::{Node, Outline, Section};
 use page::{ReportView, SectionNode, TocEntry};
+use registry::SECTIONS;
 
 /// The report could not be rendered.
 #[derive(Debug, thiserror::Error)]
@@ -104,29 +122,33 @@ pub fn build(
     let study = input.study;
     let numbers = outline.numbers();
     let differences = params::filter_differences(study);
-    let context = sections::Context {
+    let context = kind::Context {
         input,
         numbers: &numbers,
         math,
         differences: &differences,
     };
+    let node = |section: Section| -> Option<Result<SectionNode, RenderError>> {
+        let view = section.kind.build(&context, section.instance)?;
+        Some(view.map(|view| SectionNode {
+            key: section.key(),
+            view: view.into(),
+            children: Vec::new(),
+        }))
+    };
     let sections = outline
         .nodes
         .iter()
-        .map(|node| {
-            Ok(SectionNode {
-                view: context.view(node.section)?,
-                children: node
+        .filter_map(|n: &Node| {
+            let built = node(n.section)?;
+            Some(built.and_then(|mut parent| {
+                parent.children = n
                     .children
                     .iter()
-                    .map(|&c| {
-                        Ok(SectionNode {
-                            view: context.view(c)?,
-                            children: Vec::new(),
-                        })
-                    })
-                    .collect::<Result<_, RenderError>>()?,
-            })
+                    .filter_map(|&c| node(c))
+                    .collect::<Result<_, _>>()?;
+                Ok(parent)
+            }))
         })
         .collect::<Result<Vec<_>, RenderError>>()?;
     Ok(ReportView {
@@ -143,30 +165,30 @@ pub fn build(
     })
 }
 
-/// The outline of the report of `input`: every case, the sensitivity section when the study ran
-/// it, the static-noise section when its coverage is given, the drifting-bias section and the
-/// section on noise statistics from a drive and the real drive's when the study ran them.
+/// The outline of the report of `input`: every section of [`SECTIONS`] the study holds, in
+/// their order.
 pub fn outline_of(input: &ReportInput) -> Outline {
-    let outline = Outline::standard(
-        input.study.cases.len(),
-        input.study.sensitivity.is_some(),
-        input.static_noise.is_some(),
-    );
-    let outline = if input.study.drift.is_some() {
-        outline.with_drift()
-    } else {
-        outline
-    };
-    let outline = if input.study.noise.is_some() {
-        outline.with_noise(input.study.white_noise.is_some())
-    } else {
-        outline
-    };
-    if input.study.real_drive.is_some() {
-        outline.with_real_drive()
-    } else {
-        outline
+    Outline::of(input, SECTIONS)
+}
+
+/// The report's `data.json`: the study's configuration, realization and ensembles, then the
+/// record of every section of [`SECTIONS`] that has one, in their order.
+pub fn data_json(input: &ReportInput) -> String {
+    data_json_of(input, SECTIONS)
+}
+
+/// `data.json` with the records of the sections `kinds`, in their order.
+pub fn data_json_of(input: &ReportInput, kinds: &[&'static dyn SectionKind]) -> String {
+    let (mut text, pretty) = crate::export::report_data_head(input.study);
+    for (key, record) in kinds.iter().filter_map(|k| k.record(input)) {
+        let value = record.to_json(pretty);
+        text = if pretty {
+            json::append(&text, key, &value)
+        } else {
+            json::append_compact(&text, key, &value)
+        };
     }
+    text
 }
 
 /// Renders the report of `input` as HTML, with its view as JSON.
@@ -197,7 +219,7 @@ pub fn render_outline(input: &ReportInput, outline: &Outline) -> Result<Page, Re
         style: &style,
     }
     .render()?;
-    let view_json = serde_json::to_string_pretty(&view).expect("the view is plain text");
+    let view_json = view.to_json();
     Ok(Page {
         html,
         view_json,

@@ -4,15 +4,18 @@
 //! The calibration page's part, a table of the estimates and their profiles, is
 //! [`estimate_html`] (in [`super::estimate`]).
 
+use askama::Template;
 use serde::Serialize;
 
 pub use super::estimate::{estimate_html, estimate_words, profile_series};
 use super::estimate::{interval_words, search_words, symbol, with_unit};
 use super::figures::figure;
-use super::outline::{Figure, Numbers, Table};
-use super::prose::and_list;
+use super::kind::{Built, Context, Record, SectionKind, SectionView};
+use super::outline::{Figure, Label, Numbers, Table};
+
 use super::view::{FigureView, VerdictView};
-use super::{RenderError, rich};
+use super::words::and_list;
+use super::{RenderError, ReportInput, rich};
 use crate::format::{count, fixed, percent};
 use crate::likelihood::Key;
 use crate::plot::{self, RatioSeries};
@@ -336,3 +339,56 @@ pub fn view(
         white_noise_html: white.map_or_else(String::new, |d| rich::rich(&white_noise_words(d))),
     })
 }
+
+/// The section "Noise statistics from a drive", when the study ran it; instance 1 also shows
+/// the white noise's identifiability on two drives, instance 0 does not.
+pub struct Noise;
+
+impl SectionKind for Noise {
+    fn key(&self) -> &'static str {
+        "noise"
+    }
+    fn instances(&self, input: &ReportInput) -> Vec<usize> {
+        let study = input.study;
+        study
+            .noise
+            .iter()
+            .map(|_| usize::from(study.white_noise.is_some()))
+            .collect()
+    }
+    fn labels(&self, white_noise: usize) -> Vec<Label> {
+        let mut labels = vec![
+            Label::Table(Table::NoiseCoverage),
+            Label::Figure(Figure::NoiseEstimates),
+            Label::Figure(Figure::NoiseProfile),
+        ];
+        if white_noise == 1 {
+            labels.push(Label::Table(Table::WhiteNoise));
+        }
+        labels
+    }
+    fn build(&self, ctx: &Context, _: usize) -> Built {
+        let study = ctx.study();
+        let n = study.noise.as_ref()?;
+        Some(
+            view(n, study.white_noise.as_ref(), ctx.numbers)
+                .map(|v| Box::new(v) as Box<dyn SectionView>),
+        )
+    }
+    fn record<'a>(&self, input: &ReportInput<'a>) -> Option<Record<'a>> {
+        let study = input.study;
+        let n = study.noise.as_ref()?;
+        Some((
+            "noise_statistics",
+            Box::new(crate::export::noise::record(n, study.white_noise.as_ref())),
+        ))
+    }
+}
+
+#[derive(Template)]
+#[template(path = "sections/noise.html")]
+struct NoiseHtml<'a> {
+    n: &'a NoiseView,
+}
+
+crate::section_view!(NoiseView, NoiseHtml { n }, anchor: |_| "noise-estimate".to_string(), title: |_| "Noise statistics from a drive".to_string());

@@ -2,11 +2,16 @@
 //! the table of contents. Like every view, fields are text ready for a template (`_html` fields
 //! hold HTML made by [`super::rich::rich`]); the whole page view is written as `view.json`.
 
+use std::sync::Arc;
+
 use serde::Serialize;
 
+use super::json;
+use super::kind::SectionView;
+
 use super::view::{
-    AccuracyRow, CaseView, CatalogueEntry, EquationNumbers, FigureView, ParamRow, PerformanceRow,
-    PredictionRow, SensitivityView, SummaryRow,
+    AccuracyRow, CatalogueEntry, EquationNumbers, FigureView, ParamRow, PerformanceRow,
+    PredictionRow, SummaryRow,
 };
 
 /// The abstract.
@@ -164,91 +169,34 @@ pub struct AppendixView {
     pub config_toml: String,
 }
 
-/// The view of one section (the large ones boxed: a section is built once).
-#[derive(Clone, Debug, Serialize)]
-#[serde(tag = "section", rename_all = "snake_case")]
-pub enum SectionView {
-    /// The abstract.
-    Abstract(AbstractView),
-    /// The introduction.
-    Introduction(IntroductionView),
-    /// The problem and its parameters.
-    Problem(Box<ProblemView>),
-    /// Theory and algorithm.
-    Theory(Box<TheoryView>),
-    /// Results.
-    Results(Box<ResultsView>),
-    /// One case.
-    Case(Box<CaseView>),
-    /// Run times.
-    Performance(PerformanceView),
-    /// Sensitivity to the assumed statistics.
-    Sensitivity(Box<SensitivityView>),
-    /// Noise statistics from a static log.
-    StaticNoise(Box<crate::allan::section::AllanSection>),
-    /// A drifting bias.
-    Drift(Box<super::drift::DriftView>),
-    /// A real drive.
-    RealDrive(Box<super::real_drive::RealDriveView>),
-    /// Noise statistics from a drive.
-    Noise(Box<super::noise::NoiseView>),
-    /// Conclusions.
-    Conclusions(ConclusionsView),
-    /// Configuration and reproduction.
-    Appendix(AppendixView),
-}
-
-impl SectionView {
-    /// The element id of the section.
-    pub fn anchor(&self) -> String {
-        match self {
-            SectionView::Abstract(_) => "abstract".to_string(),
-            SectionView::Introduction(_) => "introduction".to_string(),
-            SectionView::Problem(_) => "problem".to_string(),
-            SectionView::Theory(_) => "theory".to_string(),
-            SectionView::Results(_) => "results".to_string(),
-            SectionView::Case(c) => format!("case-{}", c.id),
-            SectionView::Performance(_) => "performance".to_string(),
-            SectionView::Sensitivity(_) => "sensitivity".to_string(),
-            SectionView::StaticNoise(_) => "allan".to_string(),
-            SectionView::Drift(_) => "drifting-bias".to_string(),
-            SectionView::RealDrive(_) => "real-drive".to_string(),
-            SectionView::Noise(_) => "noise-estimate".to_string(),
-            SectionView::Conclusions(_) => "conclusions".to_string(),
-            SectionView::Appendix(_) => "appendix".to_string(),
-        }
-    }
-
-    /// The section's heading.
-    pub fn title(&self) -> String {
-        match self {
-            SectionView::Abstract(_) => "Abstract".to_string(),
-            SectionView::Introduction(_) => "Introduction".to_string(),
-            SectionView::Problem(_) => "The problem and its parameters".to_string(),
-            SectionView::Theory(_) => "Theory and algorithm".to_string(),
-            SectionView::Results(_) => "Results and performance".to_string(),
-            SectionView::Case(c) => format!("Case {}: {}", c.letter, c.title),
-            SectionView::Performance(_) => "Performance".to_string(),
-            SectionView::Sensitivity(_) => "Sensitivity to the assumed statistics".to_string(),
-            SectionView::StaticNoise(_) => "Noise statistics from a static log".to_string(),
-            SectionView::Drift(_) => "A drifting bias".to_string(),
-            SectionView::RealDrive(_) => "A real drive".to_string(),
-            SectionView::Noise(_) => "Noise statistics from a drive".to_string(),
-            SectionView::Conclusions(_) => "Conclusions".to_string(),
-            SectionView::Appendix(_) => "Appendix: configuration and reproduction".to_string(),
-        }
-    }
-}
-
 /// A section's view and its subsections'.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
 pub struct SectionNode {
-    /// The section.
-    #[serde(flatten)]
-    pub view: SectionView,
+    /// The key of its kind ([`super::kind::SectionKind::key`]): `view.json`'s `"section"`.
+    pub key: &'static str,
+    /// The section's view.
+    pub view: Arc<dyn SectionView>,
     /// Its subsections, in order.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub children: Vec<SectionNode>,
+}
+
+impl SectionNode {
+    /// The view as `V`, when the section's view is one.
+    pub fn get<V: SectionView>(&self) -> Option<&V> {
+        self.view.as_any().downcast_ref::<V>()
+    }
+
+    /// The node as `view.json` shows it: `"section"`, the view's fields, then `"children"`
+    /// when it has subsections.
+    pub fn to_json(&self) -> String {
+        let fields = json::prepend(&self.view.fields_json(), "section", &json::string(self.key));
+        if self.children.is_empty() {
+            fields
+        } else {
+            let children: Vec<String> = self.children.iter().map(SectionNode::to_json).collect();
+            json::append(&fields, "children", &json::array(&children))
+        }
+    }
 }
 
 /// An entry of the table of contents.
@@ -261,7 +209,7 @@ pub struct TocEntry {
 }
 
 /// Everything the report page shows: its sections in the order of the outline.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
 pub struct ReportView {
     /// accelcal version.
     pub version: String,
@@ -271,4 +219,36 @@ pub struct ReportView {
     pub toc: Vec<TocEntry>,
     /// The sections.
     pub sections: Vec<SectionNode>,
+}
+
+impl ReportView {
+    /// Every section and subsection, in reading order.
+    pub fn all(&self) -> impl Iterator<Item = &SectionNode> {
+        self.sections
+            .iter()
+            .flat_map(|n| std::iter::once(n).chain(&n.children))
+    }
+
+    /// The first section whose view is a `V`.
+    pub fn find<V: SectionView>(&self) -> Option<&V> {
+        self.all().find_map(SectionNode::get)
+    }
+
+    /// `view.json`: version, seed, contents and every section, indented.
+    pub fn to_json(&self) -> String {
+        #[derive(Serialize)]
+        struct Head<'a> {
+            version: &'a str,
+            seed: &'a str,
+            toc: &'a [TocEntry],
+        }
+        let head = serde_json::to_string_pretty(&Head {
+            version: &self.version,
+            seed: &self.seed,
+            toc: &self.toc,
+        })
+        .expect("the view is plain text");
+        let sections: Vec<String> = self.sections.iter().map(SectionNode::to_json).collect();
+        json::append(&head, "sections", &json::array(&sections))
+    }
 }

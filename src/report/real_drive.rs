@@ -1,12 +1,15 @@
 //! The section "A real drive": the shipped minute of comma2k19 calibrated as a user would, with
 //! the noise statistics estimated from the drive.
 
+use askama::Template;
 use serde::Serialize;
 
 use super::figures::figure;
-use super::outline::{Figure, Numbers, Table};
+use super::kind::{Built, Context, SectionKind, SectionView};
+use super::outline::{Figure, Label, Numbers, Table};
+
 use super::view::FigureView;
-use super::{RenderError, rich};
+use super::{RenderError, ReportInput, rich};
 use crate::format::{fixed, sig};
 use crate::likelihood::KeyEstimate;
 use crate::plot;
@@ -271,3 +274,34 @@ mod tests {
         assert!(findings(&flipped)[0].contains("does not pass"));
     }
 }
+
+/// The section "A real drive", when the study calibrated it.
+pub struct RealDrive;
+
+impl SectionKind for RealDrive {
+    fn key(&self) -> &'static str {
+        "real_drive"
+    }
+    fn instances(&self, input: &ReportInput) -> Vec<usize> {
+        input.study.real_drive.iter().map(|_| 0).collect()
+    }
+    fn labels(&self, _: usize) -> Vec<Label> {
+        vec![
+            Label::Table(Table::RealDrive),
+            Label::Figure(Figure::RealDriveGravityCompensated),
+            Label::Figure(Figure::RealDriveRaw),
+        ]
+    }
+    fn build(&self, ctx: &Context, _: usize) -> Built {
+        let runs = ctx.study().real_drive.as_ref()?;
+        Some(view(runs, ctx.numbers).map(|v| Box::new(v) as Box<dyn SectionView>))
+    }
+}
+
+#[derive(Template)]
+#[template(path = "sections/real_drive.html")]
+struct RealDriveHtml<'a> {
+    d: &'a RealDriveView,
+}
+
+crate::section_view!(RealDriveView, RealDriveHtml { d }, anchor: |_| "real-drive".to_string(), title: |_| "A real drive".to_string());

@@ -1,126 +1,23 @@
-//! The view of each section of the report, built from the study with every number of the outline
-//! known.
+//! The views of the core sections (abstract, introduction, problem, theory, results, cases,
+//! performance, conclusions), built from the study with every number of the outline known, as
+//! methods of [`Context`]; their kinds are in [`super::standard`].
 
 use super::cases::{self, case_label, states};
 use super::figures;
+use super::kind::Context;
 use super::math::Math;
-use super::outline::{Equation, Figure, Numbers, Section, Table};
+use super::outline::{Equation, Numbers, Table};
 use super::page::{
-    AbstractView, AppendixView, ConclusionsView, IntroductionView, PerformanceView, ProblemView,
-    ResultsView, SectionView, TheoryView,
+    AbstractView, ConclusionsView, PerformanceView, ProblemView, ResultsView, TheoryView,
 };
 use super::view::{CatalogueEntry, EquationNumbers};
-use super::{RenderError, ReportInput, params, prose, rich, sensitivity};
-use crate::allan::section::AllanSection;
+use super::{RenderError, findings, params, prose, quantities, rich, words};
 use crate::format::{count, fixed, percent, short, sig};
 use crate::state::ErrorState;
 use crate::study::Study;
 
-/// What every section is built from.
-pub struct Context<'a> {
-    /// The study and how the page was made.
-    pub input: &'a ReportInput<'a>,
-    /// The number of every table, figure and equation.
-    pub numbers: &'a Numbers,
-    /// The LaTeX → MathML converter.
-    pub math: &'a Math,
-    /// The statistics the filter assumes differently from the truth, in words.
-    pub differences: &'a [String],
-}
-
 impl Context<'_> {
-    fn study(&self) -> &Study {
-        self.input.study
-    }
-
-    /// The static-noise section: the report's simulated static log analysed again, with the
-    /// coverage the study measured.
-    ///
-    /// # Panics
-    /// When the input holds no static-noise coverage.
-    fn static_noise(&self) -> Result<AllanSection, RenderError> {
-        use crate::allan::section::{REPORT_LOG, REPORT_SAMPLES, section};
-        let coverage = self
-            .input
-            .static_noise
-            .expect("the outline shows the static noise only when its coverage is given");
-        let n = self.numbers;
-        let figure = n.figure(Figure::AllanDeviation);
-        let table = n.table(Table::StaticNoise);
-        debug_assert_eq!(n.table(Table::StaticNoiseCoverage), table + 1);
-        Ok(section(
-            &REPORT_LOG,
-            REPORT_SAMPLES,
-            0,
-            coverage,
-            figure,
-            table,
-        )?)
-    }
-
-    /// The view of `section`.
-    ///
-    /// # Errors
-    /// [`RenderError`] when a figure cannot be drawn.
-    ///
-    /// # Panics
-    /// When `section` is the sensitivity section of a study that did not run it.
-    pub fn view(&self, section: Section) -> Result<SectionView, RenderError> {
-        let study = self.study();
-        Ok(match section {
-            Section::Abstract => SectionView::Abstract(self.abstract_view()),
-            Section::Introduction => SectionView::Introduction(IntroductionView {}),
-            Section::Problem => SectionView::Problem(Box::new(self.problem()?)),
-            Section::Theory => SectionView::Theory(Box::new(self.theory())),
-            Section::Results => SectionView::Results(Box::new(self.results()?)),
-            Section::Case(i) => {
-                let o = &study.cases[i];
-                let n = self.numbers;
-                let tables = (n.table(Table::Checks(i)), n.table(Table::Pair(i)));
-                let figures = figures::check_figures(o, i, n)?;
-                let claimed = prose::claimed_sigma(study);
-                SectionView::Case(Box::new(cases::case_view(o, i, tables, figures, claimed)))
-            }
-            Section::Performance => SectionView::Performance(self.performance()),
-            Section::Sensitivity => SectionView::Sensitivity(Box::new(sensitivity::view(
-                study
-                    .sensitivity
-                    .as_ref()
-                    .expect("the outline shows sensitivity only when the study ran it"),
-                self.numbers,
-            )?)),
-            Section::StaticNoise => SectionView::StaticNoise(Box::new(self.static_noise()?)),
-            Section::Drift => SectionView::Drift(Box::new(super::drift::view(
-                study
-                    .drift
-                    .as_ref()
-                    .expect("the outline shows the drifting bias only when the study ran it"),
-                self.numbers,
-            )?)),
-            Section::RealDrive => SectionView::RealDrive(Box::new(super::real_drive::view(
-                study
-                    .real_drive
-                    .as_ref()
-                    .expect("the outline shows the real drive only when the study ran it"),
-                self.numbers,
-            )?)),
-            Section::Noise(_) => SectionView::Noise(Box::new(super::noise::view(
-                study
-                    .noise
-                    .as_ref()
-                    .expect("the outline shows the noise estimate only when the study ran it"),
-                study.white_noise.as_ref(),
-                self.numbers,
-            )?)),
-            Section::Conclusions => SectionView::Conclusions(self.conclusions()),
-            Section::Appendix => SectionView::Appendix(AppendixView {
-                command: self.input.command.to_string(),
-                config_toml: study.model.config.to_toml_string(),
-            }),
-        })
-    }
-
-    fn abstract_view(&self) -> AbstractView {
+    pub(super) fn abstract_view(&self) -> AbstractView {
         let study = self.study();
         let c = &study.model.config;
         let titles: Vec<String> = study.cases[0]
@@ -133,14 +30,14 @@ impl Context<'_> {
             accel_rate: short(c.accelerometer.sample_rate_hz),
             gps_rate: short(c.gps.sample_rate_hz),
             realizations: count(c.ensemble.realizations),
-            check_count: prose::checks_run(study).to_string(),
-            check_titles: prose::and_list(&titles),
+            check_count: quantities::checks_run(study).to_string(),
+            check_titles: words::and_list(&titles),
             false_alarm: percent(c.checks.false_alarm_rate),
-            findings_html: rich::rich(&prose::abstract_findings(study, self.differences)),
+            findings_html: rich::rich(&findings::abstract_findings(study, self.differences)),
         }
     }
 
-    fn problem(&self) -> Result<ProblemView, RenderError> {
+    pub(super) fn problem(&self) -> Result<ProblemView, RenderError> {
         let study = self.study();
         let c = &study.model.config;
         Ok(ProblemView {
@@ -160,39 +57,39 @@ impl Context<'_> {
         })
     }
 
-    fn theory(&self) -> TheoryView {
+    pub(super) fn theory(&self) -> TheoryView {
         let study = self.study();
         let c = &study.model.config;
         let tl = &study.model.timeline;
         TheoryView {
             eqn: equation_numbers(self.numbers),
             steps_per_fix: tl.steps_per_fix.to_string(),
-            euler_velocity_drift: prose::euler_velocity_drift(study),
+            euler_velocity_drift: quantities::euler_velocity_drift(study),
             interval_position_error: sig(
                 tl.dt_s * tl.dt_s * c.profile.accel_amplitude_m_s2 / 12.0,
                 2,
             ),
             realizations: count(c.ensemble.realizations),
             false_alarm: percent(c.checks.false_alarm_rate),
-            false_alarm_share: prose::share_words(
+            false_alarm_share: words::share_words(
                 c.checks.false_alarm_rate,
-                prose::checks_run(study),
+                quantities::checks_run(study),
             ),
-            check_count: prose::checks_run(study).to_string(),
+            check_count: quantities::checks_run(study).to_string(),
             catalogue: catalogue(study, self.math),
             steps: count(tl.steps as u64),
             fixes: count(tl.fixes() as u64),
         }
     }
 
-    fn results(&self) -> Result<ResultsView, RenderError> {
+    pub(super) fn results(&self) -> Result<ResultsView, RenderError> {
         let study = self.study();
         let c = &study.model.config;
         let r = &study.realization;
         let last = r.fixes.last().expect("at least two fixes");
         let first = &study.schedule.fixes[0];
         let n = self.numbers;
-        let claimed = prose::claimed_sigma(study);
+        let claimed = quantities::claimed_sigma(study);
         let (accuracy, mean_error) = figures::comparison_figures(study, n)?;
         let each = |f: &dyn Fn(usize) -> String| (0..study.cases.len()).map(f).collect();
         let (p, v, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
@@ -230,7 +127,7 @@ impl Context<'_> {
         })
     }
 
-    fn performance(&self) -> PerformanceView {
+    pub(super) fn performance(&self) -> PerformanceView {
         let study = self.study();
         PerformanceView {
             table: self.numbers.table(Table::Performance),
@@ -242,7 +139,7 @@ impl Context<'_> {
         }
     }
 
-    fn conclusions(&self) -> ConclusionsView {
+    pub(super) fn conclusions(&self) -> ConclusionsView {
         let n = self.numbers;
         ConclusionsView {
             paragraphs_html: prose::conclusions(
@@ -305,8 +202,8 @@ fn realization_case(study: &Study) -> String {
         .unwrap_or(0);
     format!(
         "case {} ({})",
-        prose::letter(i),
-        prose::case_title(study.realization_case)
+        words::letter(i),
+        words::case_title(study.realization_case)
     )
 }
 

@@ -1,12 +1,83 @@
-//! The page of `accelcal allan` and the report's section on it, as views of formatted text and
-//! the askama templates `allan.html` and `sections/allan.html`. Pure: HTML out, no IO.
+//! The page of `accelcal allan` (its view, its template `allan.html` on the report's base
+//! template, stylesheet and math) and the Allan figure the report's static-noise section shares
+//! with it, drawn by [`crate::plot::allan_deviation`]. Pure: HTML out, no IO.
 
 use askama::Template;
 use serde::Serialize;
 
-use super::figure::allan_plot;
-use super::{Analysis, Term, TermEstimate};
+use super::figures::figure;
+use super::math::Math;
+use super::view::FigureView;
+use super::{RenderError, stylesheet};
+use crate::allan::{Analysis, Term, TermEstimate};
 use crate::format::{count, sig};
+use crate::plot::{self, AllanMark, AllanSeries, TermCurve};
+
+/// The fitted model of the Allan variance (IEEE Std 952, annex C), as LaTeX.
+const MODEL: &str = r"\sigma^2(\tau) = \frac{3Q^2}{\tau^2} + \frac{N^2}{\tau} + \frac{2\ln 2}{\pi}B^2 + \frac{K^2\tau}{3}";
+
+/// Points along each curve of the figure.
+pub const CURVE_POINTS: usize = 200;
+
+/// The label of a term's line.
+fn term_label(term: Term) -> &'static str {
+    match term {
+        Term::Quantization => "Q: slope −1",
+        Term::VelocityRandomWalk => "N: slope −½",
+        Term::BiasInstability => "B: slope 0",
+        Term::AccelerationRandomWalk => "K: slope +½",
+    }
+}
+
+/// The figure's data: the deviation at every τ, each resolved term's σ(τ) and the fitted sum,
+/// evaluated at [`CURVE_POINTS`] log-spaced τ over the whole decades the points span.
+pub fn series(a: &Analysis) -> AllanSeries {
+    let decades = |f: fn(f64, f64) -> f64, start: f64| {
+        a.points.iter().map(|p| p.tau_s.log10()).fold(start, f)
+    };
+    let (x0, x1) = (
+        decades(f64::min, f64::INFINITY).floor(),
+        decades(f64::max, f64::NEG_INFINITY).ceil(),
+    );
+    let x1 = x1.max(x0 + 1.0);
+    let taus: Vec<f64> = (0..=CURVE_POINTS)
+        .map(|i| 10f64.powf(x0 + (x1 - x0) * i as f64 / CURVE_POINTS as f64))
+        .collect();
+    let curve = |sigma: &dyn Fn(f64) -> f64| taus.iter().map(|&t| (t, sigma(t))).collect();
+    AllanSeries {
+        marks: a
+            .points
+            .iter()
+            .map(|p| AllanMark {
+                tau_s: p.tau_s,
+                adev: p.adev,
+                interval: p.interval,
+            })
+            .collect(),
+        terms: a
+            .fit
+            .terms
+            .iter()
+            .filter(|t| t.value.is_some())
+            .map(|t| TermCurve {
+                label: term_label(t.term).to_string(),
+                slot: Term::ALL.iter().position(|&u| u == t.term).unwrap_or(0),
+                points: curve(&|tau| (t.squared * t.term.coefficient(tau)).sqrt()),
+            })
+            .collect(),
+        sum: curve(&|tau| a.fit.avar_at(tau).max(0.0).sqrt()),
+    }
+}
+
+/// The page.
+#[derive(Template)]
+#[template(path = "allan.html")]
+pub struct AllanPage<'a> {
+    /// The view.
+    pub v: &'a AllanView,
+    /// The stylesheet.
+    pub style: &'a str,
+}
 
 /// Standard gravity, m/s² (for µg).
 pub const STANDARD_GRAVITY_M_S2: f64 = 9.80665;
@@ -48,24 +119,17 @@ pub struct AllanView {
     pub extent: String,
     /// The confidence as a percentage.
     pub confidence: String,
-    /// The Allan plot (SVG).
-    pub svg: String,
+    /// The Allan plot.
+    pub figure: FigureView,
+    /// The fitted model σ²(τ), as MathML (left out of view.json).
+    #[serde(skip)]
+    pub model_math: String,
     /// The terms.
     pub terms: Vec<TermRow>,
     /// The deviation at every τ.
     pub points: Vec<PointRow>,
     /// The command that wrote the page.
     pub command: String,
-}
-
-/// The page.
-#[derive(Template)]
-#[template(path = "allan.html")]
-pub struct AllanPage<'a> {
-    /// The view.
-    pub v: &'a AllanView,
-    /// The stylesheet.
-    pub style: &'a str,
 }
 
 fn range(t: &TermEstimate, scale: f64, digits: usize) -> String {
@@ -142,8 +206,26 @@ fn point_rows(a: &Analysis) -> Vec<PointRow> {
 }
 
 /// The view of an analysis of the log `source`, written by `command`.
-pub fn view(a: &Analysis, source: &str, command: &str) -> AllanView {
-    AllanView {
+///
+/// # Errors
+/// [`RenderError`] when the figure cannot be drawn.
+pub fn view(
+    a: &Analysis,
+    source: &str,
+    command: &str,
+    math: &Math,
+) -> Result<AllanView, RenderError> {
+    let confidence = sig(100.0 * a.confidence, 3);
+    let figure = figure(
+        "allan-plot",
+        1,
+        "The Allan deviation of the log",
+        &format!(
+            "The overlapping Allan deviation (dots) at octave-spaced τ with its {confidence} % χ² intervals (whiskers; equivalent degrees of freedom of Greenhall and Riley for the noise identified at each τ by its lag-1 autocorrelation), each resolved noise term as a line of its slope, and their sum (grey)."
+        ),
+        plot::allan_deviation(&series(a)),
+    )?;
+    Ok(AllanView {
         version: env!("CARGO_PKG_VERSION").to_string(),
         source: source.to_string(),
         extent: format!(
@@ -153,20 +235,25 @@ pub fn view(a: &Analysis, source: &str, command: &str) -> AllanView {
             sig(1.0 / a.sample_period_s, 6),
             sig(a.samples as f64 * a.sample_period_s, 4)
         ),
-        confidence: sig(100.0 * a.confidence, 3),
-        svg: allan_plot(a),
+        confidence,
+        figure,
+        model_math: math.inline(MODEL),
         terms: a.fit.terms.iter().map(term_row).collect(),
         points: point_rows(a),
         command: command.to_string(),
-    }
+    })
 }
 
-/// The page of an analysis.
+/// The page of an analysis of the log `source`, written by `command`.
 ///
 /// # Errors
-/// When the template cannot be filled.
-pub fn render(a: &Analysis, source: &str, command: &str) -> Result<String, askama::Error> {
-    let v = view(a, source, command);
-    let style = include_str!("../../assets/report.css");
-    AllanPage { v: &v, style }.render()
+/// [`RenderError`] when the figure cannot be drawn or the template cannot be filled.
+pub fn render(a: &Analysis, source: &str, command: &str) -> Result<String, RenderError> {
+    let v = view(a, source, command, &Math::new())?;
+    let style = stylesheet();
+    Ok(AllanPage {
+        v: &v,
+        style: &style,
+    }
+    .render()?)
 }
