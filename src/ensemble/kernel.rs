@@ -14,7 +14,10 @@ use crate::state::ErrorState;
 use crate::state::step::{Euler, accel_output};
 
 // The truth below is the error state written out component by component.
-const _: () = assert!(ErrorState::DIM == 3 && ErrorState::MEAS == 2);
+const _: () = assert!(
+    ErrorState::DIM == 3 && ErrorState::MEAS == 2,
+    "ensemble/kernel.rs: simulate the new state's truth in SampleGroup::next_fix (as simulation.rs)"
+);
 
 /// The lane mask of a group with `active` realizations: 1 for the active lanes, 0 for the rest.
 pub(super) fn lane_mask(active: usize) -> Lanes {
