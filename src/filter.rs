@@ -153,7 +153,10 @@ impl FixCovariance {
         [T; ErrorState::MEAS],
     ) {
         // Written out for the error state's three states and two measured components.
-        const _: () = assert!(ErrorState::DIM == 3 && ErrorState::MEAS == 2);
+        const _: () = assert!(
+            ErrorState::DIM == 3 && ErrorState::MEAS == 2,
+            "filter.rs: write FixCovariance::step's rows out for the new state or measurement"
+        );
         let phi = &self.phi_from_previous;
         // Written out row by row (no `std::array::from_fn`), so that every operation is inlined
         // into the vectorized callers.

@@ -7,9 +7,11 @@
 
 use crate::config::{Case, TruthModel};
 use crate::filter::FilterSchedule;
+use crate::lanes::Real;
 use crate::model::Model;
 pub use crate::random::Stream;
 use crate::random::splitmix64;
+use crate::state::step::{Euler, accel_output};
 use crate::state::{ErrorState, MeasVector, StateVector};
 
 /// The key of the random streams of `case` under `seed`: realization l draws from
@@ -211,7 +213,7 @@ fn run_with<N: Noise, O: Observer>(
                 end
             }
         };
-        let ac = model.accel_m_s2[tl.steps] + bias + run.w_sigma * rng.normal();
+        let ac = accel_output(model.accel_m_s2[tl.steps], bias, run.w_sigma, rng.normal());
         observer.sample(&run.sample(tl.steps, end, bias, ac));
     }
     draws
@@ -228,6 +230,13 @@ pub struct BiasDrift {
 }
 
 impl BiasDrift {
+    /// The bias after one step from `b`, with the standard normal increment `eta`:
+    /// φ·b + √q_b·η_b, for one realization or a lane group (the same bits).
+    #[inline(always)]
+    pub fn advance<R: Real>(self, b: R, eta: R) -> R {
+        R::splat(self.phi) * b + R::splat(self.sigma_m_s2) * eta
+    }
+
     /// The drift of `model`'s truth over one step, `None` for a constant bias.
     pub fn of(model: &Model) -> Option<Self> {
         let ts = &model.truth_stats;
@@ -249,22 +258,18 @@ struct Run<'a> {
     drift: Option<BiasDrift>,
     /// σ of the accelerometer's white noise w, m/s².
     w_sigma: f64,
-    /// Sample interval Δt, s.
-    dt: f64,
-    /// Δt²/2, s².
-    half_dt2: f64,
+    /// The step of eqs. (3) and (4).
+    euler: Euler,
 }
 
 impl<'a> Run<'a> {
     fn new(model: &'a Model, draws: Draws) -> Self {
-        let dt = model.timeline.dt_s;
         Run {
             model,
             draws,
             drift: BiasDrift::of(model),
             w_sigma: model.truth_stats.accel_noise_var_m2_s4.sqrt(),
-            dt,
-            half_dt2: 0.5 * dt * dt,
+            euler: Euler::new(model.timeline.dt_s),
         }
     }
 
@@ -306,21 +311,18 @@ impl<'a> Run<'a> {
         rng: &mut N,
         obs: &mut O,
     ) -> [f64; 4] {
-        let (b, w_sigma, dt, half_dt2) =
-            (self.draws.bias_m_s2, self.w_sigma, self.dt, self.half_dt2);
+        let (b, w_sigma, euler) = (self.draws.bias_m_s2, self.w_sigma, self.euler);
         let [mut pc, mut vc, mut pe, mut ve] = state;
         for (k, &a) in self.model.accel_m_s2[j..end].iter().enumerate() {
             // eq. (2): the accelerometer's output.
-            let ac = a + b + w_sigma * rng.normal();
+            let ac = accel_output(a, b, w_sigma, rng.normal());
             if O::SAMPLES {
                 obs.sample(&self.sample(j + k, [pc, vc, pe, ve], b, ac));
             }
             // eq. (3): position uses the velocity before the step.
-            pc += vc * dt + ac * half_dt2;
-            vc += ac * dt;
+            (pc, vc) = euler.step((pc, vc), ac);
             // eq. (4): the true acceleration through the same formula.
-            pe += ve * dt + a * half_dt2;
-            ve += a * dt;
+            (pe, ve) = euler.step((pe, ve), a);
         }
         [pc, vc, pe, ve]
     }
@@ -338,20 +340,18 @@ impl<'a> Run<'a> {
         rng: &mut N,
         obs: &mut O,
     ) -> ([f64; 4], f64) {
-        let (w_sigma, dt, half_dt2) = (self.w_sigma, self.dt, self.half_dt2);
+        let (w_sigma, euler) = (self.w_sigma, self.euler);
         let [mut pc, mut vc, mut pe, mut ve] = state;
         let mut b = bias;
         for (k, &a) in self.model.accel_m_s2[j..end].iter().enumerate() {
             // eq. (2): the accelerometer's output, the bias held over the step.
-            let ac = a + b + w_sigma * rng.normal();
+            let ac = accel_output(a, b, w_sigma, rng.normal());
             if O::SAMPLES {
                 obs.sample(&self.sample(j + k, [pc, vc, pe, ve], b, ac));
             }
-            pc += vc * dt + ac * half_dt2;
-            vc += ac * dt;
-            pe += ve * dt + a * half_dt2;
-            ve += a * dt;
-            b = drift.phi * b + drift.sigma_m_s2 * rng.normal();
+            (pc, vc) = euler.step((pc, vc), ac);
+            (pe, ve) = euler.step((pe, ve), a);
+            b = drift.advance(b, rng.normal());
         }
         ([pc, vc, pe, ve], b)
     }
@@ -383,6 +383,15 @@ impl<'a> Run<'a> {
         (delta_x, measurement(zp, zv), measurement(zp - pc, zv - vc))
     }
 }
+
+// A GPS measurement is (position, velocity), and the true error state (δp, δv, b) is simulated
+// component by component (`Run::measure`, `SampleState::delta_x`): a new state or measured
+// component needs its truth simulated here, in `error_state` and `measurement`, before the
+// program compiles again.
+const _: () = assert!(
+    ErrorState::DIM == 3 && ErrorState::MEAS == 2,
+    "simulation.rs: simulate the new state's truth (error_state, Run::measure, SampleState)"
+);
 
 /// A GPS measurement (or its difference to the integration) from its position and velocity.
 pub fn measurement(position_m: f64, velocity_m_s: f64) -> MeasVector {

@@ -11,12 +11,17 @@
 //! (δp, δv). Its named indices ([`ErrorState::POSITION`], [`ErrorState::VELOCITY`],
 //! [`ErrorState::BIAS`]) and sizes ([`ErrorState::DIM`], [`ErrorState::MEAS`]) are the only place
 //! the numbers 0, 1, 2, 3 of the state appear.
+//!
+//! One accelerometer step — its output (eq. 2), its Euler integration (eq. 3), Φ, Γ and Q of
+//! eq. (5) — is written once, in [`step`], for every caller.
 
 use nalgebra::{SMatrix, SVector};
 
 mod bias;
+pub mod step;
 
 pub use bias::BiasModel;
+pub use step::{process_noise, transition};
 
 /// Noise statistics of the error-state system: the truth's, or the ones the filter assumes.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -153,45 +158,6 @@ pub type StateMatrix = SMatrix<f64, { ErrorState::DIM }, { ErrorState::DIM }>;
 pub type MeasVector = SVector<f64, { ErrorState::MEAS }>;
 /// A measurement-space matrix: R, S.
 pub type MeasMatrix = SMatrix<f64, { ErrorState::MEAS }, { ErrorState::MEAS }>;
-
-/// Transition Φ(τ) of the error state over τ seconds, eq. (5) composed over τ/Δt steps.
-///
-/// # Formula
-/// ```text
-/// Φ(τ) = [1  τ  −τ²/2]
-///        [0  1  −τ   ]
-///        [0  0   1   ]
-/// ```
-/// Φ is unipotent (Φ − I is nilpotent), so Φ(Δt)ⁿ = Φ(n·Δt) exactly.
-///
-/// # Examples
-/// ```
-/// use accelcal::state::transition;
-/// let phi = transition(0.005);
-/// let phi40 = transition(0.2);
-/// assert!((phi.pow(40) - phi40).norm() < 1e-12);
-/// ```
-pub fn transition(tau_s: f64) -> StateMatrix {
-    let mut phi = StateMatrix::identity();
-    // eq. (5): velocity error moves position, the bias enters velocity with −τ and position
-    // with −τ²/2.
-    phi[(ErrorState::POSITION, ErrorState::VELOCITY)] = tau_s;
-    phi[(ErrorState::POSITION, ErrorState::BIAS)] = -0.5 * tau_s * tau_s;
-    phi[(ErrorState::VELOCITY, ErrorState::BIAS)] = -tau_s;
-    phi
-}
-
-/// Process noise covariance Q(τ) = Γ·W·Γᵀ of one accelerometer step of τ seconds, (m, m/s, m/s²)².
-///
-/// # Formula
-/// Γ = −(τ²/2, τ, 0)ᵀ (eq. 5: the noise enters position with −τ²/2 and velocity with −τ), W the
-/// accelerometer's white-noise variance `accel_noise_var_m2_s4`.
-pub fn process_noise(tau_s: f64, accel_noise_var_m2_s4: f64) -> StateMatrix {
-    let mut gamma = StateVector::zeros();
-    gamma[ErrorState::POSITION] = -0.5 * tau_s * tau_s;
-    gamma[ErrorState::VELOCITY] = -tau_s;
-    gamma * gamma.transpose() * accel_noise_var_m2_s4
-}
 
 impl StateModel<{ ErrorState::DIM }, { ErrorState::MEAS }> for ErrorState {
     const STATES: [Variable; ErrorState::DIM] = [

@@ -8,7 +8,15 @@ use crate::error::FilterError;
 use crate::filter::{ErrorStateModel, propagate_over};
 use crate::logs::GpsFix;
 use crate::simulation::measurement;
+use crate::state::step::Euler;
 use crate::state::{ErrorState, MeasMatrix, MeasVector, StateMatrix, StateModel, StateVector};
+
+// `Forward::transition_to` inverts the error state's Φ in closed form, entry by entry: a new
+// state needs its row and column of the inverse there.
+const _: () = assert!(
+    ErrorState::DIM == 3,
+    "calibrate/forward.rs: add the new state to Forward::transition_to's closed-form inverse"
+);
 
 use super::StepMode;
 use super::integration::Integrated;
@@ -105,8 +113,8 @@ pub struct Forward<'m> {
     /// The error state the filter assumes, for steps of their own length.
     state: ErrorState,
     mode: StepMode,
-    /// Δt²/2 of the nominal step, s², written as in the simulation so that the bits agree.
-    half_dt2_s2: f64,
+    /// The nominal step of eq. (3), as the simulation's, so that the bits agree.
+    nominal: Euler,
     /// Index of the current sample.
     pub k: u64,
     /// Its time stamp, s.
@@ -139,12 +147,11 @@ impl<'m> Forward<'m> {
         start: Integrated,
         t0_s: f64,
     ) -> Self {
-        let dt = model.dt_s;
         Self {
             model,
             state,
             mode,
-            half_dt2_s2: 0.5 * dt * dt,
+            nominal: Euler::new(model.dt_s),
             k: 0,
             t_s: t0_s,
             filter_t_s: t0_s,
@@ -165,9 +172,7 @@ impl<'m> Forward<'m> {
         match self.mode {
             StepMode::Nominal => {
                 // The simulation's recursion, operation for operation.
-                let dt = self.model.dt_s;
-                self.pc_m += self.vc_m_s * dt + a * self.half_dt2_s2;
-                self.vc_m_s += a * dt;
+                (self.pc_m, self.vc_m_s) = self.nominal.step((self.pc_m, self.vc_m_s), a);
                 self.x = self.model.phi * self.x;
                 self.p = self.model.propagate(&self.p);
                 if !self.composes {
@@ -177,11 +182,9 @@ impl<'m> Forward<'m> {
             }
             StepMode::PerStep => {
                 let dt = t_next_s - self.t_s;
-                let half_dt2 = 0.5 * dt * dt;
                 // eq. (3) with this step's Δt_j; Φ(Δt_j) and Q(Δt_j) for eq. (5), from the last
                 // fix when one cut the step.
-                self.pc_m += self.vc_m_s * dt + a * half_dt2;
-                self.vc_m_s += a * dt;
+                (self.pc_m, self.vc_m_s) = Euler::new(dt).step((self.pc_m, self.vc_m_s), a);
                 // The rest of a step a fix cut is a piece of it.
                 let cut = (self.filter_t_s != self.t_s).then_some(dt);
                 self.propagate_to(t_next_s, cut);
@@ -194,7 +197,7 @@ impl<'m> Forward<'m> {
 
     /// The estimate and its covariance carried from their time to `t_s` (per-step mode): a
     /// whole step, or a piece of the step of `cut` = Some(Δt_j) that a fix cuts, whose white
-    /// noise is taken as white within the step ([`super::pass::NoiseUnits::add_piece`]).
+    /// noise is taken as white within the step ([`ErrorState::piece_noise`]).
     fn propagate_to(&mut self, t_s: f64, cut: Option<f64>) {
         let tau = t_s - self.filter_t_s;
         let phi = self.state.transition(self.filter_t_s, tau);
@@ -202,7 +205,8 @@ impl<'m> Forward<'m> {
         self.p = match cut {
             None => propagate_over(&self.state, &self.p, self.filter_t_s, tau),
             Some(step_s) => {
-                let p = phi * self.p * phi.transpose() + self.piece_noise(tau, step_s);
+                let q = self.state.piece_noise(self.filter_t_s, tau, step_s);
+                let p = phi * self.p * phi.transpose() + q;
                 (p + p.transpose()) * 0.5
             }
         };
@@ -210,23 +214,6 @@ impl<'m> Forward<'m> {
             self.phi_since_fix = phi * self.phi_since_fix;
         }
         self.filter_t_s = t_s;
-    }
-
-    /// Q of a piece of `tau_s` of a step of `step_s`: W·Δt_j·[[τ³/3, τ²/2], [τ²/2, τ]] and the
-    /// bias's own q_b(τ).
-    fn piece_noise(&self, tau_s: f64, step_s: f64) -> StateMatrix {
-        let (p, v, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
-        let stats = &self.state.stats;
-        let q = stats.accel_noise_var_m2_s4 * step_s;
-        let mut m = StateMatrix::zeros();
-        m[(p, p)] = q * tau_s * tau_s * tau_s / 3.0;
-        m[(p, v)] = q * 0.5 * tau_s * tau_s;
-        m[(v, p)] = m[(p, v)];
-        m[(v, v)] = q * tau_s;
-        if stats.bias_model.drifts() {
-            m[(b, b)] = stats.bias_model.step(tau_s, stats.bias_var_m2_s4).1;
-        }
-        m
     }
 
     /// Whether the time stamp, the integration, the estimate and its covariance are finite.

@@ -1,5 +1,8 @@
 //! The integration of eq. (3) at the heart of a calibration: (p_c, v_c), where it starts (the
-//! prior or the first fix), and the time a fix is applied at.
+//! prior or the first fix), and the time a fix is applied at. The step itself is
+//! [`Euler::step`], the simulation's.
+
+use crate::state::step::Euler;
 
 /// Integrated accelerometer (p_c, v_c), (m, m/s).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -11,11 +14,14 @@ pub struct Integrated {
 }
 
 impl Integrated {
-    /// eq. (3) over a step of `dt` with `half_dt2` = Δt²/2, written as the simulation does.
+    /// eq. (3) over a step of `dt` with `half_dt2` = Δt²/2: [`Euler::step`], the simulation's.
     #[inline]
     pub fn advance(&mut self, a: f64, dt: f64, half_dt2: f64) {
-        self.pc_m += self.vc_m_s * dt + a * half_dt2;
-        self.vc_m_s += a * dt;
+        let euler = Euler {
+            dt_s: dt,
+            half_dt2_s2: half_dt2,
+        };
+        (self.pc_m, self.vc_m_s) = euler.step((self.pc_m, self.vc_m_s), a);
     }
 
     /// Whether both are finite.
@@ -27,7 +33,8 @@ impl Integrated {
     pub fn advanced(self, a: f64, tau_s: f64) -> Self {
         let mut out = self;
         if tau_s != 0.0 {
-            out.advance(a, tau_s, 0.5 * tau_s * tau_s);
+            let euler = Euler::new(tau_s);
+            out.advance(a, euler.dt_s, euler.half_dt2_s2);
         }
         out
     }

@@ -12,7 +12,10 @@ use super::nis::NisTest;
 use super::smoother::SmoothedFix;
 
 // The columns and records below name the three states of the error state one by one.
-const _: () = assert!(ErrorState::DIM == 3);
+const _: () = assert!(
+    ErrorState::DIM == 3,
+    "calibrate/summary.rs: add the new state's columns and records"
+);
 
 /// Columns of `estimates.csv`: one row per accelerometer sample. Filtered values are a
 /// posteriori at a fix; corrected position and velocity are the integration plus the estimated

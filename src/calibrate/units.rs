@@ -5,7 +5,10 @@ use crate::model::NoiseStats;
 use crate::state::{BiasModel, ErrorState, StateMatrix, transition};
 
 // The unit contributions below are written out for the error state's (δp, δv, b).
-const _: () = assert!(ErrorState::DIM == 3);
+const _: () = assert!(
+    ErrorState::DIM == 3,
+    "calibrate/units.rs: add the new state's noise units to NoiseUnits"
+);
 
 /// The process noise of an interval per unit of each noise statistic: Q = W·U_W + s_b·U_b for
 /// the accelerometer's white-noise variance W and the bias's noise scale s_b (K² for a random

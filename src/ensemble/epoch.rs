@@ -32,7 +32,10 @@ use crate::simulation::{FixState, Observer, run_noise_free};
 use crate::state::{ErrorState, StateMatrix, StateModel};
 
 // The interval draw below is the error state written out component by component.
-const _: () = assert!(ErrorState::DIM == 3 && ErrorState::MEAS == 2);
+const _: () = assert!(
+    ErrorState::DIM == 3 && ErrorState::MEAS == 2,
+    "ensemble/epoch.rs: draw the new state in EpochGroup (next_fix, next_drifting)"
+);
 
 /// What the epoch engine needs of a model, computed once per ensemble.
 #[derive(Clone, Debug, PartialEq)]

@@ -11,9 +11,13 @@ use crate::model::Model;
 use crate::random::LaneStreams;
 use crate::simulation::BiasDrift;
 use crate::state::ErrorState;
+use crate::state::step::{Euler, accel_output};
 
 // The truth below is the error state written out component by component.
-const _: () = assert!(ErrorState::DIM == 3 && ErrorState::MEAS == 2);
+const _: () = assert!(
+    ErrorState::DIM == 3 && ErrorState::MEAS == 2,
+    "ensemble/kernel.rs: simulate the new state's truth in SampleGroup::next_fix (as simulation.rs)"
+);
 
 /// The lane mask of a group with `active` realizations: 1 for the active lanes, 0 for the rest.
 pub(super) fn lane_mask(active: usize) -> Lanes {
@@ -85,8 +89,7 @@ impl<const EULER: bool> LaneGroup for SampleGroup<'_, EULER> {
         let ts = &model.truth_stats;
         let s = Lanes::splat;
         let tl = &model.timeline;
-        let dt = tl.dt_s;
-        let half_dt2 = 0.5 * dt * dt;
+        let euler = Euler::new(tl.dt_s);
         let w_sigma = s(ts.accel_noise_var_m2_s4.sqrt());
         let mut b = self.b;
         let jf = tl.fix_steps[i];
@@ -94,16 +97,13 @@ impl<const EULER: bool> LaneGroup for SampleGroup<'_, EULER> {
         let mut j = self.j;
         if let Some(drift) = self.drift {
             // As simulation::Run::integrate_drifting: w, then the bias's increment, per sample.
-            let (phi, sigma) = (s(drift.phi), s(drift.sigma_m_s2));
             for &a in &model.accel_m_s2[j..jf] {
-                let ac = (s(a) + b) + w_sigma * self.rng.normal();
-                pc += vc * s(dt) + ac * s(half_dt2);
-                vc += ac * s(dt);
+                let ac = accel_output(s(a), b, w_sigma, self.rng.normal());
+                (pc, vc) = euler.step((pc, vc), ac);
                 if EULER {
-                    pe += ve * s(dt) + s(a * half_dt2);
-                    ve += s(a * dt);
+                    (pe, ve) = euler.step((pe, ve), s(a));
                 }
-                b = phi * b + sigma * self.rng.normal();
+                b = drift.advance(b, self.rng.normal());
             }
             self.b = b;
             j = jf;
@@ -114,12 +114,10 @@ impl<const EULER: bool> LaneGroup for SampleGroup<'_, EULER> {
             let w = self.rng.normals(jf - j);
             for (&a, &w) in model.accel_m_s2[j..].iter().zip(w) {
                 // eq. (2), then eq. (3); eq. (4) for the Euler truth.
-                let ac = (s(a) + b) + w_sigma * w;
-                pc += vc * s(dt) + ac * s(half_dt2);
-                vc += ac * s(dt);
+                let ac = accel_output(s(a), b, w_sigma, w);
+                (pc, vc) = euler.step((pc, vc), ac);
                 if EULER {
-                    pe += ve * s(dt) + s(a * half_dt2);
-                    ve += s(a * dt);
+                    (pe, ve) = euler.step((pe, ve), s(a));
                 }
             }
             j += w.len();

@@ -4,7 +4,10 @@
 use crate::state::{BiasModel, ErrorState, NoiseStats, StateMatrix};
 
 // The recursion below is written out for the error state's (δp, δv, b) and (p, v) fixes.
-const _: () = assert!(ErrorState::DIM == 3 && ErrorState::MEAS == 2);
+const _: () = assert!(
+    ErrorState::DIM == 3 && ErrorState::MEAS == 2,
+    "likelihood/evaluate.rs: write Drive::log_likelihood's recursion out for the new state"
+);
 const _: () = assert!(
     ErrorState::POSITION == 0
         && ErrorState::VELOCITY == 1

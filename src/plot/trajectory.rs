@@ -71,6 +71,12 @@ pub fn trajectory(r: &Realization) -> PlotResult {
 const DRIFT_INDEX: [usize; ROWS] = [ErrorState::BIAS, ErrorState::VELOCITY, ErrorState::POSITION];
 /// Rows of the figure: acceleration, velocity, position.
 const ROWS: usize = 3;
+// One right-hand row per state: a new state needs its row here (its DRIFT_INDEX entry, its
+// DRIFT_TITLES pair and the left-hand panel of motion_axes) before the program compiles again.
+const _: () = assert!(
+    ErrorState::DIM == ROWS,
+    "plot/trajectory.rs: the trajectory figure draws one row per state; add the new state's row"
+);
 
 /// The right-hand titles: in full, and shortened for a note on what the axis clips.
 const DRIFT_TITLES: [(&str, &str); ROWS] = [
