@@ -211,14 +211,16 @@ pub struct CalibrateArgs {
     #[arg(long)]
     pub estimate_noise: bool,
     /// The statistics --estimate-noise searches [default: the two GPS σ's, and
-    /// bias_random_walk_m_s2_per_sqrt_s when the filter's bias is a random walk].
+    /// bias_random_walk_m_s2_per_sqrt_s when the filter's bias is a random walk; naming it makes
+    /// a constant bias a random walk].
     #[arg(
         long,
         value_name = "KEY,…",
         value_delimiter = ',',
-        requires = "estimate_noise"
+        requires = "estimate_noise",
+        value_parser = estimate_keys()
     )]
-    pub estimate: Vec<EstimateArg>,
+    pub estimate: Vec<Key>,
     /// The confidence of --estimate-noise's intervals, in (0, 1).
     #[arg(long, value_name = "P", default_value_t = 0.95, value_parser = confidence,
           requires = "estimate_noise")]
@@ -228,32 +230,19 @@ pub struct CalibrateArgs {
     pub quiet: bool,
 }
 
-/// A statistic `--estimate` names: its [filter] key.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum EstimateArg {
-    /// GPS position noise σ, m.
-    #[value(name = "gps_position_sigma_m")]
-    GpsPositionSigmaM,
-    /// GPS velocity noise σ, m/s.
-    #[value(name = "gps_velocity_sigma_m_s")]
-    GpsVelocitySigmaMS,
-    /// Accelerometer white-noise variance W, (m/s²)².
-    #[value(name = "accel_noise_var_m2_s4")]
-    AccelNoiseVarM2S4,
-    /// The bias's random-walk K, m/s² per √s (a constant bias becomes a random walk).
-    #[value(name = "bias_random_walk_m_s2_per_sqrt_s")]
-    BiasRandomWalk,
-}
-
-impl From<EstimateArg> for Key {
-    fn from(arg: EstimateArg) -> Self {
-        match arg {
-            EstimateArg::GpsPositionSigmaM => Key::GpsPosition,
-            EstimateArg::GpsVelocitySigmaMS => Key::GpsVelocity,
-            EstimateArg::AccelNoiseVarM2S4 => Key::AccelNoiseVar,
-            EstimateArg::BiasRandomWalk => Key::BiasRandomWalk,
-        }
-    }
+/// The statistics `--estimate` accepts, each named by its `[filter]` key: every searchable row of
+/// the statistics' table ([`Key::ALL`]), with its words and unit as help.
+fn estimate_keys() -> impl TypedValueParser<Value = Key> {
+    let values = Key::ALL.map(|k| {
+        let words = k.0.words;
+        let mut help = words[..1].to_uppercase();
+        help.push_str(&words[1..]);
+        help.push_str(", ");
+        help.push_str(k.unit());
+        clap::builder::PossibleValue::new(k.name()).help(help)
+    });
+    clap::builder::PossibleValuesParser::new(values)
+        .map(|name| Key::parse(&name).expect("a possible value is a key's name"))
 }
 
 /// A confidence strictly between 0 and 1.

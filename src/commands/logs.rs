@@ -228,7 +228,7 @@ fn noise_request(args: &CalibrateArgs, settings: &Settings) -> Result<Option<Req
         return Ok(None);
     }
     let stats = &settings.filter_stats;
-    let named: Vec<Key> = args.estimate.iter().map(|&k| k.into()).collect();
+    let named = &args.estimate;
     let keys: Vec<Key> = if named.is_empty() {
         Key::defaults(stats)
     } else {
@@ -323,7 +323,7 @@ fn calibrate_command(args: &CalibrateArgs) -> String {
     if args.estimate_noise {
         s.push_str(" --estimate-noise");
         if !args.estimate.is_empty() {
-            let keys: Vec<&str> = args.estimate.iter().map(|&k| Key::from(k).name()).collect();
+            let keys: Vec<&str> = args.estimate.iter().map(|&k| k.name()).collect();
             s.push_str(&format!(" --estimate {}", keys.join(",")));
         }
         if args.confidence != 0.95 {
