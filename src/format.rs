@@ -119,11 +119,28 @@ pub fn interval(value: f64, lower: f64, upper: f64, min_sig: usize) -> (String, 
 /// d ≥ `min_sig` (within 1…17) at which pairs that differ as numbers differ as printed.
 pub fn interval_digits(value: f64, lower: f64, upper: f64, min_sig: usize) -> usize {
     let min_sig = min_sig.clamp(1, 17);
+    // Compared as numbers read back: a carry prints −0.97 at one digit as "−1.0", −1.2 as "−1".
     let apart = |d: usize| {
-        let (v, l, u) = (sig(value, d), sig(lower, d), sig(upper, d));
+        let [v, l, u] = [value, lower, upper].map(|x| reading(&sig(x, d)));
         (lower == upper || l != u) && (lower == value || l != v) && (upper == value || u != v)
     };
     (min_sig..=17).find(|&d| apart(d)).unwrap_or(17)
+}
+
+/// The number [`sig`] printed, read back: the true minus sign, "m × 10ⁿ"; NaN for "—".
+fn reading(text: &str) -> f64 {
+    let text = text.replace('−', "-");
+    let Some((mantissa, power)) = text.split_once(" × 10") else {
+        return text.parse().unwrap_or(f64::NAN);
+    };
+    let exponent: String = power
+        .chars()
+        .map(|c| match SUPERSCRIPTS.iter().position(|&d| d == c) {
+            Some(k) => char::from(b'0' + k as u8),
+            None => '-',
+        })
+        .collect();
+    format!("{mantissa}e{exponent}").parse().unwrap_or(f64::NAN)
 }
 
 /// A whole number with thin-space thousands separators: 10 000.
@@ -201,6 +218,9 @@ mod tests {
             ("2.00".into(), "2.00".into(), "2.00".into())
         );
         assert_eq!(interval(2.5e-5, 2.4e-5, 2.6e-5, 2).1, "2.4 × 10⁻⁵");
+        // A carry at one digit prints −0.97 as "−1.0" and −1.2 as "−1": one number.
+        assert_eq!(interval(-0.966, -1.215, 0.0, 1).1, "−1.2");
+        assert_eq!(reading("−2.5 × 10⁻⁵"), -2.5e-5);
     }
 
     #[test]
