@@ -100,6 +100,8 @@ fn consistent_drives_are_flagged_at_most_at_the_tests_combined_rate() {
          {robust}, white {white} covered, band [{}, {}]",
         band.0, band.1
     );
+    // One-sided: 3α bounds the rate from above only (the tests overlap, so the rate lies
+    // anywhere from α up to 3α), and there is no lower end to test against.
     assert!(flagged <= upper, "{flagged} consistent drives flagged");
     for (name, covered) in [("white", white), ("robust", robust)] {
         assert!(
