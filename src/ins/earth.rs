@@ -158,3 +158,42 @@ pub fn ecef_m(p: &Geodetic) -> Vector3<f64> {
         ((1.0 - ECCENTRICITY_SQUARED) * re + p.height_m) * sl,
     )
 }
+
+/// The radii's rates of change with latitude, (dR_N/dL, dR_E/dL), m/rad.
+///
+/// # Formula
+/// With W² = 1 − e² sin²L: dR_N/dL = 3a(1 − e²)e² sin L cos L/W⁵, dR_E/dL = a e² sin L cos L/W³
+/// (the derivatives of Groves eqs. 2.105 and 2.106).
+pub fn radii_rate_m_per_rad(lat_rad: f64) -> (f64, f64) {
+    let (s, c) = lat_rad.sin_cos();
+    let w2 = 1.0 - ECCENTRICITY_SQUARED * s * s;
+    let w = w2.sqrt();
+    let e2sc = ECCENTRICITY_SQUARED * s * c;
+    (
+        3.0 * SEMI_MAJOR_AXIS_M * (1.0 - ECCENTRICITY_SQUARED) * e2sc / (w2 * w2 * w),
+        SEMI_MAJOR_AXIS_M * e2sc / (w2 * w),
+    )
+}
+
+/// The gradient of normal gravity, (∂γ/∂L, ∂γ/∂h), in m/s² per rad and per m.
+///
+/// # Formula
+/// The derivatives of [`normal_gravity_m_s2`]'s γ = γ₀(L)·P(L, h):
+/// γ₀′ = γ_e[2k sin L cos L/W + (1 + k sin²L)e² sin L cos L/W³], ∂P/∂L = 8f sin L cos L·h/a,
+/// ∂P/∂h = −(2/a)(1 + f + m − 2f sin²L) + 6h/a².
+pub fn gravity_gradient(p: &Geodetic) -> (f64, f64) {
+    let (s, c) = p.lat_rad.sin_cos();
+    let s2 = s * s;
+    let w2 = 1.0 - ECCENTRICITY_SQUARED * s2;
+    let w = w2.sqrt();
+    let gamma0 = GRAVITY_EQUATOR_M_S2 * (1.0 + SOMIGLIANA_K * s2) / w;
+    let dgamma0 = GRAVITY_EQUATOR_M_S2
+        * (2.0 * SOMIGLIANA_K * s * c / w
+            + (1.0 + SOMIGLIANA_K * s2) * ECCENTRICITY_SQUARED * s * c / (w2 * w));
+    let (a, h) = (SEMI_MAJOR_AXIS_M, p.height_m);
+    let free_air = 1.0 + FLATTENING + GRAVITY_RATIO_M - 2.0 * FLATTENING * s2;
+    let poly = 1.0 - 2.0 / a * free_air * h + 3.0 * h * h / (a * a);
+    let dpoly_dlat = 8.0 * FLATTENING * s * c * h / a;
+    let dpoly_dh = -2.0 / a * free_air + 6.0 * h / (a * a);
+    (dgamma0 * poly + gamma0 * dpoly_dlat, gamma0 * dpoly_dh)
+}

@@ -7,8 +7,10 @@
 //! WGS-84; attitude as the Hamilton quaternion q_b^n (scalar first), read as Euler angles ZYX
 //! (yaw ψ, then pitch θ, then roll φ).
 
+pub mod discrete;
 pub mod drive;
 pub mod earth;
+pub mod error_state;
 pub mod mech;
 pub mod truth;
 

@@ -4,9 +4,9 @@
 use approx::assert_relative_eq;
 use nalgebra::{Matrix3, Vector3};
 
-use super::earth::{self, Geodetic};
-use super::mech::{self, Increment, Pva};
-use super::{attitude_from_euler, euler_of};
+use crate::ins::earth::{self, Geodetic};
+use crate::ins::mech::{self, Increment, Pva};
+use crate::ins::{attitude_from_euler, euler_of};
 
 /// Normal gravity at the pole γ_p, m/s² (NIMA TR8350.2 table 3.4): not used by the code, which
 /// takes γ_e and k.
@@ -189,13 +189,13 @@ fn leaving_out_earth_rate_makes_the_stationary_imu_drift() {
 /// The mechanization fed the default drive's exact increments at `rate_hz` from the true start:
 /// the largest position error over the drive, m, and the largest attitude error, rad.
 fn follow_the_truth(rate_hz: f64) -> (f64, f64) {
-    let drive = super::drive::Drive::default_drive();
+    let drive = crate::ins::drive::Drive::default_drive();
     let start = Geodetic {
         lat_rad: 37.4_f64.to_radians(),
         lon_rad: -122.1_f64.to_radians(),
         height_m: 30.0,
     };
-    let truth = super::truth::Truth::new(&drive, start, 1.0 / rate_hz);
+    let truth = crate::ins::truth::Truth::new(&drive, start, 1.0 / rate_hz);
     let mut pva = truth.pva();
     let mut before = None;
     let (mut worst_m, mut worst_rad) = (0.0_f64, 0.0_f64);
@@ -233,7 +233,7 @@ fn fed_the_exact_increments_the_mechanization_follows_the_drive() {
 
 #[test]
 fn the_drive_s_rates_are_the_derivatives_of_its_velocity_and_attitude() {
-    let drive = super::drive::Drive::default_drive();
+    let drive = crate::ins::drive::Drive::default_drive();
     let h = 1e-4;
     let mut t = 0.5;
     while t < drive.duration_s() - 1.0 {
@@ -242,7 +242,7 @@ fn the_drive_s_rates_are_the_derivatives_of_its_velocity_and_attitude() {
             t += 1.7;
             continue;
         }
-        let at = |t: f64| super::truth::kinematics(&drive.motion(t));
+        let at = |t: f64| crate::ins::truth::kinematics(&drive.motion(t));
         let (_, dv, q, omega_nb) = at(t);
         let (v_minus, _, q_minus, _) = at(t - h);
         let (v_plus, _, q_plus, _) = at(t + h);
