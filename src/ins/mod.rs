@@ -11,7 +11,10 @@ pub mod discrete;
 pub mod drive;
 pub mod earth;
 pub mod error_state;
+pub mod filter;
+pub mod gnss;
 pub mod mech;
+pub mod sensors;
 pub mod truth;
 
 #[cfg(test)]

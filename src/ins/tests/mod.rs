@@ -2,4 +2,5 @@
 //! truth; the error dynamics against the navigation equations they linearize.
 
 mod error_state;
+mod filter;
 mod mechanization;
