@@ -39,7 +39,27 @@ pub enum Command {
     /// intervals, N, B and K, and noise.toml for calibrate.
     Allan(AllanArgs),
     /// Print the default configuration file.
-    Config,
+    Config(ConfigArgs),
+}
+
+/// Options of `config`.
+#[derive(Debug, Args)]
+pub struct ConfigArgs {
+    /// Which model's file: the one-axis study of the accelerometer's bias, or the three-axis
+    /// INS/GNSS study.
+    #[arg(long, value_enum, default_value_t = ModelKind::Accelerometer)]
+    pub model: ModelKind,
+}
+
+/// Which study a configuration file describes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ModelKind {
+    /// The one-axis accelerometer and GPS study (the default).
+    #[value(name = "accelerometer")]
+    Accelerometer,
+    /// The three-axis strapdown INS/GNSS study.
+    #[value(name = "ins")]
+    Ins,
 }
 
 /// Options shared by every command that runs the model.

@@ -443,3 +443,26 @@ fn sensitivity_without_ensembles_writes_null_measurements() {
     assert!(c["detection"]["nees"].is_number(), "{c}");
     assert_eq!(c["detection_draws"], 50);
 }
+
+/// `config --model ins` prints the three-axis file, which reads back to its defaults and whose
+/// values a bad edit leaves refused with the field named.
+#[test]
+fn the_three_axis_configuration_is_printed_and_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = common::run_in(dir.path(), &["config", "--model", "ins"], Some(1));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    let parsed = accelcal::config::ins::InsConfig::from_toml_str(&text).unwrap();
+    parsed.validate().unwrap();
+    assert_eq!(parsed.imu, accelcal::config::ins::ImuConfig::default());
+    assert_eq!(parsed.gnss, accelcal::config::ins::GnssConfig::default());
+    // The one-axis file is another file.
+    let o = common::run_in(dir.path(), &["config"], Some(1));
+    assert_ne!(String::from_utf8(o.stdout).unwrap(), text);
+    let broken = text.replace("gnss_rate_hz = 1.0", "gnss_rate_hz = 400.0");
+    let err = accelcal::config::ins::InsConfig::from_toml_str(&broken)
+        .unwrap()
+        .validate()
+        .unwrap_err();
+    assert!(err.to_string().contains("gnss.gnss_rate_hz"), "{err}");
+}

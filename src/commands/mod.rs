@@ -13,7 +13,7 @@ use std::path::Path;
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::cli::{CaseArgs, Cli, Command, ModelArgs, ReportArgs};
+use crate::cli::{CaseArgs, Cli, Command, ModelArgs, ModelKind, ReportArgs};
 use accelcal::calibrate::CalibrateError;
 use accelcal::checks::{Untestable, Verdict, Verdicts};
 use accelcal::config::show;
@@ -102,7 +102,10 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Merge(args)) => monte_carlo::run_merge(&args),
         Some(Command::Calibrate(args)) => logs::run_calibrate(&args),
         Some(Command::Allan(args)) => allan::run_allan(&args),
-        Some(Command::Config) => say(DEFAULT_TOML),
+        Some(Command::Config(args)) => say(match args.model {
+            ModelKind::Accelerometer => DEFAULT_TOML,
+            ModelKind::Ins => accelcal::config::ins::DEFAULT_INS_TOML,
+        }),
     }
 }
 

@@ -11,6 +11,7 @@
 mod bias;
 mod case;
 mod default_toml;
+pub mod ins;
 mod keys;
 mod sensitivity;
 mod source;
