@@ -3,7 +3,7 @@
 //!
 //! Φ = I + FΔt + (FΔt)²/2, the matrix exponential to second order (Groves §3.2.3 and §14.2.4:
 //! the first-order form loses the δv–δψ–δb coupling's second-order terms, which a bias drives
-//! through [f^n×] within the step); Q_d = (Φ·S·Φᵀ + S)·Δt/2 with S = G·Q_c·Gᵀ, the trapezoidal
+//! through \[f^n×\] within the step); Q_d = (Φ·S·Φᵀ + S)·Δt/2 with S = G·Q_c·Gᵀ, the trapezoidal
 //! rule of the integral ∫₀^Δt Φ(s)·S·Φ(s)ᵀ ds (Groves §3.2.3; KF-GINS does the same). Both are
 //! tested against Van Loan's exact discretization (Van Loan, "Computing integrals involving the
 //! matrix exponential", IEEE TAC 23(3), 1978) over one step.

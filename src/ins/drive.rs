@@ -281,7 +281,7 @@ const DEFAULT_SEGMENTS: [Segment; 28] = {
 };
 
 impl Drive {
-    /// The default drive (its segments in [`DEFAULT_SEGMENTS`]), starting at rest heading 30°.
+    /// The default drive (600 s of segments), starting at rest heading 30°.
     pub fn default_drive() -> Self {
         Drive {
             speed0_m_s: 0.0,

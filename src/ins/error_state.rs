@@ -3,13 +3,13 @@
 //!
 //! Every error is the estimate minus the truth (Groves §14.2): δr^n the position error in NED
 //! metres (δr_N = (R_N + h)δL, δr_E = (R_E + h)cos L·δλ, δr_D = −δh), δv^n the velocity error,
-//! δψ the attitude error with Ĉ_b^n = (I + [δψ×])C_b^n (to first order), δb_g and δb_a the gyro
+//! δψ the attitude error with Ĉ_b^n = (I + \[δψ×\])C_b^n (to first order), δb_g and δb_a the gyro
 //! and accelerometer bias errors. The sensors are compensated by the estimated biases, so
 //! ω̂_ib^b − ω_ib^b = −δb_g and f̂^b − f^b = −δb_a (plus their white noise).
 //!
 //! F is the exact Jacobian of the NED navigation equations (Groves §5.4: ṗ = (v_N/(R_N + h),
 //! v_E/((R_E + h)cos L), −v_D), v̇^n = C_b^n f^b + g^n − (2ω_ie^n + ω_en^n) × v^n,
-//! Ċ_b^n = C_b^n[ω_ib^b×] − [ω_in^n×]C_b^n) in these coordinates: the error equations of Groves
+//! Ċ_b^n = C_b^n\[ω_ib^b×\] − \[ω_in^n×\]C_b^n) in these coordinates: the error equations of Groves
 //! §14.2.4 with every curvature, Earth-rate, transport-rate and gravity-gradient term kept, and
 //! the position block carried from curvilinear to NED metres through T = diag(R_N + h,
 //! (R_E + h)cos L, −1): F_rr = ṪT⁻¹ + T·F_pp·T⁻¹.

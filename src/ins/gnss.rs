@@ -6,8 +6,8 @@
 //! form). The measurement is the INS's prediction of the antenna minus the fix, in NED metres
 //! (m/s); to first order in the error state (estimate minus truth, `error_state`'s conventions):
 //!
-//! - position: z_r = δr − [(Cl)×]δψ − w_r;
-//! - velocity: z_v = δv − [(C(ω_ib × l))×]δψ + [ω_in×][(Cl)×]δψ + C[l×]δb_g − w_v,
+//! - position: z_r = δr − \[(Cl)×\]δψ − w_r;
+//! - velocity: z_v = δv − \[(C(ω_ib × l))×\]δψ + \[ω_in×\]\[(Cl)×\]δψ + C\[l×\]δb_g − w_v,
 //!
 //! where δω_ib^b = −δb_g because the gyros are compensated by the estimated bias.
 

@@ -38,7 +38,7 @@ pub struct Increment {
     pub dt_s: f64,
 }
 
-/// The skew-symmetric matrix [a×] with [a×]b = a × b.
+/// The skew-symmetric matrix \[a×\] with \[a×\]b = a × b.
 pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
 }
@@ -66,7 +66,7 @@ pub fn step(pva: &Pva, before: &Increment, now: &Increment) -> Pva {
 /// # Formula
 /// Δv_f^b = Δv_k + ½Δθ_k × Δv_k + (Δθ_{k−1} × Δv_k + Δv_{k−1} × Δθ_k)/12 (rotation and two-sample
 /// sculling for equal steps, Savage 1998 part 2);
-/// v_k = v_{k−1} + (I − ½[ζ×])C_b^n(t_{k−1})Δv_f^b + (g^n − (2ω_ie^n + ω_en^n) × v)·Δt with
+/// v_k = v_{k−1} + (I − ½\[ζ×\])C_b^n(t_{k−1})Δv_f^b + (g^n − (2ω_ie^n + ω_en^n) × v)·Δt with
 /// ζ = ω_in^n·Δt and the frame rates, g and v at the interval's midpoint (extrapolated from
 /// t_{k−1}, then recomputed once; Shin 2005 §2.2).
 fn velocity_update(pva: &Pva, before: &Increment, now: &Increment) -> Vector3<f64> {
