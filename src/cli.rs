@@ -202,9 +202,13 @@ pub struct SimulateArgs {
     /// Write the realization at every sample (truth, integration, estimate, covariance) here.
     #[arg(long, value_name = "FILE")]
     pub csv: Option<PathBuf>,
-    /// Write the sensor logs into this directory: accelerometer.csv, gps.csv and truth.csv.
+    /// Write the sensor logs into this directory: accelerometer.csv, gps.csv and truth.csv
+    /// (with --model ins: imu.csv, gnss.csv and truth.csv).
     #[arg(long, value_name = "DIR")]
     pub logs: Option<PathBuf>,
+    /// Which study: the one-axis accelerometer, or the three-axis INS/GNSS drive (its logs only).
+    #[arg(long = "model", value_enum, default_value_t = ModelKind::Accelerometer)]
+    pub kind: ModelKind,
 }
 
 /// Options of `calibrate`.

@@ -466,3 +466,66 @@ fn the_three_axis_configuration_is_printed_and_reads_back() {
         .unwrap_err();
     assert!(err.to_string().contains("gnss.gnss_rate_hz"), "{err}");
 }
+
+/// `simulate --model ins --logs DIR` writes the three-axis logs in the recorded formats; what
+/// belongs to the one-axis model, or a GNSS faster than the IMU, is refused with exit code 2 and
+/// nothing written.
+#[test]
+fn three_axis_logs_are_written_and_bad_requests_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("short.toml"), "[drive]\nduration_s = 5.0\n").unwrap();
+    let o = common::run_in(
+        dir.path(),
+        &[
+            "simulate",
+            "--model",
+            "ins",
+            "--config",
+            "short.toml",
+            "--logs",
+            "logs",
+        ],
+        Some(1),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let read = |f: &str| std::fs::read_to_string(dir.path().join("logs").join(f)).unwrap();
+    let imu = read("imu.csv");
+    assert!(imu.starts_with("t_s,ax_m_s2,ay_m_s2,az_m_s2,gx_rad_s,gy_rad_s,gz_rad_s\n"));
+    assert_eq!(imu.lines().count(), 1 + 1000);
+    let gnss = read("gnss.csv");
+    assert!(gnss.starts_with("t_s,lat_deg,lon_deg,height_m,vn_m_s,ve_m_s,vd_m_s\n"));
+    assert_eq!(gnss.lines().count(), 1 + 5);
+    assert!(
+        read("truth.csv").starts_with("t_s,lat_deg,lon_deg,height_m,vn_m_s,ve_m_s,vd_m_s,roll_deg")
+    );
+    std::fs::write(
+        dir.path().join("bad.toml"),
+        "[gnss]\ngnss_rate_hz = 400.0\n",
+    )
+    .unwrap();
+    for args in [
+        &["simulate", "--model", "ins", "--csv", "x.csv"][..],
+        &[
+            "simulate", "--model", "ins", "--logs", "new", "--truth", "euler",
+        ],
+        &[
+            "simulate", "--model", "ins", "--logs", "new", "--config", "bad.toml",
+        ],
+    ] {
+        let o = run(args, dir.path());
+        let msg = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {msg}");
+        assert!(!msg.contains("panicked"), "{msg}");
+        assert!(!dir.path().join("new").exists() && !dir.path().join("x.csv").exists());
+    }
+    let msg = stderr(&run(
+        &[
+            "simulate", "--model", "ins", "--logs", "new", "--config", "bad.toml",
+        ],
+        dir.path(),
+    ));
+    assert!(
+        msg.contains("bad.toml:2") && msg.contains("gnss.gnss_rate_hz"),
+        "{msg}"
+    );
+}

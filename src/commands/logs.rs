@@ -26,6 +26,9 @@ use accelcal::{export, realization, report, simulation};
 use anyhow::{Context, Result};
 
 pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
+    if args.kind == crate::cli::ModelKind::Ins {
+        return super::ins::run_simulate(args);
+    }
     let model = load_model(&args.model, &args.case, None)?;
     super::check_memory(&model, accelcal::model::Work::Simulate, &args.model)?;
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;

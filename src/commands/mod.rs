@@ -4,6 +4,7 @@
 //! `logs` those of sensor logs (simulate, calibrate).
 
 mod allan;
+mod ins;
 mod logs;
 mod monte_carlo;
 

@@ -198,7 +198,7 @@ fn bank(speed: &Jet, yaw: &Jet, pitch: &Jet) -> (f64, f64) {
 /// The default drive's segments: 600 s from rest that accelerate, brake, turn both ways, climb
 /// and dip, so that every accelerometer and gyro axis is excited (what makes all six biases
 /// observable from GNSS).
-const DEFAULT_SEGMENTS: [Segment; 28] = {
+const DEFAULT_SEGMENTS: [Segment; 30] = {
     use Segment::{Climb, SpeedChange, Straight, Turn};
     [
         Straight { duration_s: 30.0 },
@@ -272,6 +272,11 @@ const DEFAULT_SEGMENTS: [Segment; 28] = {
             heading_change_rad: deg(160.0),
         },
         Straight { duration_s: 25.0 },
+        Turn {
+            duration_s: 15.0,
+            heading_change_rad: deg(-90.0),
+        },
+        Straight { duration_s: 15.0 },
         SpeedChange {
             duration_s: 14.0,
             delta_m_s: -15.0,

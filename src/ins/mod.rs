@@ -13,8 +13,10 @@ pub mod earth;
 pub mod error_state;
 pub mod filter;
 pub mod gnss;
+pub mod logs;
 pub mod mech;
 pub mod sensors;
+pub mod setup;
 pub mod truth;
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use nalgebra::Vector3;
 
 use super::earth::{self, Geodetic};
 use super::mech::Increment;
-use crate::random::Stream;
+use crate::random::{Stream, splitmix64};
 
 /// Key of the random streams of three-axis realizations.
 const STREAM_KEY: u64 = 0x696e_735f_7265_616c;
@@ -109,9 +109,11 @@ pub struct Imu {
 }
 
 impl Imu {
-    /// The IMU of realization `seed`, its biases drawn from their initial distributions.
-    pub fn new(model: ImuModel, seed: u64) -> Self {
-        let mut stream = Stream::new(STREAM_KEY, seed);
+    /// The IMU of realization `index` under `seed`, its biases drawn from their initial
+    /// distributions. Its stream depends on nothing else: results do not depend on the thread
+    /// count.
+    pub fn new(model: ImuModel, seed: u64, index: u64) -> Self {
+        let mut stream = Stream::new(splitmix64(seed ^ STREAM_KEY), index);
         let mut draw = |sigma: f64| Vector3::from_fn(|_, _| sigma * stream.normal());
         let gyro_bias_rad_s = draw(model.gyro_bias.initial_sigma());
         let accel_bias_m_s2 = draw(model.accel_bias.initial_sigma());

@@ -95,6 +95,14 @@ impl<'a> Truth<'a> {
         }
     }
 
+    /// The truth over the drive's first `duration_s` seconds only.
+    pub fn until(mut self, duration_s: f64) -> Self {
+        self.steps = self
+            .steps
+            .min((duration_s / self.step_s + 1e-9).floor() as usize);
+        self
+    }
+
     /// The number of steps.
     pub fn steps(&self) -> usize {
         self.steps

@@ -215,7 +215,7 @@ fn fed_the_exact_increments_the_mechanization_follows_the_drive() {
         .iter()
         .map(|&r| follow_the_truth(r))
         .collect();
-    // Measured: 1.70·10⁻², 4.23·10⁻³, 1.05·10⁻³ m and 1.9·10⁻⁹, 4.6·10⁻¹⁰, 1.1·10⁻¹⁰ rad at 100,
+    // Measured: 1.90·10⁻², 4.75·10⁻³, 1.18·10⁻³ m and 2.1·10⁻⁹, 5.0·10⁻¹⁰, 1.2·10⁻¹⁰ rad at 100,
     // 200, 400 Hz: second order, as the two-sample algorithms are.
     assert!(errors[1].0 < 0.01, "position error at 200 Hz: {errors:?}");
     for pair in errors.windows(2) {
@@ -261,4 +261,10 @@ fn the_drive_s_rates_are_the_derivatives_of_its_velocity_and_attitude() {
         );
         t += 1.7;
     }
+}
+
+#[test]
+fn the_default_drive_lasts_the_configuration_s_longest_drive() {
+    let drive = crate::ins::drive::Drive::default_drive();
+    assert_eq!(drive.duration_s(), crate::config::ins::LONGEST_DRIVE_S);
 }

@@ -3,4 +3,5 @@
 
 mod error_state;
 mod filter;
+mod logs;
 mod mechanization;

@@ -1,0 +1,92 @@
+//! The three-axis study's commands: `simulate --model ins --logs DIR`.
+
+use anyhow::Result;
+
+use crate::cli::{ModelArgs, SimulateArgs};
+use accelcal::config::ConfigText;
+use accelcal::config::ins::InsConfig;
+use accelcal::error::ConfigError;
+use accelcal::ins::logs::write_realization;
+use accelcal::ins::setup::Study;
+use accelcal::output::{StagedFiles, check_directory};
+
+/// The three-axis logs a simulation writes.
+const IMU_FILE: &str = "imu.csv";
+const GNSS_FILE: &str = "gnss.csv";
+const TRUTH_FILE: &str = "truth.csv";
+
+/// The three-axis study named by `args` (`--config`, `--seed`), validated.
+pub(super) fn load_study(args: &ModelArgs) -> Result<Study, ConfigError> {
+    let text = args.config.as_deref().map(ConfigText::read).transpose()?;
+    let locate = |e: ConfigError| match &text {
+        Some(t) => t.locate(e),
+        None => e,
+    };
+    let mut config = match &text {
+        Some(t) => InsConfig::from_toml_str(&t.text).map_err(locate)?,
+        None => InsConfig::default(),
+    };
+    if let Some(s) = args.seed {
+        config.ensemble.seed = s;
+    }
+    Study::from_config(&config).map_err(locate)
+}
+
+/// `simulate --model ins`: one realization's IMU and GNSS logs and its truth.
+pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
+    if let Some(csv) = &args.csv {
+        return Err(ConfigError::invalid(
+            "--csv",
+            csv.display(),
+            "the one-axis model's per-sample file; with --model ins, --logs DIR",
+        )
+        .into());
+    }
+    if args.case.truth.is_some() || args.case.accelerometer_output.is_some() {
+        return Err(ConfigError::invalid(
+            "--truth/--accelerometer-output",
+            "given",
+            "options of the one-axis model only",
+        )
+        .into());
+    }
+    let Some(dir) = &args.logs else {
+        return Err(ConfigError::invalid(
+            "--logs",
+            "(none)",
+            "a directory for imu.csv, gnss.csv and truth.csv",
+        )
+        .into());
+    };
+    let study = load_study(&args.model)?;
+    let names = [IMU_FILE, GNSS_FILE, TRUTH_FILE];
+    check_directory(dir, &names)?;
+    let mut staged = StagedFiles::create(dir, &names)?;
+    let written = {
+        let [imu, gnss, truth]: [_; 3] = staged
+            .writers()
+            .try_into()
+            .map_err(|_| anyhow::anyhow!("three staged log files"))?;
+        write_realization(&study, args.realization, imu, gnss, truth)?
+    };
+    staged.commit()?;
+    let deg_h = |x: f64| (x * 3600.0).to_degrees();
+    let (g, a) = (written.gyro_bias_rad_s, written.accel_bias_m_s2);
+    super::say(&format!(
+        "realization {} (three axes, {} s at {} Hz): gyro biases {:.2}, {:.2}, {:.2} °/h, \
+         accelerometer biases {:.3}, {:.3}, {:.3} mg at the start; {} IMU samples and {} fixes \
+         written to {} ({IMU_FILE}, {GNSS_FILE}, {TRUTH_FILE})\n",
+        args.realization,
+        study.duration_s,
+        study.imu_rate_hz,
+        deg_h(g.x),
+        deg_h(g.y),
+        deg_h(g.z),
+        a.x / 9.80665e-3,
+        a.y / 9.80665e-3,
+        a.z / 9.80665e-3,
+        written.samples,
+        written.fixes,
+        dir.display()
+    ))
+}

@@ -1,0 +1,146 @@
+//! One simulated realization of the three-axis study written as sensor logs, in the formats of a
+//! real recording (`imu.csv`, `gnss.csv`) and its truth (`truth.csv`).
+//!
+//! - `imu.csv`: `t_s,ax_m_s2,ay_m_s2,az_m_s2,gx_rad_s,gy_rad_s,gz_rad_s`, body axes
+//!   forward-right-down; each row is the IMU's output over the step ending at `t_s` as a mean
+//!   rate (Δv/Δt, Δθ/Δt), so that rate × Δt gives back the increments.
+//! - `gnss.csv`: `t_s,lat_deg,lon_deg,height_m,vn_m_s,ve_m_s,vd_m_s`, the antenna's fix.
+//! - `truth.csv`: `t_s,lat_deg,lon_deg,height_m,vn_m_s,ve_m_s,vd_m_s,roll_deg,pitch_deg,yaw_deg`
+//!   of the IMU, and the six biases `bgx_rad_s,bgy_rad_s,bgz_rad_s,bax_m_s2,bay_m_s2,baz_m_s2`
+//!   over the step ending at `t_s`, at every IMU time.
+//!
+//! Numbers are written as the shortest decimals that read back to the same `f64` (a negative
+//! zero as 0).
+
+use std::io::{self, Write};
+
+use nalgebra::Vector3;
+
+use super::drive::Drive;
+use super::gnss::{self, Fix};
+use super::mech::Pva;
+use super::sensors::{Imu, offset};
+use super::setup::Study;
+use super::truth::{self, Truth};
+
+/// The IMU log's header.
+pub const IMU_HEADER: &str = "t_s,ax_m_s2,ay_m_s2,az_m_s2,gx_rad_s,gy_rad_s,gz_rad_s";
+/// The GNSS log's header.
+pub const GNSS_HEADER: &str = "t_s,lat_deg,lon_deg,height_m,vn_m_s,ve_m_s,vd_m_s";
+/// The truth's header.
+pub const TRUTH_HEADER: &str = "t_s,lat_deg,lon_deg,height_m,vn_m_s,ve_m_s,vd_m_s,roll_deg,pitch_deg,\
+                                yaw_deg,bgx_rad_s,bgy_rad_s,bgz_rad_s,bax_m_s2,bay_m_s2,baz_m_s2";
+
+/// What a written realization holds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Written {
+    /// IMU rows.
+    pub samples: usize,
+    /// GNSS fixes.
+    pub fixes: usize,
+    /// The gyro biases at the start, rad/s.
+    pub gyro_bias_rad_s: Vector3<f64>,
+    /// The accelerometer biases at the start, m/s².
+    pub accel_bias_m_s2: Vector3<f64>,
+}
+
+/// The fix the receiver reports at `t_s` for the true state `pva`: the antenna through the lever
+/// arm, with the receiver's white noise from the realization's stream.
+pub fn fix(study: &Study, drive: &Drive, imu: &mut Imu, t_s: f64, pva: &Pva) -> Fix {
+    let g = &study.truth_gnss;
+    let (omega, _) = truth::imu_rates(&pva.position, &drive.motion(t_s));
+    let (p, v) = gnss::antenna(pva, &g.lever_arm_b_m, &omega);
+    Fix {
+        t_s,
+        position: offset(&p, &imu.normals(&g.position_sigma_m)),
+        velocity_ned_m_s: Some(v + imu.normals(&g.velocity_sigma_m_s)),
+        position_sigma_m: g.position_sigma_m,
+        velocity_sigma_m_s: g.velocity_sigma_m_s,
+    }
+}
+
+/// Realization `index` of `study` written into `imu`, `gnss` and `truth`.
+///
+/// # Errors
+/// The writers' errors.
+pub fn write_realization(
+    study: &Study,
+    index: u64,
+    imu_out: &mut impl Write,
+    gnss_out: &mut impl Write,
+    truth_out: &mut impl Write,
+) -> io::Result<Written> {
+    writeln!(imu_out, "{IMU_HEADER}")?;
+    writeln!(gnss_out, "{GNSS_HEADER}")?;
+    writeln!(truth_out, "{TRUTH_HEADER}")?;
+    let drive = study.drive();
+    let dt = 1.0 / study.imu_rate_hz;
+    let truth = Truth::new(&drive, study.start, dt).until(study.duration_s);
+    let mut imu = study.imu(index);
+    let start = (imu.gyro_bias_rad_s, imu.accel_bias_m_s2);
+    let (mut samples, mut fixes) = (0, 0);
+    for (k, (inc, pva)) in truth.enumerate() {
+        let t = (k + 1) as f64 * dt;
+        let (bg, ba) = (imu.gyro_bias_rad_s, imu.accel_bias_m_s2);
+        let raw = imu.read(&inc);
+        let (a, w) = (raw.dvel_m_s / dt, raw.dtheta_rad / dt);
+        writeln!(
+            imu_out,
+            "{t},{},{},{},{},{},{}",
+            z(a.x),
+            z(a.y),
+            z(a.z),
+            z(w.x),
+            z(w.y),
+            z(w.z)
+        )?;
+        let (roll, pitch, yaw) = super::euler_of(&pva.attitude);
+        let v = pva.velocity_ned_m_s;
+        writeln!(
+            truth_out,
+            "{t},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            z(pva.position.lat_rad.to_degrees()),
+            z(pva.position.lon_rad.to_degrees()),
+            z(pva.position.height_m),
+            z(v.x),
+            z(v.y),
+            z(v.z),
+            z(roll.to_degrees()),
+            z(pitch.to_degrees()),
+            z(yaw.to_degrees()),
+            z(bg.x),
+            z(bg.y),
+            z(bg.z),
+            z(ba.x),
+            z(ba.y),
+            z(ba.z)
+        )?;
+        samples += 1;
+        if (k + 1) % study.imu_steps_per_fix == 0 {
+            let f = fix(study, &drive, &mut imu, t, &pva);
+            let v = f.velocity_ned_m_s.unwrap_or_else(Vector3::zeros);
+            writeln!(
+                gnss_out,
+                "{t},{},{},{},{},{},{}",
+                z(f.position.lat_rad.to_degrees()),
+                z(f.position.lon_rad.to_degrees()),
+                z(f.position.height_m),
+                z(v.x),
+                z(v.y),
+                z(v.z)
+            )?;
+            fixes += 1;
+        }
+    }
+    Ok(Written {
+        samples,
+        fixes,
+        gyro_bias_rad_s: start.0,
+        accel_bias_m_s2: start.1,
+    })
+}
+
+/// `x` with a negative zero made positive (what a reader of the CSV expects).
+fn z(x: f64) -> f64 {
+    x + 0.0
+}

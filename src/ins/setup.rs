@@ -1,0 +1,167 @@
+//! The three-axis study as the configuration describes it: the drive, the true sensors and the
+//! sensors the filter assumes, in the navigation layer's types.
+
+use nalgebra::Vector3;
+
+use super::discrete::NoiseDensities;
+use super::drive::Drive;
+use super::earth::Geodetic;
+use super::error_state::{ACCEL_BIAS, BiasDecay, GYRO_BIAS, Matrix15};
+use super::sensors::{BiasProcess, Imu, ImuModel};
+use crate::config::BiasModelKind;
+use crate::config::ins::{GnssConfig, ImuConfig, InsConfig};
+use crate::error::ConfigError;
+
+/// A GNSS receiver: its antenna and white noise.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GnssModel {
+    /// The antenna from the IMU in body axes, m.
+    pub lever_arm_b_m: Vector3<f64>,
+    /// Position σ north, east, down, m.
+    pub position_sigma_m: Vector3<f64>,
+    /// Velocity σ per component, m/s.
+    pub velocity_sigma_m_s: Vector3<f64>,
+}
+
+/// The validated study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Study {
+    /// The drive's length, s.
+    pub duration_s: f64,
+    /// Where it starts.
+    pub start: Geodetic,
+    /// The IMU's rate, Hz.
+    pub imu_rate_hz: f64,
+    /// IMU steps between fixes.
+    pub imu_steps_per_fix: usize,
+    /// The IMU as it is.
+    pub truth_imu: ImuModel,
+    /// The receiver as it is.
+    pub truth_gnss: GnssModel,
+    /// The IMU the filter assumes.
+    pub filter_imu: ImuModel,
+    /// The receiver the filter assumes.
+    pub filter_gnss: GnssModel,
+    /// The prior σ's of position (m), velocity (m/s) and attitude (rad: roll, pitch, yaw).
+    pub initial_sigma: [f64; 9],
+    /// Seed of the random streams.
+    pub seed: u64,
+    /// Realizations of the ensemble.
+    pub realizations: u64,
+}
+
+/// A sensor triad's bias process from its configured model.
+fn bias(kind: BiasModelKind, sigma: f64, tau_s: f64, k: f64) -> BiasProcess {
+    match kind {
+        BiasModelKind::Constant => BiasProcess::Constant { sigma },
+        BiasModelKind::RandomWalk => BiasProcess::RandomWalk { k_per_sqrt_s: k },
+        BiasModelKind::GaussMarkov => BiasProcess::GaussMarkov {
+            sigma,
+            correlation_time_s: tau_s,
+        },
+    }
+}
+
+fn imu_model(c: &ImuConfig) -> ImuModel {
+    ImuModel {
+        gyro_arw_rad_per_sqrt_s: c.gyro_arw_rad_per_sqrt_s,
+        accel_vrw_m_s_per_sqrt_s: c.accel_vrw_m_s_per_sqrt_s,
+        gyro_bias: bias(
+            c.gyro_bias_model,
+            c.gyro_bias_sigma_rad_s,
+            c.gyro_bias_correlation_time_s,
+            c.gyro_bias_random_walk_rad_s_per_sqrt_s,
+        ),
+        accel_bias: bias(
+            c.accel_bias_model,
+            c.accel_bias_sigma_m_s2,
+            c.accel_bias_correlation_time_s,
+            c.accel_bias_random_walk_m_s2_per_sqrt_s,
+        ),
+    }
+}
+
+fn gnss_model(c: &GnssConfig) -> GnssModel {
+    GnssModel {
+        lever_arm_b_m: Vector3::from(c.gnss_lever_arm_m),
+        position_sigma_m: Vector3::from(c.gnss_position_sigma_m),
+        velocity_sigma_m_s: Vector3::repeat(c.gnss_velocity_sigma_m_s),
+    }
+}
+
+impl Study {
+    /// The study of a configuration, validated.
+    ///
+    /// # Errors
+    /// [`ConfigError::Invalid`] naming the first field out of its range.
+    pub fn from_config(c: &InsConfig) -> Result<Self, ConfigError> {
+        c.validate()?;
+        let assumed = c.assumed();
+        let i = &c.initial;
+        let (p, v) = (i.position_sigma_m, i.velocity_sigma_m_s);
+        let (tilt, yaw) = (i.tilt_sigma_deg.to_radians(), i.yaw_sigma_deg.to_radians());
+        Ok(Study {
+            duration_s: c.drive.duration_s,
+            start: Geodetic {
+                lat_rad: c.drive.start_lat_deg.to_radians(),
+                lon_rad: c.drive.start_lon_deg.to_radians(),
+                height_m: c.drive.start_height_m,
+            },
+            imu_rate_hz: c.imu.imu_rate_hz,
+            imu_steps_per_fix: (c.imu.imu_rate_hz / c.gnss.gnss_rate_hz).round() as usize,
+            truth_imu: imu_model(&c.imu),
+            truth_gnss: gnss_model(&c.gnss),
+            filter_imu: imu_model(&assumed.imu),
+            filter_gnss: gnss_model(&assumed.gnss),
+            initial_sigma: [p, p, p, v, v, v, tilt, tilt, yaw],
+            seed: c.ensemble.seed,
+            realizations: c.ensemble.realizations,
+        })
+    }
+
+    /// The drive (the default drive; [`Self::duration_s`] says how much of it).
+    pub fn drive(&self) -> Drive {
+        Drive::default_drive()
+    }
+
+    /// The true IMU of realization `index`.
+    pub fn imu(&self, index: u64) -> Imu {
+        Imu::new(self.truth_imu, self.seed, index)
+    }
+
+    /// The noise densities the filter assumes.
+    pub fn filter_noise(&self) -> NoiseDensities {
+        let m = &self.filter_imu;
+        NoiseDensities {
+            accel_vrw_m_s_per_sqrt_s: m.accel_vrw_m_s_per_sqrt_s,
+            gyro_arw_rad_per_sqrt_s: m.gyro_arw_rad_per_sqrt_s,
+            gyro_bias_density: m.gyro_bias.density(),
+            accel_bias_density: m.accel_bias.density(),
+        }
+    }
+
+    /// The bias decay the filter assumes.
+    pub fn filter_decay(&self) -> BiasDecay {
+        BiasDecay {
+            gyro_per_s: self.filter_imu.gyro_bias.decay_per_s(),
+            accel_per_s: self.filter_imu.accel_bias.decay_per_s(),
+        }
+    }
+
+    /// The filter's prior covariance P(0): the navigation σ's and each bias's initial σ.
+    pub fn prior(&self) -> Matrix15 {
+        let mut p = Matrix15::zeros();
+        for (i, s) in self.initial_sigma.iter().enumerate() {
+            p[(i, i)] = s * s;
+        }
+        let (g, a) = (
+            self.filter_imu.gyro_bias.initial_sigma(),
+            self.filter_imu.accel_bias.initial_sigma(),
+        );
+        for i in 0..3 {
+            p[(GYRO_BIAS + i, GYRO_BIAS + i)] = g * g;
+            p[(ACCEL_BIAS + i, ACCEL_BIAS + i)] = a * a;
+        }
+        p
+    }
+}
