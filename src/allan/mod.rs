@@ -20,7 +20,9 @@ pub mod deviation;
 pub mod edf;
 pub mod export;
 pub mod fit;
+pub mod goodness;
 pub mod log;
+pub mod nnls;
 pub mod noise_id;
 pub mod section;
 pub mod simulate;
@@ -158,7 +160,8 @@ fn fitted_terms(points: &[AllanPoint]) -> Vec<Term> {
 
 /// Analyses the rate samples `y` (m/s²) taken τ₀ = `tau0_s` apart: the overlapping Allan
 /// deviation at octave τ with χ² intervals at `confidence`, and the fitted noise terms. The fit
-/// uses every τ whose noise was identified there (at least 30 block means).
+/// uses every τ with an EDF (the noise carried from the longest τ with 30 block means where fewer
+/// remain), each with the weight its EDF gives it.
 ///
 /// # Errors
 /// [`AllanError`] for fewer than [`MIN_SAMPLES`] samples, a constant log or a confidence
@@ -180,7 +183,7 @@ pub fn analyse(y: &[f64], tau0_s: f64, confidence: f64) -> Result<Analysis, Alla
     }
     let fit_points: Vec<FitPoint> = points
         .iter()
-        .filter(|p| p.identified_here && p.adev > 0.0)
+        .filter(|p| p.adev > 0.0)
         .filter_map(|p| {
             p.edf.map(|edf| FitPoint {
                 m: p.m,

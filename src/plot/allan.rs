@@ -8,14 +8,14 @@ use super::axis::{Axis, y_label_area};
 use super::geometry::extent;
 use super::legend::{Entry, Swatch, render_under_legend};
 use super::panel::{Layout, Panel};
-use super::{BLACK, BLUE, BLUISH_GREEN, GREY, PlotResult, REDDISH_PURPLE, VERMILLION};
+use super::{BLACK, BLUE, BLUISH_GREEN, GREY, ORANGE, PlotResult, REDDISH_PURPLE, VERMILLION};
 
 /// Height of the plot, px.
 const ROW_PX: u32 = 480;
 
 /// The colours of the terms' lines, by the term's slot (quantization, velocity random walk,
 /// bias instability, acceleration random walk).
-pub const TERM_COLOURS: [RGBColor; 4] = [VERMILLION, REDDISH_PURPLE, BLUE, BLUISH_GREEN];
+pub const TERM_COLOURS: [RGBColor; 5] = [VERMILLION, REDDISH_PURPLE, BLUE, BLUISH_GREEN, ORANGE];
 
 /// The deviation at one τ.
 #[derive(Clone, Copy, Debug, PartialEq)]

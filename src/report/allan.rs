@@ -26,6 +26,7 @@ fn term_label(term: Term) -> &'static str {
         Term::VelocityRandomWalk => "N: slope −½",
         Term::BiasInstability => "B: slope 0",
         Term::AccelerationRandomWalk => "K: slope +½",
+        Term::RateRamp => "R: slope +1",
     }
 }
 
@@ -178,6 +179,11 @@ pub fn term_row(t: &TermEstimate) -> TermRow {
             "acceleration random walk <i>K</i>",
             format!("{} m/s²/√s", range(t, 1.0, 3)),
             format!("{} µg/√s", range(t, micro_g, 3)),
+        ),
+        Term::RateRamp => (
+            "rate ramp <i>R</i>",
+            format!("{} m/s³", range(t, 1.0, 3)),
+            format!("{} µg/s", range(t, micro_g, 3)),
         ),
     };
     TermRow {
