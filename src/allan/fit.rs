@@ -305,6 +305,33 @@ fn exact_covariance(
     DMatrix::from_fn(points.len(), points.len(), |i, j| c[i][j])
 }
 
+/// The covariance `c` with each variance raised to at least the χ² variance 2σ⁴_fit/edf of its
+/// estimate, the correlations kept: C′_ij = ρ_ij √(V′_i V′_j), V′_i = max(C_ii, 2σ⁴_fit,i/edf_i).
+/// The exact covariance knows only white phase, white rate and random-walk noise; where flicker
+/// (B) dominates, the EDF of the noise identified at that τ (Greenhall & Riley 2003) carries its
+/// share of the variance, and the correlation of the other noises stands in for its own.
+fn with_edf_variances(
+    c: &DMatrix<f64>,
+    points: &[FitPoint],
+    fitted: &DVector<f64>,
+) -> DMatrix<f64> {
+    let k = points.len();
+    let v: Vec<f64> = (0..k)
+        .map(|i| c[(i, i)].max(2.0 * fitted[i].max(0.0).powi(2) / points[i].edf))
+        .collect();
+    DMatrix::from_fn(k, k, |i, j| {
+        if i == j {
+            return v[i];
+        }
+        let d = c[(i, i)] * c[(j, j)];
+        if d > 0.0 {
+            c[(i, j)] / d.sqrt() * (v[i] * v[j]).sqrt()
+        } else {
+            0.0
+        }
+    })
+}
+
 /// The goodness-of-fit test of `sol`, and the negative control's (see [`Fit::goodness_naive`]).
 fn goodness_tests(
     points: &[FitPoint],
@@ -354,6 +381,11 @@ fn estimate(
     let (sol, w) = weighted_fit(points, &a, constrained)?;
     let theta = &sol.theta;
     let c = exact_covariance(points, samples, tau0_s, terms, theta);
+    let c = if constrained {
+        with_edf_variances(&c, points, &(&a * theta))
+    } else {
+        c
+    };
     let cov = sandwich(&a, &w, &sol.h, &c);
     // The unconstrained direction of a term at its zero bound.
     let s = DVector::from_iterator(points.len(), points.iter().map(|p| p.avar));

@@ -24,6 +24,7 @@ pub mod goodness;
 pub mod log;
 pub mod nnls;
 pub mod noise_id;
+pub mod reading;
 pub mod section;
 pub mod simulate;
 
@@ -32,6 +33,7 @@ use thiserror::Error;
 
 pub use fit::{Fit, FitPoint, Term, TermEstimate};
 pub use noise_id::NoiseId;
+pub use reading::{Departure, Feature, Reading};
 
 /// The interval confidence when none is given: one standard deviation of a normal.
 pub const DEFAULT_CONFIDENCE: f64 = 0.683;
@@ -93,11 +95,25 @@ pub struct Analysis {
     pub confidence: f64,
     /// The deviation at every τ of the octave grid.
     pub points: Vec<AllanPoint>,
-    /// The terms.
+    /// The constrained fit.
     pub fit: Fit,
+    /// Which reading [`Analysis::terms`] come from: the fit, or IEEE 952's off the curve when the
+    /// goodness-of-fit test rejects the model.
+    pub reading: Reading,
+    /// The reported terms, in the order of the fit's.
+    pub terms: Vec<TermEstimate>,
+    /// How the fitted curve meets each point.
+    pub departures: Vec<Departure>,
+    /// Features of the curve the model does not have.
+    pub features: Vec<Feature>,
 }
 
 impl Analysis {
+    /// The reported estimate of `term`, if fitted.
+    pub fn term(&self, term: Term) -> Option<&TermEstimate> {
+        self.terms.iter().find(|t| t.term == term)
+    }
+
     /// The τ of the smallest deviation, s.
     pub fn tau_at_minimum_s(&self) -> f64 {
         self.points
@@ -196,11 +212,23 @@ pub fn analyse(y: &[f64], tau0_s: f64, confidence: f64) -> Result<Analysis, Alla
     let terms = fitted_terms(&points);
     let fit =
         fit::fit(&fit_points, y.len(), tau0_s, &terms, confidence).ok_or(AllanError::Constant)?;
+    let departures = reading::departures(&points, &fit);
+    let features = reading::features(&points, &departures, &fit);
+    let (reading, terms) = if fit.goodness.rejected {
+        let read = reading::ieee952(&points, &terms, confidence);
+        (Reading::Ieee952, read)
+    } else {
+        (Reading::Fit, fit.terms.clone())
+    };
     Ok(Analysis {
         samples: y.len(),
         sample_period_s: tau0_s,
         confidence,
         points,
         fit,
+        reading,
+        terms,
+        departures,
+        features,
     })
 }
