@@ -234,3 +234,32 @@ pub fn ieee952(points: &[AllanPoint], terms: &[Term], confidence: f64) -> Vec<Te
     }
     out
 }
+
+/// The τ where the fitted curve leaves the estimates' intervals.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Span {
+    /// The shortest τ that departs, s.
+    pub from_tau_s: f64,
+    /// The longest, s.
+    pub to_tau_s: f64,
+    /// How many τ depart.
+    pub count: usize,
+    /// The least σ̂/σ_fit among them.
+    pub least_ratio: f64,
+    /// The largest.
+    pub largest_ratio: f64,
+}
+
+/// The span of the τ whose interval excludes the fit; `None` when the fit holds everywhere.
+pub fn departing_span(points: &[AllanPoint], d: &[Departure]) -> Option<Span> {
+    let out: Vec<usize> = (0..points.len()).filter(|&i| !d[i].holds).collect();
+    let (&first, &last) = (out.first()?, out.last()?);
+    let ratios = out.iter().map(|&i| d[i].ratio);
+    Some(Span {
+        from_tau_s: points[first].tau_s,
+        to_tau_s: points[last].tau_s,
+        count: out.len(),
+        least_ratio: ratios.clone().fold(f64::INFINITY, f64::min),
+        largest_ratio: ratios.fold(0.0, f64::max),
+    })
+}
