@@ -1,19 +1,22 @@
 //! Logs beyond the model: white noise + flicker + random walk (N = 10⁻³ m/s/√s, B = 10⁻³ m/s²,
 //! K = 10⁻⁴ m/s²/√s), the same + a sinusoid of 4·10⁻³ m/s² at 0.5 Hz (its hump, 2.9·10⁻³ m/s²
 //! near τ = 0.74 s, stands about three times above the curve without it, as the real sensor's
-//! did), and the same + a linear trend R = 5·10⁻⁶ m/s³ (`FeatureLog`, 2¹⁸ samples at 100 Hz, 100
+//! did), and the same + a linear trend R = 2·10⁻⁵ m/s³ (at the longest τ, 1 300 s, sixteen times the variance of
+//! the rest) (`FeatureLog`, 2¹⁸ samples at 100 Hz, 100
 //! seeds each, 95 % intervals). On each family, per term, the count of logs whose report is
 //! honest — the model accepted and the interval covering the truth, or the model rejected and
 //! the IEEE 952 reading within 25 % of the truth or its interval covering it (an unresolved
 //! term: its bound at least the truth) — lies in the binomial band of Bin(100, 0.95) at 1 %,
 //! [89, 100]. No term is negative and no bound below what the longest τ's lower whisker
-//! demands, on every log. The negative control: the fit before this change (unconstrained, on
-//! the τ with 30 block means) covers N and B on the sinusoid logs below the band.
+//! demands, on every log. The negative controls: the fit before this change (unconstrained, on
+//! the τ with 30 block means) covers N and B on the sinusoid logs below the band, and K on the
+//! trend logs (it takes the trend for a random walk). The sinusoid is named, between 0.25 and
+//! 1 Hz, on every sinusoid log and on no other.
 
 use accelcal::allan::fit::{FitPoint, Term, fit_unconstrained};
 use accelcal::allan::section::binomial_band;
 use accelcal::allan::simulate::{FeatureLog, StaticLog};
-use accelcal::allan::{Analysis, Reading, analyse};
+use accelcal::allan::{Analysis, Feature, Reading, analyse};
 use rayon::prelude::*;
 
 const SEEDS: u64 = 100;
@@ -122,10 +125,22 @@ struct Study {
     honest: [u64; 3],
     old_covered: [u64; 3],
     physical: u64,
+    sinusoid_named: u64,
+    trend_named: u64,
 }
 
-/// One log: rejected, honest per term, the old fit's coverage per term, physical.
-type PerLog = (bool, [bool; 3], [bool; 3], bool);
+/// One log: rejected, honest per term, the old fit's coverage per term, physical, the features
+/// named (a sinusoid between 0.25 and 1 Hz, a trend).
+type PerLog = (bool, [bool; 3], [bool; 3], bool, [bool; 2]);
+
+fn named(a: &Analysis) -> [bool; 2] {
+    [
+        a.features.iter().any(|f| {
+            matches!(f, Feature::Sinusoid { frequency_hz, .. } if (0.25..=1.0).contains(frequency_hz))
+        }),
+        a.features.iter().any(|f| matches!(f, Feature::Trend { .. })),
+    ]
+}
 
 fn study(log: &FeatureLog) -> Study {
     let per: Vec<PerLog> = (0..SEEDS)
@@ -133,7 +148,7 @@ fn study(log: &FeatureLog) -> Study {
         .map(|seed| {
             let a = analyse(&log.samples(SAMPLES, seed), 0.01, CONFIDENCE).unwrap();
             let (r, h) = honest(&a, log);
-            (r, h, old_fit_covers(&a, log), physical(&a))
+            (r, h, old_fit_covers(&a, log), physical(&a), named(&a))
         })
         .collect();
     let count = |f: &dyn Fn(&PerLog) -> bool| per.iter().filter(|p| f(p)).count() as u64;
@@ -142,13 +157,15 @@ fn study(log: &FeatureLog) -> Study {
         honest: [0, 1, 2].map(|j| count(&|p| p.1[j])),
         old_covered: [0, 1, 2].map(|j| count(&|p| p.2[j])),
         physical: count(&|p| p.3),
+        sinusoid_named: count(&|p| p.4[0]),
+        trend_named: count(&|p| p.4[1]),
     }
 }
 
 fn check(name: &str, log: &FeatureLog) -> Study {
     let s = study(log);
     eprintln!(
-        "{name}: rejected {} of {SEEDS}; honest N {} B {} K {}; old fit covers N {} B {} K {}; physical {}",
+        "{name}: rejected {} of {SEEDS}; honest N {} B {} K {}; old fit covers N {} B {} K {}; physical {}; named a sinusoid {}, a trend {}",
         s.rejected,
         s.honest[0],
         s.honest[1],
@@ -156,7 +173,9 @@ fn check(name: &str, log: &FeatureLog) -> Study {
         s.old_covered[0],
         s.old_covered[1],
         s.old_covered[2],
-        s.physical
+        s.physical,
+        s.sinusoid_named,
+        s.trend_named
     );
     s
 }
@@ -171,7 +190,7 @@ fn reports_are_honest_on_every_family_and_the_old_fit_is_not_on_the_sinusoid() {
         ..BASE
     };
     let trend = FeatureLog {
-        rate_ramp_m_s3: 5e-6,
+        rate_ramp_m_s3: 2e-5,
         ..BASE
     };
     for (name, log) in [("flicker", BASE), ("sinusoid", sinusoid), ("trend", trend)] {
@@ -191,6 +210,18 @@ fn reports_are_honest_on_every_family_and_the_old_fit_is_not_on_the_sinusoid() {
                 inside(s.honest[j]),
                 "{name}: {t:?} honest in {} of {SEEDS}",
                 s.honest[j]
+            );
+        }
+        let expected_sinusoids = if name == "sinusoid" { SEEDS } else { 0 };
+        assert_eq!(
+            s.sinusoid_named, expected_sinusoids,
+            "{name}: sinusoids named"
+        );
+        if name == "trend" {
+            assert!(
+                !inside(s.old_covered[2]),
+                "the negative control passed: the old fit covers K {} on the trend logs",
+                s.old_covered[2]
             );
         }
         if name == "sinusoid" {
