@@ -2,6 +2,7 @@
 //! curve the model does not have, and — when the goodness-of-fit test rejects the model — the
 //! terms read off the curve the way IEEE Std 952-1997 (annex C) reads them.
 
+use super::edf::chi_squared_interval;
 use super::fit::{Fit, Term, TermEstimate, whisker_floor};
 use super::{AllanPoint, FitPoint};
 use crate::stats::{Tail, chi_squared_quantile};
@@ -34,12 +35,16 @@ pub struct Departure {
     pub standardized: Option<f64>,
     /// σ̂/σ_fit.
     pub ratio: f64,
-    /// Whether the fitted σ lies inside the estimate's interval (true without an interval).
+    /// Whether the fitted σ lies inside the estimate's χ² interval at 1 − α/k, α the
+    /// goodness-of-fit test's, k the points with an EDF (Bonferroni: on a log drawn from the
+    /// model, any point departs with probability at most α); true without an EDF.
     pub holds: bool,
 }
 
 /// The departure of `fit` from every point.
 pub fn departures(points: &[AllanPoint], fit: &Fit) -> Vec<Departure> {
+    let k = points.iter().filter(|p| p.edf.is_some()).count().max(1);
+    let confidence = 1.0 - fit.goodness.alpha / k as f64;
     points
         .iter()
         .map(|p| {
@@ -51,9 +56,10 @@ pub fn departures(points: &[AllanPoint], fit: &Fit) -> Vec<Departure> {
                     .edf
                     .map(|e| (p.adev * p.adev - f) / (2.0 * f * f / e).sqrt()),
                 ratio: p.adev / fit_adev,
-                holds: p
-                    .interval
-                    .is_none_or(|(lo, hi)| lo <= fit_adev && fit_adev <= hi),
+                holds: p.edf.is_none_or(|e| {
+                    let (lo, hi) = chi_squared_interval(p.adev, e, confidence);
+                    lo <= fit_adev && fit_adev <= hi
+                }),
             }
         })
         .collect()

@@ -15,7 +15,7 @@ use crate::format::{count, sig};
 use crate::plot::{self, AllanMark, AllanSeries, TermCurve};
 
 /// The fitted model of the Allan variance (IEEE Std 952, annex C), as LaTeX.
-const MODEL: &str = r"\sigma^2(\tau) = \frac{3Q^2}{\tau^2} + \frac{N^2}{\tau} + \frac{2\ln 2}{\pi}B^2 + \frac{K^2\tau}{3}";
+const MODEL: &str = r"\sigma^2(\tau) = \frac{3Q^2}{\tau^2} + \frac{N^2}{\tau} + \frac{2\ln 2}{\pi}B^2 + \frac{K^2\tau}{3} + \frac{R^2\tau^2}{2}";
 
 /// Points along each curve of the figure.
 pub const CURVE_POINTS: usize = 200;
@@ -138,14 +138,22 @@ pub fn verdict_sentence(a: &Analysis) -> String {
         format!("; {}", features.join("; "))
     };
     let span = departing_span(&a.points, &a.departures).map_or(String::new(), |s| {
-        format!(
-            ": the fit leaves the intervals at {} τ from {} to {} s, σ̂/σ_fit from {} to {}",
-            s.count,
-            sig(s.from_tau_s, 2),
-            sig(s.to_tau_s, 2),
-            sig(s.least_ratio, 2),
-            sig(s.largest_ratio, 2)
-        )
+        if s.count == 1 {
+            format!(
+                "; the fit leaves one point, at τ = {} s (σ̂/σ_fit = {})",
+                sig(s.from_tau_s, 2),
+                sig(s.largest_ratio, 2)
+            )
+        } else {
+            format!(
+                "; the fit leaves {} points from τ = {} to {} s, σ̂/σ_fit from {} to {}",
+                s.count,
+                sig(s.from_tau_s, 2),
+                sig(s.to_tau_s, 2),
+                sig(s.least_ratio, 2),
+                sig(s.largest_ratio, 2)
+            )
+        }
     });
     match a.reading {
         Reading::Fit => format!(
@@ -359,7 +367,7 @@ pub fn view(
         1,
         "The Allan deviation of the log",
         &format!(
-            "The overlapping Allan deviation (dots) at octave-spaced τ with its {confidence} % χ² intervals (whiskers; equivalent degrees of freedom of Greenhall and Riley for the noise identified at each τ by its lag-1 autocorrelation), each resolved reported noise term as a line of its slope, and the constrained model fit (grey) drawn only over the τ where it lies inside the intervals; the points it misses are ringed."
+            "The overlapping Allan deviation (dots) at octave-spaced τ with its {confidence} % χ² intervals (whiskers; equivalent degrees of freedom of Greenhall and Riley for the noise identified at each τ by its lag-1 autocorrelation), each resolved reported noise term as a line of its slope, and the constrained model fit (grey) drawn only over the τ where it holds; the points it misses are ringed (the fit outside the point's χ² interval at 1 − α/k, α = 0.01 the goodness-of-fit test's, k the points with an EDF)."
         ),
         plot::allan_deviation(&series(a)),
     )?;
