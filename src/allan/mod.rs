@@ -7,8 +7,12 @@
 //!    Greenhall 2004);
 //! 3. [`edf`]: the equivalent degrees of freedom of each estimate for that noise (Greenhall &
 //!    Riley 2003) and its χ² interval (SP 1065, eq. 45);
-//! 4. [`fit`](mod@fit): the terms Q, N, B, K by weighted least squares, with intervals from the exact
-//!    covariance of the estimates across τ ([`covariance`]).
+//! 4. [`fit`](mod@fit): the terms Q, N, B, K, R by weighted least squares with every squared term
+//!    ≥ 0 ([`nnls`]) over every τ with an EDF, with intervals from the exact covariance of the
+//!    estimates across τ ([`covariance`]) and a test of the fit ([`goodness`]);
+//! 5. [`reading`]: where the fit departs from the points, the features it lacks (a sinusoid, a
+//!    trend), and the IEEE 952 reading off the curve that replaces the fit when the test rejects
+//!    it.
 //!
 //! [`simulate`] draws synthetic static logs with known terms (for the tests, the report and the
 //! benchmarks); [`export`] writes `allan.json`, `noise.toml` and `imu.yaml`; [`section`] measures
