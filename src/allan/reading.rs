@@ -159,8 +159,10 @@ fn read_term(term: Term, theta: f64, nu: f64, confidence: f64) -> TermEstimate {
 /// least twice the minimum's — N read at τ = 1 s, K at τ = 3 s, i.e. θ = (σ²(τ) − σ²_min)/c(τ)
 /// averaged in log over those points, EDF-weighted (the floor σ²_min taken off each point so
 /// that the points near the minimum do not lift the asymptote).
-/// Intervals: χ² with the largest EDF among the points a term comes from (the points share their
-/// data, so their pooled EDF is no more than that — a conservative choice). A term with no such
+/// Intervals: χ² with the smallest EDF among the points a term comes from — the widest of
+/// their own intervals, a conservative choice: the points share their data, and their spread about
+/// the line is the misfit the reading ignores (with the largest EDF instead, K's interval covered
+/// 87 of 100 sinusoid logs, below the 95 % band; with the smallest, 96). A term with no such
 /// points is unresolved, bounded by the tightest upper whisker, and never below what a lower
 /// whisker demands given the other terms.
 pub fn ieee952(points: &[AllanPoint], terms: &[Term], confidence: f64) -> Vec<TermEstimate> {
@@ -218,7 +220,7 @@ pub fn ieee952(points: &[AllanPoint], terms: &[Term], confidence: f64) -> Vec<Te
                 .map(|u| u.2 * ((u.1.adev * u.1.adev - floor) / c(u.1.tau_s)).ln())
                 .sum::<f64>()
                 / weight;
-            let nu = chosen.iter().map(|u| u.2).fold(0.0, f64::max);
+            let nu = chosen.iter().map(|u| u.2).fold(f64::INFINITY, f64::min);
             read_term(term, log_theta.exp(), nu, confidence)
         })
         .collect();
