@@ -96,6 +96,53 @@ pub fn short(x: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// An estimate and its interval's ends, each with the significant digits that show the
+/// interval's width: the fewest digits d ≥ `min_sig` (at most 17) at which the printed ends
+/// differ from each other and each from the printed estimate, wherever they differ as numbers.
+/// All three take the same d; rounding to d significant digits is monotone, so the printed ends
+/// keep their order.
+///
+/// # Examples
+/// ```
+/// use accelcal::format::interval;
+/// // 0.061389 ± 1.06 × 10⁻⁵ at 3 digits would read [0.0614, 0.0614].
+/// let (v, lo, hi) = interval(0.0613890, 0.0613682, 0.0614098, 3);
+/// assert_eq!((v.as_str(), lo.as_str(), hi.as_str()), ("0.06139", "0.06137", "0.06141"));
+/// assert_eq!(interval(1.5, 1.0, 2.0, 3).1, "1.00");
+/// ```
+pub fn interval(value: f64, lower: f64, upper: f64, min_sig: usize) -> (String, String, String) {
+    let d = interval_digits(value, lower, upper, min_sig);
+    (sig(value, d), sig(lower, d), sig(upper, d))
+}
+
+/// The significant digits [`interval`] gives an estimate and its interval's ends: the fewest
+/// d ≥ `min_sig` (within 1…17) at which pairs that differ as numbers differ as printed.
+pub fn interval_digits(value: f64, lower: f64, upper: f64, min_sig: usize) -> usize {
+    let min_sig = min_sig.clamp(1, 17);
+    // Compared as numbers read back: a carry prints −0.97 at one digit as "−1.0", −1.2 as "−1".
+    let apart = |d: usize| {
+        let [v, l, u] = [value, lower, upper].map(|x| reading(&sig(x, d)));
+        (lower == upper || l != u) && (lower == value || l != v) && (upper == value || u != v)
+    };
+    (min_sig..=17).find(|&d| apart(d)).unwrap_or(17)
+}
+
+/// The number [`sig`] printed, read back: the true minus sign, "m × 10ⁿ"; NaN for "—".
+fn reading(text: &str) -> f64 {
+    let text = text.replace('−', "-");
+    let Some((mantissa, power)) = text.split_once(" × 10") else {
+        return text.parse().unwrap_or(f64::NAN);
+    };
+    let exponent: String = power
+        .chars()
+        .map(|c| match SUPERSCRIPTS.iter().position(|&d| d == c) {
+            Some(k) => char::from(b'0' + k as u8),
+            None => '-',
+        })
+        .collect();
+    format!("{mantissa}e{exponent}").parse().unwrap_or(f64::NAN)
+}
+
 /// A whole number with thin-space thousands separators: 10 000.
 pub fn count(n: u64) -> String {
     let digits = n.to_string();
@@ -148,6 +195,32 @@ mod tests {
         assert_eq!(short(0.005), "0.005");
         assert_eq!(short(0.6283185307179586), "0.6283");
         assert_eq!(short(30.0), "30");
+    }
+
+    #[test]
+    fn interval_ends_differ_from_each_other_and_from_the_estimate() {
+        // The hour-long simulated log's bias: 0.0613890 ± 1.96 × 1.06 × 10⁻⁵.
+        let (b, h) = (0.0613890, 1.96 * 1.06e-5);
+        let (v, lo, hi) = interval(b, b - h, b + h, 3);
+        assert_eq!(
+            (v.as_str(), lo.as_str(), hi.as_str()),
+            ("0.06139", "0.06137", "0.06141")
+        );
+        // Wide enough at 3 digits: nothing added.
+        assert_eq!(
+            interval(-0.56, -0.567, -0.554, 3),
+            ("−0.560".into(), "−0.567".into(), "−0.554".into())
+        );
+        // An end equal to the estimate stays equal; the other still differs.
+        assert_eq!(interval(1.0, 1.0, 1.0 + 1e-9, 3).2, "1.000000001");
+        assert_eq!(
+            interval(2.0, 2.0, 2.0, 3),
+            ("2.00".into(), "2.00".into(), "2.00".into())
+        );
+        assert_eq!(interval(2.5e-5, 2.4e-5, 2.6e-5, 2).1, "2.4 × 10⁻⁵");
+        // A carry at one digit prints −0.97 as "−1.0" and −1.2 as "−1": one number.
+        assert_eq!(interval(-0.966, -1.215, 0.0, 1).1, "−1.2");
+        assert_eq!(reading("−2.5 × 10⁻⁵"), -2.5e-5);
     }
 
     #[test]

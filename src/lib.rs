@@ -19,6 +19,7 @@ pub mod error;
 pub mod export;
 pub mod filter;
 pub mod format;
+pub mod ins;
 pub mod lanes;
 pub mod likelihood;
 pub mod logs;

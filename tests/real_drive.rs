@@ -32,6 +32,29 @@ fn the_real_drive_calibrates_as_the_report_says() {
         s.bias_m_s2,
         s.bias_sigma_m_s2
     );
+    // Every run's flag is the tests' verdicts, and the runs the NIS test rejects say so.
+    for (i, r) in runs.iter().enumerate() {
+        let s = &r.calibration.summary;
+        let rejects = s.nis.verdict == "fail"
+            || s.diagnostics.bias.verdict == "fail"
+            || s.diagnostics
+                .measurements
+                .iter()
+                .any(|m| m.whiteness.verdict == "fail");
+        assert_eq!(
+            s.intervals_conditional, rejects,
+            "run {i}: {:?}",
+            s.rejected_by
+        );
+        assert!(s.bias_robust.sigma >= s.bias_sigma_m_s2, "run {i}");
+    }
+    assert!(
+        runs[0]
+            .calibration
+            .summary
+            .rejected_by
+            .contains(&"nis".to_string())
+    );
     // The raw axis with a random walk: K is identified (gravity's share moves with the pitch).
     let k = &runs[3].noise.keys[3];
     assert!(k.identifiable, "{k:?}");
@@ -148,4 +171,44 @@ fn a_prior_900_sigma_off_warns_and_the_first_fix_gives_the_right_sign() {
     let position = &s["diagnostics"]["measurements"][0];
     assert_eq!(position["measurement"], "position");
     assert_eq!(position["whiteness"]["verdict"], "fail", "{position}");
+}
+
+#[test]
+fn the_raw_axis_with_the_defaults_says_its_interval_rests_on_a_rejected_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let raw = format!("\"{}\"", example("accel_raw.csv").display());
+    let (said, s) = calibrate_sh(d, &raw, "", "raw");
+    // The NIS sum is hundreds of times its band: the flag, the tests, and the words beside the
+    // interval.
+    assert_eq!(s["intervals_conditional"], true, "{said}");
+    let rejected: Vec<&str> = s["rejected_by"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap())
+        .collect();
+    assert!(rejected.contains(&"nis"), "{rejected:?}");
+    assert!(
+        said.contains("which assumes a model the data reject (nis"),
+        "{said}"
+    );
+    assert!(said.contains("bias without white innovations:"), "{said}");
+    // The interval that does not assume white innovations is wider by √F, F ≥ the NIS mean's
+    // excess (the sum is above its band, so the innovations' variance alone is > 1).
+    let r = &s["bias_robust"];
+    let (sigma, robust) = (
+        s["bias_sigma_m_s2"].as_f64().unwrap(),
+        r["sigma"].as_f64().unwrap(),
+    );
+    let factor = r["variance_factor"].as_f64().unwrap();
+    assert!((robust / sigma - factor.sqrt()).abs() < 1e-9 * factor.sqrt());
+    let nis_mean = s["nis"]["mean"].as_f64().unwrap();
+    assert!(factor > nis_mean / 2.0, "F {factor}, NIS mean {nis_mean}");
+    // The printed ends differ: at three digits alone they read [−0.614, −0.613].
+    let line = said.lines().find(|l| l.starts_with("bias ")).unwrap();
+    let ends = line.split("interval [").nth(1).unwrap();
+    let (lo, hi) = ends.split_once(']').unwrap().0.split_once(", ").unwrap();
+    assert_ne!(lo, hi, "{line}");
+    assert!(lo.len() > "−0.614".len(), "{line}");
 }

@@ -28,6 +28,7 @@ pub mod noise;
 pub mod pass;
 mod record;
 mod replay;
+pub mod robust;
 mod scan;
 mod smoother;
 pub mod summary;

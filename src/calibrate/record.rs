@@ -1,7 +1,7 @@
 //! A calibration's results as they are handed on: the summary and the per-fix series.
 
 use super::summary::{Calibration, FilterRecord, FixReport, StateRecord, Summary, sigma};
-use super::{Prepared, StepMode, diagnose, nis_test, noise, warnings};
+use super::{Prepared, StepMode, diagnose, nis_test, noise, robust, warnings};
 use crate::state::{ErrorState, StateVector};
 
 impl Prepared<'_> {
@@ -38,12 +38,28 @@ impl Prepared<'_> {
             })
             .collect();
         let (lo, hi) = sc.accepted_step_s();
+        let nis_test = nis_test(&nis, s.false_alarm_rate);
+        let diagnostics = diagnose::diagnose(
+            &self.fixes,
+            &self.smoothed,
+            f,
+            &nis_test,
+            s.false_alarm_rate,
+        );
+        let rejected_by = robust::rejected_by(&nis_test, &diagnostics);
+        let (bias, bias_sigma) = (
+            x_end[ErrorState::BIAS],
+            p_end[(ErrorState::BIAS, ErrorState::BIAS)].sqrt(),
+        );
         let summary = Summary {
             accelcal_version: env!("CARGO_PKG_VERSION"),
             accelerometer_log: self.accel.name().to_string(),
             gps_log: sc.gps_name.clone(),
-            bias_m_s2: x_end[ErrorState::BIAS],
-            bias_sigma_m_s2: p_end[(ErrorState::BIAS, ErrorState::BIAS)].sqrt(),
+            bias_m_s2: bias,
+            bias_sigma_m_s2: bias_sigma,
+            intervals_conditional: !rejected_by.is_empty(),
+            rejected_by,
+            bias_robust: robust::bias_robust(bias, bias_sigma, &self.fixes),
             samples: sc.samples,
             fixes: self.fixes.len(),
             start_s: sc.span_s.0,
@@ -59,7 +75,7 @@ impl Prepared<'_> {
             start_smoothed: StateRecord::new(&start_smoothed.0, &start_smoothed.1),
             end_estimate: StateRecord::new(x_end, p_end),
             end_smoothed: StateRecord::new(x_end, p_end),
-            nis: nis_test(&nis, s.false_alarm_rate),
+            nis: nis_test,
             filter: self.filter_record(),
             // A prior taken from the first fix agrees with it by construction; it may lie far
             // from the log's start.
@@ -68,13 +84,7 @@ impl Prepared<'_> {
             } else {
                 warnings::prior_warnings(fixes.first())
             },
-            diagnostics: diagnose::diagnose(
-                &self.fixes,
-                &self.smoothed,
-                f,
-                &nis_test(&nis, s.false_alarm_rate),
-                s.false_alarm_rate,
-            ),
+            diagnostics,
             log_likelihood: noise::log_likelihood(&self.fixes),
             noise_estimate: self.noise.clone().map(noise::NoiseRecord),
         };

@@ -329,6 +329,12 @@ pub struct Summary {
     pub bias_m_s2: f64,
     /// Its σ, m/s².
     pub bias_sigma_m_s2: f64,
+    /// Whether a test rejects the model the bias's σ assumes: `rejected_by` is not empty.
+    pub intervals_conditional: bool,
+    /// The tests that reject, by name ([`rejected_by`](super::robust::rejected_by)).
+    pub rejected_by: Vec<String>,
+    /// The bias with an interval that does not assume white innovations.
+    pub bias_robust: super::robust::BiasRobust,
     /// Accelerometer samples.
     pub samples: u64,
     /// GPS fixes applied.

@@ -13,7 +13,7 @@ use accelcal::calibrate::{self, Settings};
 use accelcal::config::{Config, ConfigText};
 use accelcal::error::ConfigError;
 use accelcal::filter::FilterSchedule;
-use accelcal::format::{count, sig};
+use accelcal::format::{count, interval, interval_digits, sig};
 use accelcal::likelihood::{Key, NoiseEstimate, Request};
 use accelcal::logs::read::{LogFile, LogSource};
 use accelcal::logs::write::LogWriter;
@@ -195,13 +195,20 @@ fn print_result(
     if let Some(e) = noise {
         super::say(&noise_lines(e))?;
     }
+    let z = accelcal::stats::normal_bound(1.0 - calibrate::robust::CONFIDENCE);
+    let (b, h) = (s.bias_m_s2, z * s.bias_sigma_m_s2);
+    let d = interval_digits(b, b - h, b + h, 3);
+    let conditional = match calibrate::robust::conditional_words(&s.rejected_by) {
+        w if w.is_empty() => w,
+        w => format!(", which {w}"),
+    };
     super::say(&format!(
-        "bias {} ± {} m/s² (95 % interval [{}, {}]) at t = {} s ({} samples, {} fixes, Δt mode \
-         {}{model}); NIS test {} (sum {} {} [{}, {}]); written to {}\n",
-        sig(s.bias_m_s2, 6),
+        "bias {} ± {} m/s² (95 % interval [{}, {}]{conditional}) at t = {} s ({} samples, {} \
+         fixes, Δt mode {}{model}); NIS test {} (sum {} {} [{}, {}]); written to {}\n",
+        sig(b, d.max(6)),
         sig(s.bias_sigma_m_s2, 3),
-        sig(s.bias_m_s2 - 1.96 * s.bias_sigma_m_s2, 3),
-        sig(s.bias_m_s2 + 1.96 * s.bias_sigma_m_s2, 3),
+        sig(b - h, d),
+        sig(b + h, d),
         s.end_s,
         count(s.samples),
         count(s.fixes as u64),
@@ -213,6 +220,12 @@ fn print_result(
         sig(s.nis.upper, 5),
         args.out.join(PAGE_FILE).display()
     ))?;
+    if s.intervals_conditional {
+        super::say(&format!(
+            "bias without white innovations: {}\n",
+            s.bias_robust.words(&s.rejected_by)
+        ))?;
+    }
     super::say(&format!("diagnosis: {}\n", s.diagnostics.headline()))?;
     Ok(())
 }
@@ -263,12 +276,10 @@ fn noise_lines(e: &NoiseEstimate) -> String {
     for k in &e.keys {
         let unit = k.key.unit();
         let line = if k.identifiable {
+            let (value, lower, upper) = interval(k.value, k.lower, k.upper.unwrap_or(f64::NAN), 4);
             format!(
-                "  {} = {} {unit}, interval [{}, {}]\n",
-                k.key.name(),
-                sig(k.value, 4),
-                sig(k.lower, 4),
-                sig(k.upper.unwrap_or(f64::NAN), 4)
+                "  {} = {value} {unit}, interval [{lower}, {upper}]\n",
+                k.key.name()
             )
         } else {
             let known = match (k.lower > 0.0, k.upper) {

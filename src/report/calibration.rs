@@ -28,6 +28,14 @@ pub struct CalibrationView {
     pub version: String,
     /// The bias estimate with its σ and unit.
     pub bias: String,
+    /// Its 95 % interval with the digits that show its width: "[−0.6137, −0.6126] m/s²".
+    pub bias_interval: String,
+    /// That the interval assumes a model the data reject, and which tests reject it; empty
+    /// when none does.
+    pub conditional: String,
+    /// The bias with an interval that does not assume white innovations, in words; empty
+    /// when no test rejects.
+    pub robust: String,
     /// Time stamp of the last sample, s.
     pub end_time: String,
     /// The logs and their extent.
@@ -80,6 +88,15 @@ fn with_sigma(x: f64, s: f64, unit: &str) -> String {
         3
     };
     format!("{} ± {} {unit}", sig(x, digits.min(12)), sig(s, 2))
+}
+
+/// The bias's interval at the printed line's confidence, its ends with the digits of
+/// [`crate::format::interval`].
+fn bias_interval(s: &Summary) -> String {
+    let z = crate::stats::normal_bound(1.0 - crate::calibrate::robust::CONFIDENCE);
+    let (b, h) = (s.bias_m_s2, z * s.bias_sigma_m_s2);
+    let (_, lo, hi) = crate::format::interval(b, b - h, b + h, 3);
+    format!("[{lo}, {hi}] m/s²")
 }
 
 fn seconds(x: f64) -> String {
@@ -196,6 +213,13 @@ pub fn build(
     Ok(CalibrationView {
         version: s.accelcal_version.to_string(),
         bias: with_sigma(s.bias_m_s2, s.bias_sigma_m_s2, "m/s²"),
+        bias_interval: bias_interval(s),
+        conditional: crate::calibrate::robust::conditional_words(&s.rejected_by),
+        robust: if s.intervals_conditional {
+            s.bias_robust.words(&s.rejected_by)
+        } else {
+            String::new()
+        },
         end_time: short(s.end_s),
         logs: logs(s),
         method_html: method(s),

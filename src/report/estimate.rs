@@ -9,7 +9,7 @@ use serde::Serialize;
 use super::figures::figure;
 use super::view::FigureView;
 use super::{RenderError, rich};
-use crate::format::{count, fixed, percent, sig};
+use crate::format::{count, fixed, interval, percent, sig};
 use crate::likelihood::{Key, KeyEstimate, NoiseEstimate};
 use crate::plot::{self, ProfileSeries};
 
@@ -30,12 +30,11 @@ pub(super) fn with_unit(x: f64, key: Key) -> String {
 /// the one bound it gives (never the bare value).
 pub fn estimate_words(k: &KeyEstimate) -> String {
     match (k.identifiable, k.lower > 0.0, k.upper) {
-        (true, _, Some(u)) => format!(
-            "{} [{}, {}]",
-            with_unit(k.value, k.key),
-            sig(k.lower, 3),
-            with_unit(u, k.key)
-        ),
+        (true, _, Some(u)) => {
+            let (value, lower, upper) = interval(k.value, k.lower, u, 3);
+            let unit = k.key.unit();
+            format!("{value} {unit} [{lower}, {upper} {unit}]")
+        }
         (_, false, Some(u)) => format!(
             "not identifiable: only an upper bound, {} ≤ {}",
             symbol(k.key),
@@ -50,14 +49,16 @@ pub fn estimate_words(k: &KeyEstimate) -> String {
     }
 }
 
-/// The interval as text, an open end written as 0 or ∞.
+/// The interval as text, an open end written as 0 or ∞; closed ends with the digits that
+/// tell them from each other and from the estimate ([`interval`]).
 pub(super) fn interval_words(k: &KeyEstimate) -> String {
-    let lower = if k.lower > 0.0 {
-        sig(k.lower, 3)
+    let (_, lo, hi) = interval(k.value, k.lower, k.upper.unwrap_or(f64::INFINITY), 3);
+    let lower = if k.lower > 0.0 { lo } else { "0".to_string() };
+    let upper = if k.upper.is_some() {
+        hi
     } else {
-        "0".to_string()
+        "∞".to_string()
     };
-    let upper = k.upper.map_or_else(|| "∞".to_string(), |u| sig(u, 3));
     format!("[{lower}, {upper}]")
 }
 

@@ -10,9 +10,11 @@ use super::outline::{Figure, Label, Numbers, Table};
 
 use super::view::FigureView;
 use super::{RenderError, ReportInput, rich};
-use crate::format::{fixed, sig};
+use crate::calibrate::robust;
+use crate::format::{fixed, interval, sig};
 use crate::likelihood::KeyEstimate;
 use crate::plot;
+use crate::stats::normal_bound;
 use crate::study::drive::{Axis, DRIVE_DIR, DriveRun};
 
 /// One run's row of the section's table.
@@ -24,8 +26,11 @@ pub struct DriveRow {
     pub estimates: Vec<String>,
     /// The bias at the end ± σ, m/s².
     pub bias: String,
-    /// Its 95 % interval.
+    /// Its 95 % interval, the ends with the digits that tell them apart.
     pub bias_interval: String,
+    /// When a test rejects the model that interval rests on: which, and the interval from the
+    /// innovations' long-run variance; empty otherwise.
+    pub conditional: String,
     /// The smoothed bias at the start ± σ.
     pub bias_start: String,
     /// The NIS sum against its band.
@@ -84,11 +89,21 @@ fn row(r: &DriveRun) -> DriveRow {
         run: run_words(r),
         estimates: r.noise.keys.iter().map(named_estimate).collect(),
         bias: format!("{} ± {}", sig(b.0, 3), sig(b.1, 2)),
-        bias_interval: format!(
-            "[{}, {}]",
-            sig(b.0 - 1.96 * b.1, 3),
-            sig(b.0 + 1.96 * b.1, 3)
-        ),
+        bias_interval: {
+            let h = normal_bound(1.0 - robust::CONFIDENCE) * b.1;
+            let (_, lo, hi) = interval(b.0, b.0 - h, b.0 + h, 3);
+            format!("[{lo}, {hi}]")
+        },
+        conditional: if s.intervals_conditional {
+            let r = &s.bias_robust;
+            let (_, lo, hi) = interval(r.value, r.lower, r.upper, 3);
+            format!(
+                "{}; without white innovations [{lo}, {hi}]",
+                robust::conditional_words(&s.rejected_by)
+            )
+        } else {
+            String::new()
+        },
         bias_start: format!(
             "{} ± {}",
             sig(start.bias_m_s2, 3),
@@ -108,6 +123,28 @@ fn row(r: &DriveRun) -> DriveRow {
             .map(|m| format!("{}: {}", m.measurement, m.whiteness.verdict))
             .collect(),
     }
+}
+
+/// When the bias's interval rests on a model the data reject: which tests reject it, and where
+/// the interval from the innovations' long-run variance lies against zero.
+fn robust_sign(s: &crate::calibrate::summary::Summary) -> String {
+    if !s.intervals_conditional {
+        return String::new();
+    }
+    let r = &s.bias_robust;
+    let (_, lo, hi) = interval(r.value, r.lower, r.upper, 3);
+    let place = if r.upper < 0.0 {
+        "lies below zero too"
+    } else if r.lower > 0.0 {
+        "lies above zero too"
+    } else {
+        "holds zero"
+    };
+    format!(
+        "; but that interval {}, and the one from the innovations' long-run variance, \
+         [{lo}, {hi}] m/s², {place}",
+        robust::conditional_words(&s.rejected_by)
+    )
 }
 
 /// The sentences the numbers decide.
@@ -163,9 +200,10 @@ pub fn findings(runs: &[DriveRun]) -> Vec<String> {
             "not distinguishable from zero: its 95 % interval holds zero"
         };
         out.push(format!(
-            "The bias of that run is {} ± {} m/s², {sign}.",
+            "The bias of that run is {} ± {} m/s², {sign}{}.",
             sig(b, 3),
-            sig(sb, 2)
+            sig(sb, 2),
+            robust_sign(s)
         ));
     }
     if let Some(rw) = runs

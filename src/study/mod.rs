@@ -6,6 +6,7 @@
 //! it is handed, and knows nothing of terminals or pages.
 
 pub mod analysis;
+pub mod correlated;
 pub mod drift;
 pub mod drive;
 pub mod identify;

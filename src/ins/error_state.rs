@@ -1,0 +1,168 @@
+//! The INS error state of 15 and its continuous-time dynamics F(t), linearized about the
+//! navigation solution.
+//!
+//! Every error is the estimate minus the truth (Groves §14.2): δr^n the position error in NED
+//! metres (δr_N = (R_N + h)δL, δr_E = (R_E + h)cos L·δλ, δr_D = −δh), δv^n the velocity error,
+//! δψ the attitude error with Ĉ_b^n = (I + [δψ×])C_b^n (to first order), δb_g and δb_a the gyro
+//! and accelerometer bias errors. The sensors are compensated by the estimated biases, so
+//! ω̂_ib^b − ω_ib^b = −δb_g and f̂^b − f^b = −δb_a (plus their white noise).
+//!
+//! F is the exact Jacobian of the NED navigation equations (Groves §5.4: ṗ = (v_N/(R_N + h),
+//! v_E/((R_E + h)cos L), −v_D), v̇^n = C_b^n f^b + g^n − (2ω_ie^n + ω_en^n) × v^n,
+//! Ċ_b^n = C_b^n[ω_ib^b×] − [ω_in^n×]C_b^n) in these coordinates: the error equations of Groves
+//! §14.2.4 with every curvature, Earth-rate, transport-rate and gravity-gradient term kept, and
+//! the position block carried from curvilinear to NED metres through T = diag(R_N + h,
+//! (R_E + h)cos L, −1): F_rr = ṪT⁻¹ + T·F_pp·T⁻¹.
+
+use nalgebra::{Matrix3, SMatrix, Vector3};
+
+use super::earth::{self, Geodetic};
+use super::mech::{Pva, skew};
+
+/// The number of error states.
+pub const STATES: usize = 15;
+/// The first index of δr^n (NED, m).
+pub const POSITION: usize = 0;
+/// The first index of δv^n (NED, m/s).
+pub const VELOCITY: usize = 3;
+/// The first index of δψ (rad).
+pub const ATTITUDE: usize = 6;
+/// The first index of δb_g (body axes, rad/s).
+pub const GYRO_BIAS: usize = 9;
+/// The first index of δb_a (body axes, m/s²).
+pub const ACCEL_BIAS: usize = 12;
+
+/// A square matrix over the error state.
+pub type Matrix15 = SMatrix<f64, STATES, STATES>;
+
+/// How each bias group decays: 1/τ of a Gauss–Markov bias, 0 for a constant or a random walk, in
+/// 1/s.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BiasDecay {
+    /// The gyro biases' 1/τ, 1/s.
+    pub gyro_per_s: f64,
+    /// The accelerometer biases' 1/τ, 1/s.
+    pub accel_per_s: f64,
+}
+
+/// The Jacobians of the frame rates and of the velocity equation with respect to position
+/// (curvilinear: L, λ, h) and velocity.
+struct RateJacobians {
+    /// ∂ṗ/∂p (rows L̇, λ̇, ḣ).
+    position_rate_p: Matrix3<f64>,
+    /// ∂ω_in^n/∂p.
+    nav_rate_p: Matrix3<f64>,
+    /// ∂ω_in^n/∂v (also ∂ω_en^n/∂v).
+    nav_rate_v: Matrix3<f64>,
+    /// ∂(2ω_ie^n + ω_en^n)/∂p.
+    coriolis_p: Matrix3<f64>,
+}
+
+/// The partial derivatives of the frame rates at `p` for velocity `v`.
+///
+/// # Formula
+/// With R_n = R_N + h, R_e = R_E + h, ω = ω_ie: ω_in^n = (ω cos L + v_E/R_e, −v_N/R_n,
+/// −ω sin L − v_E tan L/R_e) (Groves §5.4), differentiated term by term; the radii's rates from
+/// [`earth::radii_rate_m_per_rad`].
+fn rate_jacobians(p: &Geodetic, v: &Vector3<f64>) -> RateJacobians {
+    let (rn0, re0) = earth::radii_m(p.lat_rad);
+    let (drn, dre) = earth::radii_rate_m_per_rad(p.lat_rad);
+    let (rn, re) = (rn0 + p.height_m, re0 + p.height_m);
+    let (sl, cl) = p.lat_rad.sin_cos();
+    let tl = sl / cl;
+    let w = earth::ROTATION_RATE_RAD_S;
+    let (vn, ve) = (v.x, v.y);
+    // Transport rate ω_en^n = (v_E/R_e, −v_N/R_n, −v_E tan L/R_e) by L and h.
+    let en_lat = Vector3::new(
+        -ve * dre / (re * re),
+        vn * drn / (rn * rn),
+        -ve * (re / (cl * cl) - tl * dre) / (re * re),
+    );
+    let en_h = Vector3::new(-ve / (re * re), vn / (rn * rn), ve * tl / (re * re));
+    let ie_lat = Vector3::new(-w * sl, 0.0, -w * cl);
+    let columns =
+        |lat: Vector3<f64>, h: Vector3<f64>| Matrix3::from_columns(&[lat, Vector3::zeros(), h]);
+    let nav_rate_v = Matrix3::new(0.0, 1.0 / re, 0.0, -1.0 / rn, 0.0, 0.0, 0.0, -tl / re, 0.0);
+    let position_rate_p = Matrix3::new(
+        -vn * drn / (rn * rn),
+        0.0,
+        -vn / (rn * rn),
+        -ve * (dre * cl - re * sl) / (re * re * cl * cl),
+        0.0,
+        -ve / (re * re * cl),
+        0.0,
+        0.0,
+        0.0,
+    );
+    RateJacobians {
+        position_rate_p,
+        nav_rate_p: columns(ie_lat + en_lat, en_h),
+        nav_rate_v,
+        coriolis_p: columns(2.0 * ie_lat + en_lat, en_h),
+    }
+}
+
+/// The error dynamics F at the navigation solution `pva` with the compensated specific force
+/// `f_b` (body axes, m/s²).
+pub fn dynamics(pva: &Pva, f_b: &Vector3<f64>, decay: &BiasDecay) -> Matrix15 {
+    let p = &pva.position;
+    let v = pva.velocity_ned_m_s;
+    let c = *pva.attitude.to_rotation_matrix().matrix();
+    let (rn0, re0) = earth::radii_m(p.lat_rad);
+    let (drn, dre) = earth::radii_rate_m_per_rad(p.lat_rad);
+    let (rn, re) = (rn0 + p.height_m, re0 + p.height_m);
+    let (sl, cl) = p.lat_rad.sin_cos();
+    let j = rate_jacobians(p, &v);
+
+    // NED metres from curvilinear errors: δr = T·δp, and T's rate along the solution.
+    let t = Matrix3::from_diagonal(&Vector3::new(rn, re * cl, -1.0));
+    let t_inv = Matrix3::from_diagonal(&Vector3::new(1.0 / rn, 1.0 / (re * cl), -1.0));
+    let p_rate = earth::geodetic_rate(p, &v);
+    let (dlat, dh) = (p_rate.x, p_rate.z);
+    let t_rate = Matrix3::from_diagonal(&Vector3::new(
+        drn * dlat + dh,
+        (dre * dlat + dh) * cl - re * sl * dlat,
+        0.0,
+    ));
+
+    let w_ie = earth::earth_rate_ned(p.lat_rad);
+    let w_en = earth::transport_rate_ned(p, &v);
+    let w_in = w_ie + w_en;
+    let coriolis = 2.0 * w_ie + w_en;
+    let (dg_dlat, dg_dh) = earth::gravity_gradient(p);
+    let gravity_p = Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, dg_dlat, 0.0, dg_dh);
+    let sv = skew(&v);
+    let f_n = c * f_b;
+
+    let mut f = Matrix15::zeros();
+    let mut set = |row: usize, col: usize, m: Matrix3<f64>| {
+        f.fixed_view_mut::<3, 3>(row, col).copy_from(&m);
+    };
+    set(
+        POSITION,
+        POSITION,
+        t_rate * t_inv + t * j.position_rate_p * t_inv,
+    );
+    set(POSITION, VELOCITY, Matrix3::identity());
+    // v̇ = C f + g − Ω × v with Ω = 2ω_ie + ω_en: −Ω × v = [v×]Ω.
+    set(VELOCITY, POSITION, (gravity_p + sv * j.coriolis_p) * t_inv);
+    set(VELOCITY, VELOCITY, -skew(&coriolis) + sv * j.nav_rate_v);
+    set(VELOCITY, ATTITUDE, -skew(&f_n));
+    set(VELOCITY, ACCEL_BIAS, -c);
+    // δψ̇ = C δω_ib^b − δω_in^n − ω_in^n × δψ (Groves §14.2.4).
+    set(ATTITUDE, POSITION, -j.nav_rate_p * t_inv);
+    set(ATTITUDE, VELOCITY, -j.nav_rate_v);
+    set(ATTITUDE, ATTITUDE, -skew(&w_in));
+    set(ATTITUDE, GYRO_BIAS, -c);
+    set(
+        GYRO_BIAS,
+        GYRO_BIAS,
+        -decay.gyro_per_s * Matrix3::identity(),
+    );
+    set(
+        ACCEL_BIAS,
+        ACCEL_BIAS,
+        -decay.accel_per_s * Matrix3::identity(),
+    );
+    f
+}

@@ -1,0 +1,91 @@
+//! The loosely coupled GNSS measurement: the antenna's position (and velocity, where the fix has
+//! it) against the INS's, through the lever arm from the IMU to the antenna.
+//!
+//! With the lever arm l^b in body axes, the antenna is at r^n + C_b^n l^b and moves at
+//! v^n + C_b^n(ω_ib^b × l^b) − ω_in^n × C_b^n l^b (Groves §14.3.1, the local-navigation-frame
+//! form). The measurement is the INS's prediction of the antenna minus the fix, in NED metres
+//! (m/s); to first order in the error state (estimate minus truth, `error_state`'s conventions):
+//!
+//! - position: z_r = δr − [(Cl)×]δψ − w_r;
+//! - velocity: z_v = δv − [(C(ω_ib × l))×]δψ + [ω_in×][(Cl)×]δψ + C[l×]δb_g − w_v,
+//!
+//! where δω_ib^b = −δb_g because the gyros are compensated by the estimated bias.
+
+use nalgebra::{Matrix3, SMatrix, Vector3};
+
+use super::earth::{self, Geodetic};
+use super::error_state::{ATTITUDE, GYRO_BIAS, POSITION, STATES, VELOCITY};
+use super::mech::{Pva, skew};
+
+/// One GNSS fix: the antenna's position and, when measured, its velocity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fix {
+    /// Time, s.
+    pub t_s: f64,
+    /// The antenna's position.
+    pub position: Geodetic,
+    /// The antenna's velocity in NED, m/s, when the fix has it.
+    pub velocity_ned_m_s: Option<Vector3<f64>>,
+    /// The position's σ in north, east and down, m.
+    pub position_sigma_m: Vector3<f64>,
+    /// The velocity's σ per component, m/s.
+    pub velocity_sigma_m_s: Vector3<f64>,
+}
+
+/// The INS's antenna position and velocity from `pva`, lever arm `lever_b_m` and the
+/// compensated angular rate `omega_ib_b`.
+pub fn antenna(
+    pva: &Pva,
+    lever_b_m: &Vector3<f64>,
+    omega_ib_b: &Vector3<f64>,
+) -> (Geodetic, Vector3<f64>) {
+    let p = &pva.position;
+    let (rn, re) = earth::radii_m(p.lat_rad);
+    let arm_n = pva.attitude * lever_b_m;
+    let position = Geodetic {
+        lat_rad: p.lat_rad + arm_n.x / (rn + p.height_m),
+        lon_rad: p.lon_rad + arm_n.y / ((re + p.height_m) * p.lat_rad.cos()),
+        height_m: p.height_m - arm_n.z,
+    };
+    let w_in =
+        earth::earth_rate_ned(p.lat_rad) + earth::transport_rate_ned(p, &pva.velocity_ned_m_s);
+    let velocity =
+        pva.velocity_ned_m_s + pva.attitude * omega_ib_b.cross(lever_b_m) - w_in.cross(&arm_n);
+    (position, velocity)
+}
+
+/// `a − b` in NED metres at `a`: ((L_a − L_b)(R_N + h), (λ_a − λ_b)(R_E + h)cos L, −(h_a − h_b)).
+pub fn ned_difference_m(a: &Geodetic, b: &Geodetic) -> Vector3<f64> {
+    let (rn, re) = earth::radii_m(a.lat_rad);
+    Vector3::new(
+        (a.lat_rad - b.lat_rad) * (rn + a.height_m),
+        (a.lon_rad - b.lon_rad) * (re + a.height_m) * a.lat_rad.cos(),
+        -(a.height_m - b.height_m),
+    )
+}
+
+/// The rows of H for the antenna's position (3) and velocity (3).
+pub fn observation(
+    pva: &Pva,
+    lever_b_m: &Vector3<f64>,
+    omega_ib_b: &Vector3<f64>,
+) -> SMatrix<f64, 6, STATES> {
+    let c = *pva.attitude.to_rotation_matrix().matrix();
+    let arm_n = c * lever_b_m;
+    let w_in = earth::earth_rate_ned(pva.position.lat_rad)
+        + earth::transport_rate_ned(&pva.position, &pva.velocity_ned_m_s);
+    let mut h = SMatrix::<f64, 6, STATES>::zeros();
+    let mut set = |row: usize, col: usize, m: Matrix3<f64>| {
+        h.fixed_view_mut::<3, 3>(row, col).copy_from(&m);
+    };
+    set(0, POSITION, Matrix3::identity());
+    set(0, ATTITUDE, -skew(&arm_n));
+    set(3, VELOCITY, Matrix3::identity());
+    set(
+        3,
+        ATTITUDE,
+        -skew(&(c * omega_ib_b.cross(lever_b_m))) + skew(&w_in) * skew(&arm_n),
+    );
+    set(3, GYRO_BIAS, c * skew(lever_b_m));
+    h
+}

@@ -1,0 +1,165 @@
+//! The sensors of one simulated realization: an IMU that reads the truth's increments with a
+//! drifting bias and white noise, and a GNSS receiver that reads the antenna's position and
+//! velocity with white noise.
+//!
+//! Each gyro and accelerometer bias is a first-order Gauss–Markov process (or a constant, or a
+//! random walk) discretized exactly per step, b_{k+1} = e^(−Δt/τ)·b_k + η with
+//! η ~ N(0, σ²(1 − e^(−2Δt/τ))); the white noise adds N(0, ARW²·Δt) to each Δθ and
+//! N(0, VRW²·Δt) to each Δv (angle and velocity random walk: Groves §4.4.3).
+
+use nalgebra::Vector3;
+
+use super::earth::{self, Geodetic};
+use super::mech::Increment;
+use crate::random::Stream;
+
+/// Key of the random streams of three-axis realizations.
+const STREAM_KEY: u64 = 0x696e_735f_7265_616c;
+
+/// How one sensor triad's bias moves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BiasProcess {
+    /// Drawn once from N(0, σ²) and held.
+    Constant {
+        /// σ, in the sensor's unit.
+        sigma: f64,
+    },
+    /// Starts at zero and walks: b(t + τ) − b(t) ~ N(0, K²τ).
+    RandomWalk {
+        /// K, the sensor's unit per √s.
+        k_per_sqrt_s: f64,
+    },
+    /// Stationary first-order Gauss–Markov of σ and correlation time τ.
+    GaussMarkov {
+        /// σ, in the sensor's unit.
+        sigma: f64,
+        /// τ, s.
+        correlation_time_s: f64,
+    },
+}
+
+impl BiasProcess {
+    /// The bias's initial σ (what its estimate's prior variance is), in the sensor's unit.
+    pub fn initial_sigma(self) -> f64 {
+        match self {
+            BiasProcess::Constant { sigma } | BiasProcess::GaussMarkov { sigma, .. } => sigma,
+            BiasProcess::RandomWalk { .. } => 0.0,
+        }
+    }
+
+    /// 1/τ: 0 unless Gauss–Markov.
+    pub fn decay_per_s(self) -> f64 {
+        match self {
+            BiasProcess::GaussMarkov {
+                correlation_time_s, ..
+            } => 1.0 / correlation_time_s,
+            _ => 0.0,
+        }
+    }
+
+    /// The white-noise density that drives the bias, (unit)²/s: K², 2σ²/τ, or 0.
+    pub fn density(self) -> f64 {
+        match self {
+            BiasProcess::Constant { .. } => 0.0,
+            BiasProcess::RandomWalk { k_per_sqrt_s } => k_per_sqrt_s * k_per_sqrt_s,
+            BiasProcess::GaussMarkov {
+                sigma,
+                correlation_time_s,
+            } => 2.0 * sigma * sigma / correlation_time_s,
+        }
+    }
+
+    /// (φ, σ_η) of the exact one-step discretization over `dt`.
+    fn step(self, dt: f64) -> (f64, f64) {
+        match self {
+            BiasProcess::Constant { .. } => (1.0, 0.0),
+            BiasProcess::RandomWalk { k_per_sqrt_s } => (1.0, k_per_sqrt_s * dt.sqrt()),
+            BiasProcess::GaussMarkov {
+                sigma,
+                correlation_time_s,
+            } => (
+                (-dt / correlation_time_s).exp(),
+                sigma * (-(-2.0 * dt / correlation_time_s).exp_m1()).sqrt(),
+            ),
+        }
+    }
+}
+
+/// The IMU's error model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImuModel {
+    /// Angle random walk, rad/√s.
+    pub gyro_arw_rad_per_sqrt_s: f64,
+    /// Velocity random walk, m/s/√s.
+    pub accel_vrw_m_s_per_sqrt_s: f64,
+    /// The gyro biases' process (rad/s).
+    pub gyro_bias: BiasProcess,
+    /// The accelerometer biases' process (m/s²).
+    pub accel_bias: BiasProcess,
+}
+
+/// One realization's IMU: its random stream and its biases now.
+pub struct Imu {
+    model: ImuModel,
+    stream: Stream,
+    /// The gyro biases now, rad/s.
+    pub gyro_bias_rad_s: Vector3<f64>,
+    /// The accelerometer biases now, m/s².
+    pub accel_bias_m_s2: Vector3<f64>,
+}
+
+impl Imu {
+    /// The IMU of realization `seed`, its biases drawn from their initial distributions.
+    pub fn new(model: ImuModel, seed: u64) -> Self {
+        let mut stream = Stream::new(STREAM_KEY, seed);
+        let mut draw = |sigma: f64| Vector3::from_fn(|_, _| sigma * stream.normal());
+        let gyro_bias_rad_s = draw(model.gyro_bias.initial_sigma());
+        let accel_bias_m_s2 = draw(model.accel_bias.initial_sigma());
+        Imu {
+            model,
+            stream,
+            gyro_bias_rad_s,
+            accel_bias_m_s2,
+        }
+    }
+
+    /// What the IMU outputs for the true increments `truth` (its biases then step on).
+    pub fn read(&mut self, truth: &Increment) -> Increment {
+        let dt = truth.dt_s;
+        let s = &mut self.stream;
+        let arw = self.model.gyro_arw_rad_per_sqrt_s * dt.sqrt();
+        let vrw = self.model.accel_vrw_m_s_per_sqrt_s * dt.sqrt();
+        let dtheta = truth.dtheta_rad
+            + self.gyro_bias_rad_s * dt
+            + Vector3::from_fn(|_, _| arw * s.normal());
+        let dvel =
+            truth.dvel_m_s + self.accel_bias_m_s2 * dt + Vector3::from_fn(|_, _| vrw * s.normal());
+        let (phi_g, eta_g) = self.model.gyro_bias.step(dt);
+        let (phi_a, eta_a) = self.model.accel_bias.step(dt);
+        self.gyro_bias_rad_s =
+            self.gyro_bias_rad_s * phi_g + Vector3::from_fn(|_, _| eta_g * s.normal());
+        self.accel_bias_m_s2 =
+            self.accel_bias_m_s2 * phi_a + Vector3::from_fn(|_, _| eta_a * s.normal());
+        Increment {
+            dtheta_rad: dtheta,
+            dvel_m_s: dvel,
+            dt_s: dt,
+        }
+    }
+
+    /// A draw of N(0, σ²) per component from this realization's stream (for the GNSS noise and
+    /// the initial errors, in a fixed order).
+    pub fn normals(&mut self, sigma: &Vector3<f64>) -> Vector3<f64> {
+        Vector3::from_fn(|i, _| sigma[i] * self.stream.normal())
+    }
+}
+
+/// `p` moved by `d` NED metres (small: first order in d/R).
+pub fn offset(p: &Geodetic, d: &Vector3<f64>) -> Geodetic {
+    let (rn, re) = earth::radii_m(p.lat_rad);
+    Geodetic {
+        lat_rad: p.lat_rad + d.x / (rn + p.height_m),
+        lon_rad: p.lon_rad + d.y / ((re + p.height_m) * p.lat_rad.cos()),
+        height_m: p.height_m - d.z,
+    }
+}

@@ -1,0 +1,6 @@
+//! The navigation layer's tests: the mechanization against independent values and the exact
+//! truth; the error dynamics against the navigation equations they linearize.
+
+mod error_state;
+mod filter;
+mod mechanization;
