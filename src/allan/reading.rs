@@ -153,6 +153,19 @@ fn read_term(term: Term, theta: f64, nu: f64, confidence: f64) -> TermEstimate {
     }
 }
 
+/// An unresolved term with the upper bound `upper`.
+fn unresolved(term: Term, upper: f64) -> TermEstimate {
+    TermEstimate {
+        term,
+        value: None,
+        lower: None,
+        upper,
+        squared: 0.0,
+        squared_sigma: f64::NAN,
+        squared_sigma_nominal: f64::NAN,
+    }
+}
+
 /// The terms read off the curve (IEEE Std 952-1997, annex C, fig. C.2): B = σ_min/0.664 from the
 /// minimum; every other term from the line of its slope through the points whose local slope is
 /// within ¼ of it (left of the minimum for Q and N, right of it for K and R) and whose σ² is at
@@ -186,9 +199,12 @@ pub fn ieee952(points: &[AllanPoint], terms: &[Term], confidence: f64) -> Vec<Te
         .map(|&term| {
             let c = |tau: f64| term.coefficient(tau);
             if term == Term::BiasInstability {
-                let (_, p, edf, _) =
-                    usable[usable.iter().position(|u| u.0 == minimum).unwrap_or(0)];
-                return read_term(term, p.adev * p.adev / c(p.tau_s), edf, confidence);
+                return match usable.iter().find(|u| u.0 == minimum) {
+                    Some((_, p, edf, _)) => {
+                        read_term(term, p.adev * p.adev / c(p.tau_s), *edf, confidence)
+                    }
+                    None => unresolved(term, f64::INFINITY),
+                };
             }
             let side = |i: usize| match term.slope() < 0.0 {
                 true => i < minimum,
@@ -204,15 +220,7 @@ pub fn ieee952(points: &[AllanPoint], terms: &[Term], confidence: f64) -> Vec<Te
                     .iter()
                     .map(|u| u.3.1 * u.3.1 / c(u.1.tau_s))
                     .fold(f64::INFINITY, f64::min);
-                return TermEstimate {
-                    term,
-                    value: None,
-                    lower: None,
-                    upper: bound.sqrt(),
-                    squared: 0.0,
-                    squared_sigma: f64::NAN,
-                    squared_sigma_nominal: f64::NAN,
-                };
+                return unresolved(term, bound.sqrt());
             }
             let weight: f64 = chosen.iter().map(|u| u.2).sum();
             let log_theta: f64 = chosen
