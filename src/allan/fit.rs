@@ -350,19 +350,23 @@ fn goodness_tests(
         .collect();
     let naive_w = DVector::from_fn(points.len(), |i, _| naive_edf[i] / edf[i] * w[i]);
     let naive_h = solve_on(a, &s, &naive_w, &sol.free).map_or(sol.h.clone(), |n| n.h);
-    let theta = &sol.theta;
-    let exact = goodness::test(a, &s, &edf, &taus, theta, &sol.h, w, c, Correlation::Exact);
-    let naive = goodness::test(
-        a,
-        &s,
-        &naive_edf,
-        &taus,
-        theta,
-        &naive_h,
-        &naive_w,
-        c,
-        Correlation::Ignored,
-    );
+    let exact_fit = goodness::WeightedFit {
+        design: a,
+        avar: &s,
+        edf: &edf,
+        tau_s: &taus,
+        theta: &sol.theta,
+        h: &sol.h,
+        weights: w,
+    };
+    let naive_fit = goodness::WeightedFit {
+        edf: &naive_edf,
+        h: &naive_h,
+        weights: &naive_w,
+        ..exact_fit
+    };
+    let exact = goodness::test(&exact_fit, c, Correlation::Exact);
+    let naive = goodness::test(&naive_fit, c, Correlation::Ignored);
     (exact, naive)
 }
 

@@ -46,21 +46,29 @@ pub enum Correlation {
     Ignored,
 }
 
-/// The test of the fit `theta` (with `h` = (A_FᵀWA_F)⁻¹ placed in the full matrix, zero off
-/// the support) of design `a` to the estimates `s` with `edf`, weights `w`, at `taus`, with the
-/// exact covariance `c` of the estimates at the fitted levels.
-#[allow(clippy::too_many_arguments)]
-pub fn test(
-    a: &DMatrix<f64>,
-    s: &DVector<f64>,
-    edf: &[f64],
-    taus: &[f64],
-    theta: &DVector<f64>,
-    h: &DMatrix<f64>,
-    w: &DVector<f64>,
-    c: &DMatrix<f64>,
-    correlation: Correlation,
-) -> Goodness {
+/// A weighted fit as the test sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct WeightedFit<'a> {
+    /// The design matrix A.
+    pub design: &'a DMatrix<f64>,
+    /// The estimates σ̂², (m/s²)².
+    pub avar: &'a DVector<f64>,
+    /// Their EDF.
+    pub edf: &'a [f64],
+    /// Their τ, s.
+    pub tau_s: &'a [f64],
+    /// θ̂.
+    pub theta: &'a DVector<f64>,
+    /// (A_FᵀWA_F)⁻¹ placed in the full matrix, zero off the support F.
+    pub h: &'a DMatrix<f64>,
+    /// The weights W.
+    pub weights: &'a DVector<f64>,
+}
+
+/// The test of the fit `f` with the exact covariance `c` of the estimates at the fitted levels.
+pub fn test(f: &WeightedFit, c: &DMatrix<f64>, correlation: Correlation) -> Goodness {
+    let (a, s, edf, taus, theta, h, w) =
+        (f.design, f.avar, f.edf, f.tau_s, f.theta, f.h, f.weights);
     let k = s.len();
     let fitted = a * theta;
     let r = s - &fitted;
