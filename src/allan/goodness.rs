@@ -7,7 +7,7 @@
 //! Σ_ij = ρ_ij √(V_i V_j), V_i = 2σ⁴_fit,i / edf_i (the χ² variance of an estimate with edf_i
 //! degrees of freedom; NIST SP 1065 §5.3) and ρ the correlation of the exact covariance of the
 //! estimates at the fitted levels ([`super::covariance`]). T is a quadratic form in e; with
-//! M = PᵀWPΣ, E[T] = tr M and Var T = 2 tr M², and T ≈ g·χ²_ν with g = Var/(2E), ν = 2E²/Var
+//! M = PᵀWPΣ, E(T) = tr M and Var T = 2 tr M², and T ≈ g·χ²_ν with g = Var/(2E), ν = 2E²/Var
 //! (Satterthwaite, "An approximate distribution of estimates of variance components",
 //! Biometrics Bulletin 2 (1946); Box, Ann. Math. Stat. 25 (1954), theorem 3.1).
 
