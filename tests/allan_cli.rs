@@ -245,3 +245,76 @@ fn the_same_numbers_on_any_thread_count() {
     };
     assert_eq!(run("1"), run("3"));
 }
+
+/// A log with a sinusoid the model lacks: the fit is rejected in `allan.json` (`fit.goodness`,
+/// `fit.reading`, the sinusoid named near its frequency, the per-τ fitted curve), in the files
+/// another tool reads, on the page and in the printed line; a log drawn from the model is not.
+#[test]
+fn a_sinusoid_log_is_rejected_everywhere_and_a_model_log_is_not() {
+    use accelcal::allan::simulate::FeatureLog;
+    let dir = tempfile::tempdir().unwrap();
+    let base = StaticLog {
+        sample_period_s: 0.01,
+        velocity_random_walk_m_s_per_sqrt_s: 1e-3,
+        acceleration_random_walk_m_s2_per_sqrt_s: 1e-4,
+        offset_m_s2: 9.80665,
+    };
+    let sinusoid = FeatureLog {
+        base,
+        bias_instability_m_s2: 0.0,
+        sinusoid_amplitude_m_s2: 4e-3,
+        sinusoid_frequency_hz: 0.5,
+        rate_ramp_m_s3: 0.0,
+    };
+    for (name, y, rejected) in [
+        ("sinusoid", sinusoid.samples(1 << 16, 2), true),
+        ("model", base.samples(1 << 16, 2), false),
+    ] {
+        let csv = dir.path().join(format!("{name}.csv"));
+        write_log(
+            &csv,
+            &["t_s", "accel_m_s2"],
+            y.iter().enumerate().map(|(i, v)| vec![i as f64 * 0.01, *v]),
+        );
+        let out = dir.path().join(name);
+        let o = allan(&[
+            "--accel",
+            csv.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let line = String::from_utf8_lossy(&o.stdout).to_string();
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("allan.json")).unwrap())
+                .unwrap();
+        let fit = &json["fit"];
+        let g = &fit["goodness"];
+        assert_eq!(g["alpha"].as_f64(), Some(0.01), "{g}");
+        for key in ["statistic", "dof", "p_value", "worst_tau_s"] {
+            assert!(g[key].as_f64().is_some_and(f64::is_finite), "{key}: {g}");
+        }
+        let taus = json["tau_s"].as_array().unwrap().len();
+        assert_eq!(json["fit_adev_m_s2"].as_array().unwrap().len(), taus);
+        assert!(fit["rate_ramp_m_s3"]["upper"].as_f64().unwrap() > 0.0);
+        let toml = std::fs::read_to_string(out.join("noise.toml")).unwrap();
+        let yaml = std::fs::read_to_string(out.join("imu.yaml")).unwrap();
+        let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+        if rejected {
+            assert_eq!(g["verdict"], "fail", "{g}");
+            assert_eq!(fit["reading"], "ieee952");
+            let f = &fit["features"][0];
+            assert_eq!(f["kind"], "sinusoid", "{fit}");
+            let hz = f["frequency_hz"].as_f64().unwrap();
+            assert!((0.25..=1.0).contains(&hz), "{hz}");
+            assert!(toml.contains("IEEE Std 952") && yaml.contains("IEEE Std 952"));
+            assert!(line.contains("the model is rejected") && line.contains("sinusoid near"));
+            assert!(page.contains("the model is rejected") && page.contains("departs"));
+        } else {
+            assert_eq!(g["verdict"], "pass", "{g}");
+            assert_eq!(fit["reading"], "fit");
+            assert!(toml.contains("model fit (goodness of fit"), "{toml}");
+            assert!(line.contains("the model fits"), "{line}");
+        }
+    }
+}

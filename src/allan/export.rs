@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use super::{Analysis, Term, TermEstimate};
+use super::{Analysis, Feature, Reading, Term, TermEstimate};
 use crate::format::sig;
 
 /// A term in `allan.json`: `value` null when unresolved, `upper` then its upper bound.
@@ -35,12 +35,76 @@ pub struct FitRecord {
     pub bias_instability_m_s2: TermRecord,
     /// K, m/s²/√s.
     pub acceleration_random_walk_m_s2_per_sqrt_s: TermRecord,
+    /// R, m/s³ (a linear trend of the bias).
+    pub rate_ramp_m_s3: TermRecord,
     /// Q, m/s, when the shortest τ shows phase noise; null otherwise.
     pub quantization_m_s: Option<TermRecord>,
+    /// Where the terms above come from: "fit" (the constrained fit, not rejected) or "ieee952"
+    /// (read off the curve, the fit rejected).
+    pub reading: &'static str,
+    /// The goodness-of-fit test of the constrained fit.
+    pub goodness: GoodnessRecord,
+    /// Features of the curve the model lacks (a sinusoid's hump, a trend).
+    pub features: Vec<FeatureRecord>,
     /// The τ the fit used, s.
     pub tau_s: Vec<f64>,
     /// A term is a value when it stands this many standard errors above zero.
     pub resolution_sigmas: f64,
+}
+
+/// `fit.goodness` of `allan.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GoodnessRecord {
+    /// T = rᵀWr of the σ² residuals.
+    pub statistic: f64,
+    /// The Satterthwaite degrees of freedom ν of T ≈ g·χ²_ν.
+    pub dof: f64,
+    /// The scale g.
+    pub scale: f64,
+    /// P(g·χ²_ν > T).
+    pub p_value: f64,
+    /// The stated false-rejection rate.
+    pub alpha: f64,
+    /// "pass" or "fail" (p < α).
+    pub verdict: &'static str,
+    /// The τ of the largest standardized residual, s.
+    pub worst_tau_s: f64,
+}
+
+/// One entry of `fit.features`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FeatureRecord {
+    /// "sinusoid" or "trend".
+    pub kind: &'static str,
+    /// The τ of a sinusoid's largest departure, or the first τ of a trend's rise, s.
+    pub tau_s: f64,
+    /// A sinusoid's frequency 0.371/τ_peak, Hz (null for a trend).
+    pub frequency_hz: Option<f64>,
+    /// σ̂/σ_fit at that τ (a trend: at the longest τ).
+    pub ratio: f64,
+}
+
+impl From<&Feature> for FeatureRecord {
+    fn from(f: &Feature) -> Self {
+        match *f {
+            Feature::Sinusoid {
+                tau_peak_s,
+                frequency_hz,
+                ratio,
+            } => Self {
+                kind: "sinusoid",
+                tau_s: tau_peak_s,
+                frequency_hz: Some(frequency_hz),
+                ratio,
+            },
+            Feature::Trend { from_tau_s, ratio } => Self {
+                kind: "trend",
+                tau_s: from_tau_s,
+                frequency_hz: None,
+                ratio,
+            },
+        }
+    }
 }
 
 /// `allan.json`.
@@ -64,12 +128,18 @@ pub struct AllanRecord {
     pub edf: Vec<Option<f64>>,
     /// The noise exponent α of S_y ∝ f^α identified at each τ.
     pub noise_alpha: Vec<Option<i32>>,
+    /// The constrained fit's σ(τ) at each τ, m/s².
+    pub fit_adev_m_s2: Vec<f64>,
+    /// (σ̂² − σ²_fit)/√(2σ⁴_fit/edf) at each τ (null without an EDF).
+    pub fit_departure_sigmas: Vec<Option<f64>>,
+    /// Whether the fitted σ lies inside the estimate's interval at each τ.
+    pub fit_holds: Vec<bool>,
     /// The fitted terms.
     pub fit: FitRecord,
 }
 
 fn record(a: &Analysis, term: Term) -> Option<TermRecord> {
-    a.fit.term(term).map(TermRecord::from)
+    a.term(term).map(TermRecord::from)
 }
 
 impl AllanRecord {
@@ -81,6 +151,7 @@ impl AllanRecord {
             upper: f64::NAN,
         };
         let term = |t| record(a, t).unwrap_or_else(|| unfitted.clone());
+        let g = &a.fit.goodness;
         Self {
             samples: a.samples,
             sample_period_s: a.sample_period_s,
@@ -91,11 +162,26 @@ impl AllanRecord {
             adev_upper_m_s2: a.points.iter().map(|p| p.interval.map(|i| i.1)).collect(),
             edf: a.points.iter().map(|p| p.edf).collect(),
             noise_alpha: a.points.iter().map(|p| p.noise.map(|n| n.alpha)).collect(),
+            fit_adev_m_s2: a.departures.iter().map(|d| d.fit_adev).collect(),
+            fit_departure_sigmas: a.departures.iter().map(|d| d.standardized).collect(),
+            fit_holds: a.departures.iter().map(|d| d.holds).collect(),
             fit: FitRecord {
                 velocity_random_walk_m_s_per_sqrt_s: term(Term::VelocityRandomWalk),
                 bias_instability_m_s2: term(Term::BiasInstability),
                 acceleration_random_walk_m_s2_per_sqrt_s: term(Term::AccelerationRandomWalk),
+                rate_ramp_m_s3: term(Term::RateRamp),
                 quantization_m_s: record(a, Term::Quantization),
+                reading: a.reading.key(),
+                goodness: GoodnessRecord {
+                    statistic: g.statistic,
+                    dof: g.dof,
+                    scale: g.scale,
+                    p_value: g.p_value,
+                    alpha: g.alpha,
+                    verdict: if g.rejected { "fail" } else { "pass" },
+                    worst_tau_s: g.worst_tau_s,
+                },
+                features: a.features.iter().map(FeatureRecord::from).collect(),
                 tau_s: a.fit.points.iter().map(|p| p.tau_s).collect(),
                 resolution_sigmas: super::fit::RESOLUTION_SIGMAS,
             },
@@ -129,7 +215,7 @@ fn ten_digits(x: f64) -> f64 {
 /// The value of `term` for a file another tool reads: the estimate, else the upper bound, with
 /// a comment saying which.
 fn value_or_bound(a: &Analysis, term: Term) -> (f64, &'static str) {
-    match a.fit.term(term) {
+    match a.term(term) {
         Some(TermEstimate { value: Some(v), .. }) => (*v, ""),
         Some(t) => (
             t.upper,
@@ -164,8 +250,9 @@ pub fn noise_toml(a: &Analysis, source: &str) -> String {
         num(per_sample_var),
         num(per_sample_var)
     );
-    let k = a.fit.term(Term::AccelerationRandomWalk);
-    let b = a.fit.term(Term::BiasInstability);
+    s.push_str(&reading_comment(a));
+    let k = a.term(Term::AccelerationRandomWalk);
+    let b = a.term(Term::BiasInstability);
     let k_resolved = k.is_some_and(|t| t.value.is_some());
     match (k_resolved, b.and_then(|t| t.value)) {
         (false, Some(b_value)) => {
@@ -195,18 +282,39 @@ pub fn noise_toml(a: &Analysis, source: &str) -> String {
     s
 }
 
+/// The comment of `noise.toml` and `imu.yaml` saying which reading the terms come from.
+pub fn reading_comment(a: &Analysis) -> String {
+    let g = &a.fit.goodness;
+    match a.reading {
+        Reading::Fit => format!(
+            "# Terms from the model fit (goodness of fit: p = {} ≥ α = {}).\n",
+            sig(g.p_value, 2),
+            g.alpha
+        ),
+        Reading::Ieee952 => format!(
+            "# The model fit was rejected (p = {} < α = {}; worst at τ = {} s): the terms are\n\
+             # read off the curve the IEEE Std 952 way (N on the −½ line, B = σ_min/0.664, K on\n\
+             # the +½ line), with intervals from the EDF of the points they come from.\n",
+            sig(g.p_value, 2),
+            g.alpha,
+            sig(g.worst_tau_s, 3)
+        ),
+    }
+}
+
 /// `imu.yaml`: the accelerometer's terms in the convention of Kalibr, OpenVINS and VINS-Mono.
 pub fn imu_yaml(a: &Analysis, source: &str) -> String {
     let (n, n_note) = value_or_bound(a, Term::VelocityRandomWalk);
     let (k, k_note) = value_or_bound(a, Term::AccelerationRandomWalk);
     format!(
-        "# Accelerometer noise measured by `accelcal allan` from {source}: {} samples.\n\
+        "# Accelerometer noise measured by `accelcal allan` from {source}: {} samples.\n{}\
          # Continuous-time densities: noise density N in m/s²/√Hz (= m/s/√s), random walk K in\n\
          # m/s³/√Hz (= m/s²/√s).\n\
          accelerometer_noise_density: {}{}\n\
          accelerometer_random_walk: {}{}\n\
          update_rate: {}\n",
         a.samples,
+        reading_comment(a),
         num(n),
         comment(n_note),
         num(k),
@@ -239,7 +347,7 @@ mod tests {
             offset_m_s2: 0.0,
         };
         let mut a = analyse(&log.samples(20_000, 3), 0.01, 0.683).unwrap();
-        for t in &mut a.fit.terms {
+        for t in &mut a.terms {
             if t.term == term {
                 t.value = Some(value);
             } else if t.term != Term::VelocityRandomWalk {
@@ -247,10 +355,10 @@ mod tests {
             }
         }
         if a.fit.term(term).is_none() {
-            let mut t = a.fit.terms[0];
+            let mut t = a.terms[0];
             t.term = term;
             t.value = Some(value);
-            a.fit.terms.push(t);
+            a.terms.push(t);
         }
         a
     }

@@ -7,8 +7,12 @@
 //!    Greenhall 2004);
 //! 3. [`edf`]: the equivalent degrees of freedom of each estimate for that noise (Greenhall &
 //!    Riley 2003) and its χ² interval (SP 1065, eq. 45);
-//! 4. [`fit`](mod@fit): the terms Q, N, B, K by weighted least squares, with intervals from the exact
-//!    covariance of the estimates across τ ([`covariance`]).
+//! 4. [`fit`](mod@fit): the terms Q, N, B, K, R by weighted least squares with every squared term
+//!    ≥ 0 ([`nnls`]) over every τ with an EDF, with intervals from the exact covariance of the
+//!    estimates across τ ([`covariance`]) and a test of the fit ([`goodness`]);
+//! 5. [`reading`]: where the fit departs from the points, the features it lacks (a sinusoid, a
+//!    trend), and the IEEE 952 reading off the curve that replaces the fit when the test rejects
+//!    it.
 //!
 //! [`simulate`] draws synthetic static logs with known terms (for the tests, the report and the
 //! benchmarks); [`export`] writes `allan.json`, `noise.toml` and `imu.yaml`; [`section`] measures
@@ -20,8 +24,11 @@ pub mod deviation;
 pub mod edf;
 pub mod export;
 pub mod fit;
+pub mod goodness;
 pub mod log;
+pub mod nnls;
 pub mod noise_id;
+pub mod reading;
 pub mod section;
 pub mod simulate;
 
@@ -30,6 +37,7 @@ use thiserror::Error;
 
 pub use fit::{Fit, FitPoint, Term, TermEstimate};
 pub use noise_id::NoiseId;
+pub use reading::{Departure, Feature, Reading};
 
 /// The interval confidence when none is given: one standard deviation of a normal.
 pub const DEFAULT_CONFIDENCE: f64 = 0.683;
@@ -91,11 +99,25 @@ pub struct Analysis {
     pub confidence: f64,
     /// The deviation at every τ of the octave grid.
     pub points: Vec<AllanPoint>,
-    /// The terms.
+    /// The constrained fit.
     pub fit: Fit,
+    /// Which reading [`Analysis::terms`] come from: the fit, or IEEE 952's off the curve when the
+    /// goodness-of-fit test rejects the model.
+    pub reading: Reading,
+    /// The reported terms, in the order of the fit's.
+    pub terms: Vec<TermEstimate>,
+    /// How the fitted curve meets each point.
+    pub departures: Vec<Departure>,
+    /// Features of the curve the model does not have.
+    pub features: Vec<Feature>,
 }
 
 impl Analysis {
+    /// The reported estimate of `term`, if fitted.
+    pub fn term(&self, term: Term) -> Option<&TermEstimate> {
+        self.terms.iter().find(|t| t.term == term)
+    }
+
     /// The τ of the smallest deviation, s.
     pub fn tau_at_minimum_s(&self) -> f64 {
         self.points
@@ -158,7 +180,8 @@ fn fitted_terms(points: &[AllanPoint]) -> Vec<Term> {
 
 /// Analyses the rate samples `y` (m/s²) taken τ₀ = `tau0_s` apart: the overlapping Allan
 /// deviation at octave τ with χ² intervals at `confidence`, and the fitted noise terms. The fit
-/// uses every τ whose noise was identified there (at least 30 block means).
+/// uses every τ with an EDF (the noise carried from the longest τ with 30 block means where fewer
+/// remain), each with the weight its EDF gives it.
 ///
 /// # Errors
 /// [`AllanError`] for fewer than [`MIN_SAMPLES`] samples, a constant log or a confidence
@@ -180,7 +203,7 @@ pub fn analyse(y: &[f64], tau0_s: f64, confidence: f64) -> Result<Analysis, Alla
     }
     let fit_points: Vec<FitPoint> = points
         .iter()
-        .filter(|p| p.identified_here && p.adev > 0.0)
+        .filter(|p| p.adev > 0.0)
         .filter_map(|p| {
             p.edf.map(|edf| FitPoint {
                 m: p.m,
@@ -193,11 +216,23 @@ pub fn analyse(y: &[f64], tau0_s: f64, confidence: f64) -> Result<Analysis, Alla
     let terms = fitted_terms(&points);
     let fit =
         fit::fit(&fit_points, y.len(), tau0_s, &terms, confidence).ok_or(AllanError::Constant)?;
+    let departures = reading::departures(&points, &fit);
+    let features = reading::features(&points, &departures, &fit);
+    let (reading, terms) = if fit.goodness.rejected {
+        let read = reading::ieee952(&points, &terms, confidence);
+        (Reading::Ieee952, read)
+    } else {
+        (Reading::Fit, fit.terms.clone())
+    };
     Ok(Analysis {
         samples: y.len(),
         sample_period_s: tau0_s,
         confidence,
         points,
         fit,
+        reading,
+        terms,
+        departures,
+        features,
     })
 }

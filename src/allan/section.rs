@@ -45,10 +45,15 @@ pub struct Coverage {
 
 pub use crate::stats::binomial_band;
 
-/// Whether the interval of `term` in `a` contains `truth`; `nominal` takes the fit's nominal
-/// standard error instead of the sandwich one.
+/// Whether the reported interval of `term` in `a` contains `truth` (the fit's, or the IEEE 952
+/// reading's when the fit is rejected); `nominal` takes the fit's nominal standard error instead.
 pub fn covers(a: &Analysis, term: Term, truth: f64, nominal: bool) -> bool {
-    let Some(t) = a.fit.term(term) else {
+    let reported = if nominal {
+        a.fit.term(term)
+    } else {
+        a.term(term)
+    };
+    let Some(t) = reported else {
         return false;
     };
     let (lower, upper) = if nominal {

@@ -38,3 +38,75 @@ impl StaticLog {
             .collect()
     }
 }
+
+/// Key of the random streams of the features beyond [`StaticLog`] (one stream per seed).
+const FEATURE_KEY: u64 = 0x616c_6c61_6e00_0002;
+
+/// Correlation times of the flicker generator's Gauss–Markov processes: two per decade from
+/// 10⁻² s to 10⁵ s.
+const FLICKER_DECADES: (i32, i32) = (-2, 5);
+
+/// A synthetic static log with the features the Allan model lacks or barely has: flicker noise
+/// (bias instability B), a sinusoid and a linear trend of the bias, on top of a [`StaticLog`]
+/// (whose samples they add to, unchanged).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FeatureLog {
+    /// White noise, random walk and offset.
+    pub base: StaticLog,
+    /// B, m/s²: flicker noise whose Allan deviation is flat at √(2 ln 2/π)·B ≈ 0.664·B.
+    pub bias_instability_m_s2: f64,
+    /// Amplitude A of a sinusoid, m/s².
+    pub sinusoid_amplitude_m_s2: f64,
+    /// Its frequency f₀, Hz.
+    pub sinusoid_frequency_hz: f64,
+    /// R, m/s³: the bias grows by R per second (σ² = R²τ²/2).
+    pub rate_ramp_m_s3: f64,
+}
+
+impl FeatureLog {
+    /// `samples` rate samples, m/s², of seed `seed`: the base log's samples plus the features
+    /// from a second stream.
+    ///
+    /// # Formula
+    /// Flicker as a sum of first-order Gauss–Markov processes with correlation times T_k spaced
+    /// Δ = ½ decade (Keshner, "1/f noise", Proc. IEEE 70 (1982); each a Lorentzian 4σ²T/(1 +
+    /// (2πfT)²)): the one-sided PSD is σ²/(Δ ln 10 · f) between 1/(2πT_max) and 1/(2πT_min), so
+    /// σ_k² = B²·Δ·ln 10/π gives h₋₁ = B²/π and σ²(τ) = 2 ln 2·h₋₁ = (2 ln 2/π)B² (IEEE Std 952,
+    /// annex C). Each process: x_{i+1} = φx_i + σ_k√(1 − φ²)·ξ, φ = e^{−τ₀/T_k}, x₀ ~ N(0, σ_k²).
+    /// The sinusoid A·sin(2πf₀t + φ₀) with φ₀ uniform; the trend R·t.
+    pub fn samples(&self, samples: usize, seed: u64) -> Vec<f64> {
+        let mut y = self.base.samples(samples, seed);
+        let mut s = Stream::new(FEATURE_KEY, seed);
+        let tau0 = self.base.sample_period_s;
+        let spacing = 0.5;
+        let var_k = self.bias_instability_m_s2.powi(2) * spacing * std::f64::consts::LN_10
+            / std::f64::consts::PI;
+        if var_k > 0.0 {
+            let (lo, hi) = FLICKER_DECADES;
+            let mut gm: Vec<(f64, f64, f64)> = (2 * lo..=2 * hi)
+                .map(|k| {
+                    let phi = (-tau0 / 10f64.powf(k as f64 * spacing)).exp();
+                    (
+                        phi,
+                        (var_k * (1.0 - phi * phi)).sqrt(),
+                        var_k.sqrt() * s.normal(),
+                    )
+                })
+                .collect();
+            for v in y.iter_mut() {
+                for (phi, drive, x) in gm.iter_mut() {
+                    *v += *x;
+                    *x = *phi * *x + *drive * s.normal();
+                }
+            }
+        }
+        let phase = 2.0 * std::f64::consts::PI * (s.next_u64() as f64 / u64::MAX as f64);
+        let omega = 2.0 * std::f64::consts::PI * self.sinusoid_frequency_hz;
+        for (i, v) in y.iter_mut().enumerate() {
+            let t = i as f64 * tau0;
+            *v +=
+                self.sinusoid_amplitude_m_s2 * (omega * t + phase).sin() + self.rate_ramp_m_s3 * t;
+        }
+        y
+    }
+}

@@ -57,7 +57,7 @@ pub(super) fn run_allan(args: &AllanArgs) -> Result<()> {
 }
 
 fn summary(a: &allan::Analysis, out: &std::path::Path) -> String {
-    let term = |t: Term, unit: &str| match a.fit.term(t) {
+    let term = |t: Term, unit: &str| match a.term(t) {
         Some(e) => match (e.value, e.lower) {
             (Some(v), Some(lo)) => {
                 format!("{} [{}, {}] {unit}", sig(v, 4), sig(lo, 3), sig(e.upper, 3))
@@ -66,14 +66,21 @@ fn summary(a: &allan::Analysis, out: &std::path::Path) -> String {
         },
         None => "not fitted".to_string(),
     };
+    let ramp = a
+        .term(Term::RateRamp)
+        .filter(|t| t.value.is_some())
+        .map_or(String::new(), |_| {
+            format!(", R = {}", term(Term::RateRamp, "m/s³"))
+        });
     format!(
-        "{} samples, τ₀ = {} s: N = {}, B = {}, K = {} ({} % intervals); written to {}",
+        "{} samples, τ₀ = {} s: N = {}, B = {}, K = {}{ramp} ({} % intervals); {}; written to {}",
         count(a.samples as u64),
         sig(a.sample_period_s, 6),
         term(Term::VelocityRandomWalk, "m/s/√s"),
         term(Term::BiasInstability, "m/s²"),
         term(Term::AccelerationRandomWalk, "m/s²/√s"),
         sig(100.0 * a.confidence, 3),
+        page::verdict_sentence(a),
         out.display()
     )
 }

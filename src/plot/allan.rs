@@ -1,5 +1,6 @@
 //! The Allan deviation of a static log on log–log axes: the deviation at each τ with its
-//! interval (whiskers), each resolved noise term as a line, and their fitted sum. Plain data in
+//! interval (whiskers), each resolved noise term as a line, the model fit over the τ where it
+//! holds, and the points it misses ringed. Plain data in
 //! (the caller evaluates the terms' curves), SVG out, in the look of every other figure.
 
 use plotters::style::{Color, RGBColor};
@@ -8,14 +9,14 @@ use super::axis::{Axis, y_label_area};
 use super::geometry::extent;
 use super::legend::{Entry, Swatch, render_under_legend};
 use super::panel::{Layout, Panel};
-use super::{BLACK, BLUE, BLUISH_GREEN, GREY, PlotResult, REDDISH_PURPLE, VERMILLION};
+use super::{BLACK, BLUE, BLUISH_GREEN, GREY, ORANGE, PlotResult, REDDISH_PURPLE, VERMILLION};
 
 /// Height of the plot, px.
 const ROW_PX: u32 = 480;
 
 /// The colours of the terms' lines, by the term's slot (quantization, velocity random walk,
 /// bias instability, acceleration random walk).
-pub const TERM_COLOURS: [RGBColor; 4] = [VERMILLION, REDDISH_PURPLE, BLUE, BLUISH_GREEN];
+pub const TERM_COLOURS: [RGBColor; 5] = [VERMILLION, REDDISH_PURPLE, BLUE, BLUISH_GREEN, ORANGE];
 
 /// The deviation at one τ.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,6 +27,8 @@ pub struct AllanMark {
     pub adev: f64,
     /// Its interval, when it has one.
     pub interval: Option<(f64, f64)>,
+    /// Whether the fitted curve leaves the interval here.
+    pub departs: bool,
 }
 
 /// A resolved term's σ(τ) as a line.
@@ -46,8 +49,8 @@ pub struct AllanSeries {
     pub marks: Vec<AllanMark>,
     /// The resolved terms.
     pub terms: Vec<TermCurve>,
-    /// The fitted sum, (τ s, σ m/s²).
-    pub sum: Vec<(f64, f64)>,
+    /// The fitted sum over the stretches of τ where it holds, (τ s, σ m/s²) each.
+    pub sum: Vec<Vec<(f64, f64)>>,
 }
 
 /// The Allan deviation against τ, log–log: dots with interval whiskers, the terms' lines and
@@ -76,7 +79,16 @@ pub fn allan_deviation(s: &AllanSeries) -> PlotResult {
             t.label.clone(),
         ));
     }
-    legend.push(Entry::new(Swatch::Line(GREY.stroke_width(2)), "fitted sum"));
+    legend.push(Entry::new(
+        Swatch::Line(GREY.stroke_width(2)),
+        "model fit, where it holds",
+    ));
+    if s.marks.iter().any(|m| m.departs) {
+        legend.push(Entry::new(
+            Swatch::Marker(VERMILLION.stroke_width(2)),
+            "departs from the fit",
+        ));
+    }
     render_under_legend(&legend, &[ROW_PX], 6, |areas| {
         let p = Panel::new(
             &areas[0],
@@ -89,12 +101,22 @@ pub fn allan_deviation(s: &AllanSeries) -> PlotResult {
             let c = TERM_COLOURS[t.slot % TERM_COLOURS.len()];
             p.line(t.points.iter().copied(), c.stroke_width(2))?;
         }
-        p.line(s.sum.iter().copied(), GREY.stroke_width(2))?;
+        for stretch in &s.sum {
+            p.line(stretch.iter().copied(), GREY.stroke_width(2))?;
+        }
         for m in &s.marks {
             if let Some((lo, hi)) = m.interval {
                 p.line([(m.tau_s, lo), (m.tau_s, hi)], BLACK.stroke_width(1))?;
             }
         }
-        p.dots(s.marks.iter().map(|m| (m.tau_s, m.adev)), 4, BLACK.filled())
+        p.dots(s.marks.iter().map(|m| (m.tau_s, m.adev)), 4, BLACK.filled())?;
+        p.dots(
+            s.marks
+                .iter()
+                .filter(|m| m.departs)
+                .map(|m| (m.tau_s, m.adev)),
+            7,
+            VERMILLION.stroke_width(2),
+        )
     })
 }

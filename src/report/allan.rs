@@ -9,12 +9,13 @@ use super::figures::figure;
 use super::math::Math;
 use super::view::FigureView;
 use super::{RenderError, stylesheet};
-use crate::allan::{Analysis, Term, TermEstimate};
+use crate::allan::reading::departing_span;
+use crate::allan::{Analysis, Feature, Reading, Term, TermEstimate};
 use crate::format::{count, sig};
 use crate::plot::{self, AllanMark, AllanSeries, TermCurve};
 
 /// The fitted model of the Allan variance (IEEE Std 952, annex C), as LaTeX.
-const MODEL: &str = r"\sigma^2(\tau) = \frac{3Q^2}{\tau^2} + \frac{N^2}{\tau} + \frac{2\ln 2}{\pi}B^2 + \frac{K^2\tau}{3}";
+const MODEL: &str = r"\sigma^2(\tau) = \frac{3Q^2}{\tau^2} + \frac{N^2}{\tau} + \frac{2\ln 2}{\pi}B^2 + \frac{K^2\tau}{3} + \frac{R^2\tau^2}{2}";
 
 /// Points along each curve of the figure.
 pub const CURVE_POINTS: usize = 200;
@@ -26,6 +27,7 @@ fn term_label(term: Term) -> &'static str {
         Term::VelocityRandomWalk => "N: slope −½",
         Term::BiasInstability => "B: slope 0",
         Term::AccelerationRandomWalk => "K: slope +½",
+        Term::RateRamp => "R: slope +1",
     }
 }
 
@@ -48,14 +50,15 @@ pub fn series(a: &Analysis) -> AllanSeries {
         marks: a
             .points
             .iter()
-            .map(|p| AllanMark {
+            .zip(&a.departures)
+            .map(|(p, d)| AllanMark {
                 tau_s: p.tau_s,
                 adev: p.adev,
                 interval: p.interval,
+                departs: !d.holds,
             })
             .collect(),
         terms: a
-            .fit
             .terms
             .iter()
             .filter(|t| t.value.is_some())
@@ -65,7 +68,104 @@ pub fn series(a: &Analysis) -> AllanSeries {
                 points: curve(&|tau| (t.squared * t.term.coefficient(tau)).sqrt()),
             })
             .collect(),
-        sum: curve(&|tau| a.fit.avar_at(tau).max(0.0).sqrt()),
+        sum: holding_stretches(a)
+            .into_iter()
+            .map(|(lo, hi)| {
+                taus.iter()
+                    .filter(|&&t| t >= lo && t <= hi)
+                    .map(|&t| (t, a.fit.avar_at(t).max(0.0).sqrt()))
+                    .collect()
+            })
+            .collect(),
+    }
+}
+
+/// The stretches of τ where the fit holds: runs of consecutive points inside whose intervals the
+/// fitted curve lies, each from its first τ to its last (a lone point: a half octave either side).
+fn holding_stretches(a: &Analysis) -> Vec<(f64, f64)> {
+    let mut out = vec![];
+    let mut run: Option<(f64, f64)> = None;
+    for (p, d) in a.points.iter().zip(&a.departures) {
+        run = match (d.holds, run) {
+            (true, Some((lo, _))) => Some((lo, p.tau_s)),
+            (true, None) => Some((p.tau_s, p.tau_s)),
+            (false, r) => {
+                out.extend(r);
+                None
+            }
+        };
+    }
+    out.extend(run);
+    out.into_iter()
+        .map(|(lo, hi)| {
+            if lo == hi {
+                (lo / 2f64.sqrt(), hi * 2f64.sqrt())
+            } else {
+                (lo, hi)
+            }
+        })
+        .collect()
+}
+
+/// One sentence on whether the model holds and which reading the terms come from, for the page
+/// and the printed line.
+pub fn verdict_sentence(a: &Analysis) -> String {
+    let g = &a.fit.goodness;
+    let features: Vec<String> = a
+        .features
+        .iter()
+        .map(|f| match *f {
+            Feature::Sinusoid {
+                frequency_hz,
+                tau_peak_s,
+                ..
+            } => format!(
+                "a hump at τ ≈ {} s, a sinusoid near {} Hz",
+                sig(tau_peak_s, 2),
+                sig(frequency_hz, 2)
+            ),
+            Feature::Trend { from_tau_s, .. } => {
+                format!(
+                    "a rise of slope +1 from τ ≈ {} s, a trend",
+                    sig(from_tau_s, 2)
+                )
+            }
+        })
+        .collect();
+    let named = if features.is_empty() {
+        String::new()
+    } else {
+        format!("; {}", features.join("; "))
+    };
+    let span = departing_span(&a.points, &a.departures).map_or(String::new(), |s| {
+        if s.count == 1 {
+            format!(
+                "; the fit leaves one point, at τ = {} s (σ̂/σ_fit = {})",
+                sig(s.from_tau_s, 2),
+                sig(s.largest_ratio, 2)
+            )
+        } else {
+            format!(
+                "; the fit leaves {} points from τ = {} to {} s, σ̂/σ_fit from {} to {}",
+                s.count,
+                sig(s.from_tau_s, 2),
+                sig(s.to_tau_s, 2),
+                sig(s.least_ratio, 2),
+                sig(s.largest_ratio, 2)
+            )
+        }
+    });
+    match a.reading {
+        Reading::Fit => format!(
+            "the model fits (goodness of fit p = {} ≥ α = {}{span}){named}",
+            sig(g.p_value, 2),
+            g.alpha
+        ),
+        Reading::Ieee952 => format!(
+            "the model is rejected (goodness of fit p = {} < α = {}{span}){named}; the terms are read off the curve as IEEE Std 952 does",
+            sig(g.p_value, 2),
+            g.alpha
+        ),
     }
 }
 
@@ -91,6 +191,8 @@ pub struct TermRow {
     pub si: String,
     /// The same in datasheet units.
     pub datasheet: String,
+    /// Whether to trust it, in a sentence (empty in the report's section).
+    pub trust: String,
 }
 
 /// One τ of the deviation table.
@@ -106,6 +208,10 @@ pub struct PointRow {
     pub edf: String,
     /// The identified α.
     pub alpha: String,
+    /// The fitted σ(τ).
+    pub fit: String,
+    /// The standardized residual and whether the fit departs, in words.
+    pub departure: String,
 }
 
 /// Everything the page shows, as text.
@@ -126,6 +232,10 @@ pub struct AllanView {
     pub model_math: String,
     /// The terms.
     pub terms: Vec<TermRow>,
+    /// Whether the model holds and which reading the terms come from, in a sentence.
+    pub verdict: String,
+    /// Whether the model was rejected (the terms read off the curve).
+    pub rejected: bool,
     /// The deviation at every τ.
     pub points: Vec<PointRow>,
     /// The command that wrote the page.
@@ -179,18 +289,33 @@ pub fn term_row(t: &TermEstimate) -> TermRow {
             format!("{} m/s²/√s", range(t, 1.0, 3)),
             format!("{} µg/√s", range(t, micro_g, 3)),
         ),
+        Term::RateRamp => (
+            "rate ramp <i>R</i>",
+            format!("{} m/s³", range(t, 1.0, 3)),
+            format!("{} µg/s", range(t, micro_g, 3)),
+        ),
     };
     TermRow {
         name_html: name_html.to_string(),
         si,
         datasheet,
+        trust: String::new(),
     }
 }
 
 fn point_rows(a: &Analysis) -> Vec<PointRow> {
     a.points
         .iter()
-        .map(|p| PointRow {
+        .zip(&a.departures)
+        .map(|(p, d)| PointRow {
+            fit: sig(d.fit_adev, 3),
+            departure: match (d.standardized, d.holds) {
+                (Some(z), true) => sig(z, 2).replace('-', "−"),
+                (Some(z), false) => {
+                    format!("{} (departs, {}×)", sig(z, 2), sig(d.ratio, 2)).replace('-', "−")
+                }
+                (None, _) => "—".to_string(),
+            },
             tau: sig(p.tau_s, 4),
             adev: sig(p.adev, 4),
             interval: p.interval.map_or("—".to_string(), |(lo, hi)| {
@@ -203,6 +328,27 @@ fn point_rows(a: &Analysis) -> Vec<PointRow> {
             }),
         })
         .collect()
+}
+
+/// Whether to trust a reported term, in a sentence.
+pub fn trust_sentence(a: &Analysis, t: &TermEstimate) -> String {
+    match (a.reading, t.value.is_some(), t.term) {
+        (Reading::Fit, true, _) => {
+            "Fitted, and the model holds: the interval stands as stated.".to_string()
+        }
+        (Reading::Fit, false, _) => {
+            "The log does not resolve it: only the bound stands (never below what the longest τ demand).".to_string()
+        }
+        (Reading::Ieee952, true, Term::BiasInstability) => {
+            "Read from the curve's minimum (σ_min/0.664): the other terms' share at the minimum is in it, so take it as an upper estimate; the interval counts that point's EDF only.".to_string()
+        }
+        (Reading::Ieee952, true, _) => {
+            "Read off the line of its slope through the points that follow it (IEEE Std 952): approximate; the interval counts those points' EDF, not the model's misfit.".to_string()
+        }
+        (Reading::Ieee952, false, _) => {
+            "No stretch of the curve has its slope: only the bound stands.".to_string()
+        }
+    }
 }
 
 /// The view of an analysis of the log `source`, written by `command`.
@@ -221,7 +367,7 @@ pub fn view(
         1,
         "The Allan deviation of the log",
         &format!(
-            "The overlapping Allan deviation (dots) at octave-spaced τ with its {confidence} % χ² intervals (whiskers; equivalent degrees of freedom of Greenhall and Riley for the noise identified at each τ by its lag-1 autocorrelation), each resolved noise term as a line of its slope, and their sum (grey)."
+            "The overlapping Allan deviation (dots) at octave-spaced τ with its {confidence} % χ² intervals (whiskers; equivalent degrees of freedom of Greenhall and Riley for the noise identified at each τ by its lag-1 autocorrelation), each resolved reported noise term as a line of its slope, and the constrained model fit (grey) drawn only over the τ where it holds; the points it misses are ringed (the fit outside the point's χ² interval at 1 − α/k, α = 0.01 the goodness-of-fit test's, k the points with an EDF)."
         ),
         plot::allan_deviation(&series(a)),
     )?;
@@ -238,7 +384,16 @@ pub fn view(
         confidence,
         figure,
         model_math: math.inline(MODEL),
-        terms: a.fit.terms.iter().map(term_row).collect(),
+        terms: a
+            .terms
+            .iter()
+            .map(|t| TermRow {
+                trust: trust_sentence(a, t),
+                ..term_row(t)
+            })
+            .collect(),
+        verdict: verdict_sentence(a),
+        rejected: a.reading == Reading::Ieee952,
         points: point_rows(a),
         command: command.to_string(),
     })

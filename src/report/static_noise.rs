@@ -162,7 +162,7 @@ fn recovered(a: &Analysis, log: &StaticLog) -> Vec<RecoveredRow> {
     ]
     .into_iter()
     .filter_map(|(term, truth, unit)| {
-        let t = a.fit.term(term)?;
+        let t = a.term(term)?;
         let row = term_row(t);
         Some(RecoveredRow {
             name_html: row.name_html.clone(),
