@@ -1,7 +1,8 @@
-//! `accelcal.calibrate`: the calibration of `accelcal calibrate` from arrays. The arrays are
-//! written once into the logs' CSV form in memory, each number in its shortest round-trip
-//! form (`logs::write::push_row`), so that the library reads exactly the doubles it was given
-//! and every number equals the command line's on the same data.
+//! `accelcal.calibrate`: the calibration of `accelcal calibrate` from arrays. The accelerometer's
+//! arrays are read in place (`logs::arrays::AccelArrays`: calibrate's pass takes the slices, no
+//! text in between); the GPS fixes, a few thousand rows, are written once as the GPS log's CSV in
+//! memory with every number in its shortest round-trip form (`logs::write::push_row`), which
+//! reads back as the same doubles. Every number equals the command line's on the same data.
 
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
@@ -11,9 +12,10 @@ use accelcal::calibrate::{self, Settings};
 use accelcal::config::Config;
 use accelcal::error::ConfigError;
 use accelcal::likelihood::{Key, Request};
+use accelcal::logs::GPS_COLUMNS;
+use accelcal::logs::arrays::AccelArrays;
 use accelcal::logs::read::LogText;
 use accelcal::logs::write::{header, push_row};
-use accelcal::logs::{ACCEL_COLUMNS, GPS_COLUMNS};
 use accelcal::state::BiasModel;
 
 use crate::config::{self, Source};
@@ -149,7 +151,7 @@ pub(crate) fn calibrate_arrays(
         gps_velocity.as_slice().map_err(crate::bad_input)?,
     );
     let (calibration, estimates_csv) = py.detach(|| {
-        let accel_log = LogText::new("accel", csv(&ACCEL_COLUMNS, &[at, a]));
+        let accel_log = AccelArrays::new("accel", at, a).map_err(crate::bad_input)?;
         let gps_log = LogText::new("gps", csv(&GPS_COLUMNS, &[gt, gp, gv]));
         let prepared = calibrate::prepare_with(&accel_log, &gps_log, &settings, request.as_ref())
             .map_err(crate::bad_input)?;
