@@ -81,7 +81,7 @@ def _vector(name: str, x: Any) -> np.ndarray:
     bad = np.flatnonzero(~np.isfinite(a))
     if bad.size:
         i = int(bad[0])
-        raise ValueError(f"{name}[{i}] is {a[i]}: expected a finite number")
+        raise ValueError(f"{name}[{i}] is {float(a[i])}: expected a finite number")
     return a
 
 
@@ -92,7 +92,7 @@ def _times(name: str, x: Any) -> np.ndarray:
     if bad.size:
         i = int(bad[0]) + 1
         raise ValueError(
-            f"{name}[{i}] = {t[i]!r} s is not after {name}[{i - 1}] = {t[i - 1]!r} s: "
+            f"{name}[{i}] = {float(t[i])!r} s is not after {name}[{i - 1}] = {float(t[i - 1])!r} s: "
             "time stamps must increase"
         )
     return t
