@@ -69,6 +69,10 @@ def test_mismatched_lengths(k):
 
 def test_other_real_dtypes_and_strides_are_converted_once():
     args = arrays()
+    # A float64, contiguous array is the data handed on, not a copy; any other is copied once.
+    a = np.ascontiguousarray(args[1])
+    assert accelcal._vector("accel", a) is a
+    assert not np.shares_memory(accelcal._vector("accel", a.astype(np.float32)), a)
     base = accelcal.calibrate(*args).summary_json
     # A strided view of the same doubles: converted to a contiguous copy, the same numbers.
     wide = np.stack([args[1], args[1]], axis=1)
