@@ -225,6 +225,61 @@ impl Stitch<'_> {
     }
 }
 
+impl<'g> Stitch<'g> {
+    /// A pass about to read the log `file`, before its first row.
+    fn new(
+        file: &str,
+        gps: &'g [GpsFix],
+        (nominal_dt_s, bias): (f64, BiasModel),
+        start: Start,
+    ) -> Self {
+        let empty = StepAt {
+            previous_s: 0.0,
+            t_s: f64::INFINITY,
+            ..StepAt::default()
+        };
+        Stitch {
+            dt_s: nominal_dt_s,
+            bias,
+            half_dt2_s2: 0.5 * nominal_dt_s * nominal_dt_s,
+            gps,
+            start,
+            k: 0,
+            current: None,
+            integrated: [Integrated::default(); 2],
+            units: NoiseUnits::default(),
+            reduced: Reduced {
+                samples: 0,
+                span_s: (0.0, 0.0),
+                first_line: 0,
+                first_accel_m_s2: 0.0,
+                median: StepMedian::new(),
+                step_range: (empty, StepAt::default()),
+                nominal: true,
+                fixes: Vec::with_capacity(gps.len()),
+                end: Default::default(),
+                overflow: [None; 2],
+            },
+            file: file.to_string(),
+        }
+    }
+
+    /// The reduced log once every row is in.
+    fn finish(mut self) -> Result<Reduced, LogError> {
+        let Some(last) = self.current else {
+            return Err(too_few(&self.file, 0));
+        };
+        self.assign(last, None);
+        self.reduced.samples = self.k + 1;
+        if self.k == 0 {
+            return Err(too_few(&self.file, 1));
+        }
+        self.reduced.span_s.1 = last.t_s;
+        self.reduced.end = (self.integrated, self.units);
+        Ok(self.reduced)
+    }
+}
+
 /// What the reading thread hands over: a block, or the problem that ended the reading.
 type Message = Result<Block, LogError>;
 
@@ -334,36 +389,25 @@ pub fn reduce(
     (nominal_dt_s, bias): (f64, BiasModel),
     start: Start,
 ) -> Result<Reduced, LogError> {
+    let mut stitch = Stitch::new(source.name(), gps, (nominal_dt_s, bias), start);
+    if let Some((times_s, samples_m_s2)) = source.accel_columns() {
+        // Arrays: every sample checked as a row of text is, in place (sample i is line i + 2).
+        for (i, (&t_s, &accel_m_s2)) in times_s.iter().zip(samples_m_s2).enumerate() {
+            let line = i as u64 + 2;
+            for (column, x) in [(ACCEL_COLUMNS[0], t_s), (ACCEL_COLUMNS[1], accel_m_s2)] {
+                if !x.is_finite() {
+                    let problem = LogProblem::NotFinite {
+                        column,
+                        text: x.to_string(),
+                    };
+                    return Err(LogError::at(source.name(), line, problem));
+                }
+            }
+            stitch.row(t_s, accel_m_s2, line)?;
+        }
+        return stitch.finish();
+    }
     let (layout, mut feed) = open_blocks(source, ACCEL_COLUMNS)?;
-    let empty = StepAt {
-        previous_s: 0.0,
-        t_s: f64::INFINITY,
-        ..StepAt::default()
-    };
-    let mut stitch = Stitch {
-        dt_s: nominal_dt_s,
-        bias,
-        half_dt2_s2: 0.5 * nominal_dt_s * nominal_dt_s,
-        gps,
-        start,
-        k: 0,
-        current: None,
-        integrated: [Integrated::default(); 2],
-        units: NoiseUnits::default(),
-        reduced: Reduced {
-            samples: 0,
-            span_s: (0.0, 0.0),
-            first_line: 0,
-            first_accel_m_s2: 0.0,
-            median: StepMedian::new(),
-            step_range: (empty, StepAt::default()),
-            nominal: true,
-            fixes: Vec::with_capacity(gps.len()),
-            end: Default::default(),
-            overflow: [None; 2],
-        },
-        file: source.name().to_string(),
-    };
     let (tx, rx) = mpsc::sync_channel::<Message>(2 * PARSE_GROUP);
     let (used_tx, used) = mpsc::channel::<Vec<u8>>();
     std::thread::scope(|scope| {
@@ -390,17 +434,7 @@ pub fn reduce(
         drop(tx);
         worker.join().expect("the stitching does not panic")
     })?;
-    let Some(last) = stitch.current else {
-        return Err(too_few(source.name(), 0));
-    };
-    stitch.assign(last, None);
-    stitch.reduced.samples = stitch.k + 1;
-    if stitch.k == 0 {
-        return Err(too_few(source.name(), 1));
-    }
-    stitch.reduced.span_s.1 = last.t_s;
-    stitch.reduced.end = (stitch.integrated, stitch.units);
-    Ok(stitch.reduced)
+    stitch.finish()
 }
 
 fn too_few(file: &str, found: u64) -> LogError {

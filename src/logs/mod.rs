@@ -11,6 +11,7 @@
 //! the line and what was expected; [`write`](mod@write) formats every number so that it reads back bit for
 //! bit; [`steps`] finds the median time step of a log in bounded memory.
 
+pub mod arrays;
 pub mod block;
 pub mod read;
 pub mod steps;

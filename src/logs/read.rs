@@ -28,6 +28,13 @@ pub trait LogSource {
     fn rereadable(&self) -> bool {
         true
     }
+
+    /// An accelerometer log held as arrays (time stamps in s, samples in m/s², of equal
+    /// length; `logs::arrays::AccelArrays`): calibrate's pass then reads them in place instead
+    /// of parsing text. `None` for a log of text.
+    fn accel_columns(&self) -> Option<(&[f64], &[f64])> {
+        None
+    }
 }
 
 /// The two bytes that start a gzip member.
