@@ -111,6 +111,32 @@ pub fn conditional_words(rejected: &[String]) -> String {
     format!("assumes a model the data reject ({})", rejected.join(", "))
 }
 
+/// A rejecting test named for a reader: `nis` → "the NIS test", `whiteness_position` → "the
+/// position innovations' whiteness", `bias_path` → "the bias-path test".
+pub fn test_words(id: &str) -> String {
+    match id {
+        "nis" => "the NIS test".to_string(),
+        "bias_path" => "the bias-path test".to_string(),
+        other => match other.strip_prefix("whiteness_") {
+            Some(m) => format!("the {m} innovations' whiteness"),
+            None => other.to_string(),
+        },
+    }
+}
+
+/// [`conditional_words`] for a page: the tests named in words, "a, b and c".
+pub fn conditional_page_words(rejected: &[String]) -> String {
+    let names: Vec<String> = rejected.iter().map(|r| test_words(r)).collect();
+    match names.as_slice() {
+        [] => String::new(),
+        [one] => format!("assumes a model the data reject ({one})"),
+        [rest @ .., last] => format!(
+            "assumes a model the data reject ({} and {last})",
+            rest.join(", ")
+        ),
+    }
+}
+
 impl BiasRobust {
     /// The robust bias in words: "−0.613172 ± 0.0213 m/s² (95 % interval [−0.655, −0.571]),
     /// the filter's variance × 5540 from the innovations' long-run variance", the ends with the
@@ -130,7 +156,9 @@ impl BiasRobust {
             sig(self.variance_factor, 3),
         );
         if rejected.iter().any(|r| r == "bias_path") {
-            out.push_str("; it still assumes the filter's bias model, which bias_path rejects");
+            out.push_str(
+                "; it still assumes the filter's bias model, which the bias-path test rejects",
+            );
         }
         out
     }

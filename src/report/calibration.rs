@@ -214,7 +214,7 @@ pub fn build(
         version: s.accelcal_version.to_string(),
         bias: with_sigma(s.bias_m_s2, s.bias_sigma_m_s2, "m/s²"),
         bias_interval: bias_interval(s),
-        conditional: crate::calibrate::robust::conditional_words(&s.rejected_by),
+        conditional: crate::calibrate::robust::conditional_page_words(&s.rejected_by),
         robust: if s.intervals_conditional {
             s.bias_robust.words(&s.rejected_by)
         } else {

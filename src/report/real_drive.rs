@@ -99,7 +99,7 @@ fn row(r: &DriveRun) -> DriveRow {
             let (_, lo, hi) = interval(r.value, r.lower, r.upper, 3);
             format!(
                 "{}; without white innovations [{lo}, {hi}]",
-                robust::conditional_words(&s.rejected_by)
+                robust::conditional_page_words(&s.rejected_by)
             )
         } else {
             String::new()
@@ -143,7 +143,7 @@ fn robust_sign(s: &crate::calibrate::summary::Summary) -> String {
     format!(
         "; but that interval {}, and the one from the innovations' long-run variance, \
          [{lo}, {hi}] m/s², {place}",
-        robust::conditional_words(&s.rejected_by)
+        robust::conditional_page_words(&s.rejected_by)
     )
 }
 
