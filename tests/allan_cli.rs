@@ -119,6 +119,15 @@ fn recovers_n_and_k_of_a_random_walk_log() {
         );
         assert!(t["value"].as_f64().is_some());
     }
+    // The printed N shows its narrow interval's ends apart from each other and from N.
+    let line = String::from_utf8_lossy(&o.stdout).into_owned();
+    let n = line.split("N = ").nth(1).expect("N printed");
+    let (value, rest) = n.split_once(" [").unwrap();
+    let (lo, rest) = rest.split_once(", ").unwrap();
+    let hi = rest.split_once(']').unwrap().0;
+    let read = |x: &str| x.replace('−', "-").parse::<f64>().unwrap();
+    let (v, lo, hi) = (read(value), read(lo), read(hi));
+    assert!(lo < v && v < hi, "printed N {v} [{lo}, {hi}] in {line}");
     let toml = std::fs::read_to_string(out.join("noise.toml")).unwrap();
     assert!(toml.contains("bias_model = \"random_walk\""), "{toml}");
     noise_toml_drives_simulate_and_calibrate(&out.join("noise.toml"), dir.path());

@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 
 use crate::cli::AllanArgs;
 use accelcal::allan::{self, Term, export, log::read_static_log};
-use accelcal::format::{count, sig};
+use accelcal::format::{count, interval_digits, sig};
 use accelcal::logs::read::LogFile;
 use accelcal::output::StagedFiles;
 use accelcal::report::allan as page;
@@ -60,7 +60,9 @@ fn summary(a: &allan::Analysis, out: &std::path::Path) -> String {
     let term = |t: Term, unit: &str| match a.term(t) {
         Some(e) => match (e.value, e.lower) {
             (Some(v), Some(lo)) => {
-                format!("{} [{}, {}] {unit}", sig(v, 4), sig(lo, 3), sig(e.upper, 3))
+                let d = interval_digits(v, lo, e.upper, 3);
+                let (lo, hi) = (sig(lo, d), sig(e.upper, d));
+                format!("{} [{lo}, {hi}] {unit}", sig(v, d.max(4)))
             }
             _ => format!("unresolved (≤ {} {unit})", sig(e.upper, 3)),
         },

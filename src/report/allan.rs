@@ -11,7 +11,7 @@ use super::view::FigureView;
 use super::{RenderError, stylesheet};
 use crate::allan::reading::departing_span;
 use crate::allan::{Analysis, Feature, Reading, Term, TermEstimate};
-use crate::format::{count, sig};
+use crate::format::{count, interval, sig};
 use crate::plot::{self, AllanMark, AllanSeries, TermCurve};
 
 /// The fitted model of the Allan variance (IEEE Std 952, annex C), as LaTeX.
@@ -246,15 +246,9 @@ fn range(t: &TermEstimate, scale: f64, digits: usize) -> String {
     match (t.value, t.lower) {
         (Some(v), Some(lo)) => {
             let [v, lo, hi] = [v, lo, t.upper].map(|x| x * scale);
-            // Enough digits that an interval narrower than the last digit still shows its ends
-            // apart from the estimate (at most three more).
-            let apart = |d: usize| {
-                (lo == v || sig(lo, d) != sig(v, d)) && (hi == v || sig(hi, d) != sig(v, d))
-            };
-            let d = (digits..digits + 4)
-                .find(|&d| apart(d))
-                .unwrap_or(digits + 3);
-            format!("{} [{}, {}]", sig(v, d), sig(lo, d), sig(hi, d))
+            // The digits that show the interval's ends apart from each other and the estimate.
+            let (v, lo, hi) = interval(v, lo, hi, digits);
+            format!("{v} [{lo}, {hi}]")
         }
         _ => format!("unresolved, ≤ {}", sig(t.upper * scale, digits)),
     }
@@ -319,7 +313,8 @@ fn point_rows(a: &Analysis) -> Vec<PointRow> {
             tau: sig(p.tau_s, 4),
             adev: sig(p.adev, 4),
             interval: p.interval.map_or("—".to_string(), |(lo, hi)| {
-                format!("[{}, {}]", sig(lo, 3), sig(hi, 3))
+                let (_, lo, hi) = interval(p.adev, lo, hi, 3);
+                format!("[{lo}, {hi}]")
             }),
             edf: p.edf.map_or("—".to_string(), |e| sig(e, 3)),
             alpha: p.noise.map_or("—".to_string(), |n| {
