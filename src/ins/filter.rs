@@ -25,6 +25,9 @@ pub enum FilterError {
         /// The fix's time, s.
         t_s: f64,
     },
+    /// The error state's covariance is not positive definite.
+    #[error("the error state's covariance is not positive definite")]
+    Covariance,
 }
 
 /// What one fix's update saw: the innovation, its covariance and the normalized squared

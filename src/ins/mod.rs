@@ -10,6 +10,7 @@
 pub mod discrete;
 pub mod drive;
 pub mod earth;
+pub mod ensemble;
 pub mod error_state;
 pub mod filter;
 pub mod gnss;

@@ -1,7 +1,7 @@
 //! The navigation layer's tests: the mechanization against independent values and the exact
 //! truth; the error dynamics against the navigation equations they linearize.
 
+mod ensemble;
 mod error_state;
-mod filter;
 mod logs;
 mod mechanization;
