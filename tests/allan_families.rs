@@ -14,7 +14,7 @@
 //! trend logs (it takes the trend for a random walk). The sinusoid is named, between 0.25 and
 //! 1 Hz, on every sinusoid log and on no other.
 
-use accelcal::allan::fit::{FitPoint, Term, fit_unconstrained};
+use accelcal::allan::fit::Term;
 use accelcal::allan::section::binomial_band;
 use accelcal::allan::simulate::{FeatureLog, StaticLog};
 use accelcal::allan::{Analysis, Feature, Reading, analyse};
@@ -76,18 +76,7 @@ fn honest(a: &Analysis, log: &FeatureLog) -> (bool, [bool; 3]) {
 /// Coverage of N, B, K by the fit of the code before the constraint: unconstrained, over the τ
 /// with 30 block means only.
 fn old_fit_covers(a: &Analysis, log: &FeatureLog) -> [bool; 3] {
-    let points: Vec<FitPoint> = a
-        .points
-        .iter()
-        .filter(|p| p.identified_here)
-        .map(|p| FitPoint {
-            m: p.m,
-            tau_s: p.tau_s,
-            avar: p.adev * p.adev,
-            edf: p.edf.unwrap(),
-        })
-        .collect();
-    let f = fit_unconstrained(&points, a.samples, a.sample_period_s, &TERMS, CONFIDENCE).unwrap();
+    let f = a.fit_before_constraint(&TERMS).unwrap();
     TERMS.map(|t| {
         let e = f.term(t).unwrap();
         e.lower.unwrap_or(0.0) <= truth(log, t) && truth(log, t) <= e.upper

@@ -9,19 +9,11 @@
 
 use accelcal::allan::analyse;
 use accelcal::allan::goodness::ALPHA;
-use accelcal::allan::section::binomial_band;
-use accelcal::allan::simulate::StaticLog;
+use accelcal::allan::section::{REPORT_LOG as LOG, binomial_band};
 use rayon::prelude::*;
 
 const LOGS: u64 = 400;
 const SAMPLES: usize = 1 << 16;
-
-const LOG: StaticLog = StaticLog {
-    sample_period_s: 0.01,
-    velocity_random_walk_m_s_per_sqrt_s: 2e-3,
-    acceleration_random_walk_m_s2_per_sqrt_s: 1e-4,
-    offset_m_s2: 9.80665,
-};
 
 #[test]
 fn rejects_model_logs_at_its_alpha_and_a_wrong_sigma_does_not() {

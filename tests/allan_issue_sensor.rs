@@ -1,15 +1,16 @@
 //! The sensor of the report that asked for an honest fit, simulated: 10⁶ samples at 100 Hz, a
 //! flicker floor of 2.9·10⁻³ m/s² (B = 4.4·10⁻³ m/s²), white noise N = 3·10⁻³ m/s/√s, a random
 //! walk K = 4·10⁻⁴ m/s²/√s that lifts σ to about 1.2·10⁻² m/s² at τ = 2 600 s, and a 0.56 Hz line
-//! of 8·10⁻³ m/s² whose hump sits near τ = 0.3–0.6 s. The fit before (the negative control, kept
-//! as `fit_unconstrained` over the τ with 30 block means) repeats the report's failure on this log:
+//! of 8·10⁻³ m/s² whose hump sits near τ = 0.3–0.6 s. The fit before (the negative control,
+//! `Analysis::fit_before_constraint`: unconstrained over the τ with 30 block means) repeats the
+//! report's failure on this log:
 //! B = 7.04·10⁻³ [7.02, 7.05]·10⁻³ m/s² (1.6 times the truth, ±0.25 %) and K "unresolved,
 //! ≤ 5.3·10⁻⁵". Here the model is rejected, the hump is named as a sinusoid (0.58 Hz), B is read
 //! within 25 % of the truth (4.79·10⁻³ when written) and K's bound or interval reaches what the
 //! longest τ's lower whisker demands (K = 3.8·10⁻⁴ [2.8, 9.0]·10⁻⁴ when written). One log (seed
 //! 0): under a second.
 
-use accelcal::allan::fit::{FitPoint, Term, fit_unconstrained};
+use accelcal::allan::fit::Term;
 use accelcal::allan::simulate::{FeatureLog, StaticLog};
 use accelcal::allan::{Feature, Reading, analyse};
 
@@ -53,23 +54,12 @@ fn the_reported_sensor_is_rejected_its_hump_named_and_b_read_off_the_floor() {
     assert!(k.upper >= k_at_last, "K ≤ {} against {k_at_last}", k.upper);
     // The negative control: the fit before, unconstrained over the τ with 30 block means, on the
     // same log.
-    let points: Vec<FitPoint> = a
-        .points
-        .iter()
-        .filter(|p| p.identified_here)
-        .map(|p| FitPoint {
-            m: p.m,
-            tau_s: p.tau_s,
-            avar: p.adev * p.adev,
-            edf: p.edf.unwrap(),
-        })
-        .collect();
     let terms = [
         Term::VelocityRandomWalk,
         Term::BiasInstability,
         Term::AccelerationRandomWalk,
     ];
-    let old = fit_unconstrained(&points, a.samples, 0.01, &terms, 0.683).unwrap();
+    let old = a.fit_before_constraint(&terms).unwrap();
     let old_b = old.term(Term::BiasInstability).unwrap();
     let old_k = old.term(Term::AccelerationRandomWalk).unwrap();
     eprintln!(

@@ -16,7 +16,6 @@ use accelcal::logs::GPS_COLUMNS;
 use accelcal::logs::arrays::AccelArrays;
 use accelcal::logs::read::LogText;
 use accelcal::logs::write::{header, push_row};
-use accelcal::state::BiasModel;
 
 use crate::config::{self, Source};
 
@@ -49,16 +48,7 @@ impl CalibrationResult {
 /// The settings of `source` as `accelcal calibrate --config` reads them.
 fn settings(source: Option<Source>) -> Result<Settings, ConfigError> {
     let (text, config): (_, Config) = config::load(source)?;
-    let sets = |key: &str| text.as_ref().is_some_and(|t| t.sets(key));
-    Settings::from_config(
-        &config,
-        sets("accelerometer.sample_rate_hz"),
-        sets("initial"),
-    )
-    .map_err(|e| match &text {
-        Some(t) => t.locate(e),
-        None => e,
-    })
+    Settings::from_config_text(&config, text.as_ref())
 }
 
 /// What `--estimate-noise [--estimate KEYS]` asks for: `None` for no estimation, an empty list
@@ -87,21 +77,9 @@ fn request(
             ))
         })?);
     }
-    let keys: Vec<Key> = if named.is_empty() {
-        Key::defaults(stats)
-    } else {
-        Key::ALL.into_iter().filter(|k| named.contains(k)).collect()
-    };
-    if keys.contains(&Key::BiasRandomWalk)
-        && matches!(stats.bias_model, BiasModel::GaussMarkov { .. })
-    {
-        return Err(crate::bad_input(format!(
-            "--estimate {}: K is the random walk's statistic, and the filter's bias model is \
-             gauss_markov; estimate it with bias_model = \"random_walk\" or \"constant\" in [filter]",
-            Key::BiasRandomWalk.name()
-        )));
-    }
-    Ok(Some(Request { keys, confidence }))
+    Request::new(&named, confidence, stats)
+        .map(Some)
+        .map_err(|e| crate::bad_input(e.to_string()))
 }
 
 /// Columns of equal length as a log's CSV text.

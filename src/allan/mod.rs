@@ -113,6 +113,32 @@ pub struct Analysis {
 }
 
 impl Analysis {
+    /// The fit as it was before the constraint, on this analysis: unconstrained, over the τ with
+    /// at least 30 block means only ([`fit::fit_unconstrained`]). Kept for the tests' negative
+    /// controls.
+    pub fn fit_before_constraint(&self, terms: &[Term]) -> Option<Fit> {
+        let points: Vec<FitPoint> = self
+            .points
+            .iter()
+            .filter(|p| p.identified_here)
+            .filter_map(|p| {
+                p.edf.map(|edf| FitPoint {
+                    m: p.m,
+                    tau_s: p.tau_s,
+                    avar: p.adev * p.adev,
+                    edf,
+                })
+            })
+            .collect();
+        fit::fit_unconstrained(
+            &points,
+            self.samples,
+            self.sample_period_s,
+            terms,
+            self.confidence,
+        )
+    }
+
     /// The reported estimate of `term`, if fitted.
     pub fn term(&self, term: Term) -> Option<&TermEstimate> {
         self.terms.iter().find(|t| t.term == term)

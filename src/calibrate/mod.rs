@@ -112,6 +112,28 @@ impl Settings {
         }
     }
 
+    /// The settings of `config` as `calibrate --config` takes them: [`Self::from_config`] with
+    /// the rate and the prior as the file `text` sets them (none without a file), an error
+    /// pointed at its line there.
+    ///
+    /// # Errors
+    /// [`ConfigError::Invalid`] naming the first key outside its accepted range.
+    pub fn from_config_text(
+        config: &Config,
+        text: Option<&crate::config::ConfigText>,
+    ) -> Result<Self, ConfigError> {
+        let sets = |key: &str| text.is_some_and(|t| t.sets(key));
+        Self::from_config(
+            config,
+            sets("accelerometer.sample_rate_hz"),
+            sets("initial"),
+        )
+        .map_err(|e| match text {
+            Some(t) => t.locate(e),
+            None => e,
+        })
+    }
+
     /// The settings of a recording's configuration `config`, checking only the keys a
     /// calibration uses ([`validate_calibration`]): `rate_set` when it sets
     /// `accelerometer.sample_rate_hz`, `initial_set` when it has an `[initial]` section.

@@ -14,14 +14,13 @@ use accelcal::config::{Config, ConfigText};
 use accelcal::error::ConfigError;
 use accelcal::filter::FilterSchedule;
 use accelcal::format::{count, interval, interval_digits, sig};
-use accelcal::likelihood::{Key, NoiseEstimate, Request};
+use accelcal::likelihood::{NoiseEstimate, Request};
 use accelcal::logs::read::{LogFile, LogSource};
 use accelcal::logs::write::LogWriter;
 use accelcal::logs::{ACCEL_FILE, GPS_FILE, TRUTH_FILE};
 use accelcal::logs::{LogError, LogProblem};
 use accelcal::model::Model;
 use accelcal::output::{StagedFiles, check_directory, check_file};
-use accelcal::state::BiasModel;
 use accelcal::{export, realization, report, simulation};
 use anyhow::{Context, Result};
 
@@ -112,16 +111,7 @@ fn calibrate_settings(args: &CalibrateArgs) -> Result<Settings, ConfigError> {
         Some(t) => t.parse()?,
         None => Config::default(),
     };
-    let sets = |key: &str| text.as_ref().is_some_and(|t| t.sets(key));
-    Settings::from_config(
-        &config,
-        sets("accelerometer.sample_rate_hz"),
-        sets("initial"),
-    )
-    .map_err(|e| match &text {
-        Some(t) => t.locate(e),
-        None => e,
-    })
+    Settings::from_config_text(&config, text.as_ref())
 }
 
 pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
@@ -243,27 +233,9 @@ fn noise_request(args: &CalibrateArgs, settings: &Settings) -> Result<Option<Req
     if !args.estimate_noise {
         return Ok(None);
     }
-    let stats = &settings.filter_stats;
-    let named = &args.estimate;
-    let keys: Vec<Key> = if named.is_empty() {
-        Key::defaults(stats)
-    } else {
-        Key::ALL.into_iter().filter(|k| named.contains(k)).collect()
-    };
-    if keys.contains(&Key::BiasRandomWalk)
-        && matches!(stats.bias_model, BiasModel::GaussMarkov { .. })
-    {
-        return Err(UsageError(format!(
-            "--estimate {}: K is the random walk's statistic, and the filter's bias model is \
-             gauss_markov; estimate it with bias_model = \"random_walk\" or \"constant\" in [filter]",
-            Key::BiasRandomWalk.name()
-        ))
-        .into());
-    }
-    Ok(Some(Request {
-        keys,
-        confidence: args.confidence,
-    }))
+    Request::new(&args.estimate, args.confidence, &settings.filter_stats)
+        .map(Some)
+        .map_err(|e| UsageError(e.to_string()).into())
 }
 
 /// The printed lines of a noise estimate: each statistic with its interval, or what the drive

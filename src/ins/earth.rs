@@ -104,6 +104,17 @@ pub fn transport_rate_ned(p: &Geodetic, v_ned: &Vector3<f64>) -> Vector3<f64> {
     )
 }
 
+/// `p` moved by `d_ned_m` metres north, east and down (first order in d/R: the lever arm, a
+/// fix's noise, a prior's draw).
+pub fn offset(p: &Geodetic, d_ned_m: &Vector3<f64>) -> Geodetic {
+    let (rn, re) = radii_m(p.lat_rad);
+    Geodetic {
+        lat_rad: p.lat_rad + d_ned_m.x / (rn + p.height_m),
+        lon_rad: p.lon_rad + d_ned_m.y / ((re + p.height_m) * p.lat_rad.cos()),
+        height_m: p.height_m - d_ned_m.z,
+    }
+}
+
 /// The rate of change of latitude, longitude and height for a velocity `v_ned`:
 /// (dL/dt, dλ/dt, dh/dt), rad/s, rad/s, m/s.
 ///

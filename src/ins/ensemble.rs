@@ -11,12 +11,13 @@
 use nalgebra::{SVector, UnitQuaternion, Vector3};
 use rayon::prelude::*;
 
+use super::earth::offset;
 use super::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, Matrix15, POSITION, STATES, VELOCITY};
 use super::filter::{Ekf, FilterError};
 use super::gnss;
 use super::logs::fix;
 use super::mech::{Increment, Pva};
-use super::sensors::{Imu, offset};
+use super::sensors::Imu;
 use super::setup::Study;
 use super::truth::Truth;
 

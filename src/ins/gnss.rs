@@ -40,13 +40,8 @@ pub fn antenna(
     omega_ib_b: &Vector3<f64>,
 ) -> (Geodetic, Vector3<f64>) {
     let p = &pva.position;
-    let (rn, re) = earth::radii_m(p.lat_rad);
     let arm_n = pva.attitude * lever_b_m;
-    let position = Geodetic {
-        lat_rad: p.lat_rad + arm_n.x / (rn + p.height_m),
-        lon_rad: p.lon_rad + arm_n.y / ((re + p.height_m) * p.lat_rad.cos()),
-        height_m: p.height_m - arm_n.z,
-    };
+    let position = earth::offset(p, &arm_n);
     let w_in =
         earth::earth_rate_ned(p.lat_rad) + earth::transport_rate_ned(p, &pva.velocity_ned_m_s);
     let velocity =

@@ -17,9 +17,10 @@ use std::io::{self, Write};
 use nalgebra::Vector3;
 
 use super::drive::Drive;
+use super::earth::offset;
 use super::gnss::{self, Fix};
 use super::mech::Pva;
-use super::sensors::{Imu, offset};
+use super::sensors::Imu;
 use super::setup::Study;
 use super::truth::{self, Truth};
 
@@ -84,51 +85,39 @@ pub fn write_realization(
         let (bg, ba) = (imu.gyro_bias_rad_s, imu.accel_bias_m_s2);
         let raw = imu.read(&inc);
         let (a, w) = (raw.dvel_m_s / dt, raw.dtheta_rad / dt);
-        writeln!(
-            imu_out,
-            "{t},{},{},{},{},{},{}",
-            z(a.x),
-            z(a.y),
-            z(a.z),
-            z(w.x),
-            z(w.y),
-            z(w.z)
-        )?;
+        row(imu_out, t, &[a.x, a.y, a.z, w.x, w.y, w.z])?;
         let (roll, pitch, yaw) = super::euler_of(&pva.attitude);
-        let v = pva.velocity_ned_m_s;
-        writeln!(
+        let (p, v) = (&pva.position, pva.velocity_ned_m_s);
+        row(
             truth_out,
-            "{t},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            z(pva.position.lat_rad.to_degrees()),
-            z(pva.position.lon_rad.to_degrees()),
-            z(pva.position.height_m),
-            z(v.x),
-            z(v.y),
-            z(v.z),
-            z(roll.to_degrees()),
-            z(pitch.to_degrees()),
-            z(yaw.to_degrees()),
-            z(bg.x),
-            z(bg.y),
-            z(bg.z),
-            z(ba.x),
-            z(ba.y),
-            z(ba.z)
+            t,
+            &[
+                p.lat_rad.to_degrees(),
+                p.lon_rad.to_degrees(),
+                p.height_m,
+                v.x,
+                v.y,
+                v.z,
+                roll.to_degrees(),
+                pitch.to_degrees(),
+                yaw.to_degrees(),
+                bg.x,
+                bg.y,
+                bg.z,
+                ba.x,
+                ba.y,
+                ba.z,
+            ],
         )?;
         samples += 1;
         if (k + 1) % study.imu_steps_per_fix == 0 {
             let f = fix(study, &drive, &mut imu, t, &pva);
-            let v = f.velocity_ned_m_s.unwrap_or_else(Vector3::zeros);
-            writeln!(
-                gnss_out,
-                "{t},{},{},{},{},{},{}",
-                z(f.position.lat_rad.to_degrees()),
-                z(f.position.lon_rad.to_degrees()),
-                z(f.position.height_m),
-                z(v.x),
-                z(v.y),
-                z(v.z)
-            )?;
+            let (p, v) = (
+                &f.position,
+                f.velocity_ned_m_s.unwrap_or_else(Vector3::zeros),
+            );
+            let (lat, lon) = (p.lat_rad.to_degrees(), p.lon_rad.to_degrees());
+            row(gnss_out, t, &[lat, lon, p.height_m, v.x, v.y, v.z])?;
             fixes += 1;
         }
     }
@@ -140,7 +129,12 @@ pub fn write_realization(
     })
 }
 
-/// `x` with a negative zero made positive (what a reader of the CSV expects).
-fn z(x: f64) -> f64 {
-    x + 0.0
+/// One CSV row: `t` and `values`, each the shortest decimal that reads back to it, a negative
+/// zero written as 0 (what a reader of the CSV expects).
+fn row(out: &mut impl Write, t: f64, values: &[f64]) -> io::Result<()> {
+    write!(out, "{t}")?;
+    for x in values {
+        write!(out, ",{}", x + 0.0)?;
+    }
+    writeln!(out)
 }

@@ -9,7 +9,6 @@
 
 use nalgebra::Vector3;
 
-use super::earth::{self, Geodetic};
 use super::mech::Increment;
 use crate::random::{Stream, splitmix64};
 
@@ -153,15 +152,5 @@ impl Imu {
     /// the initial errors, in a fixed order).
     pub fn normals(&mut self, sigma: &Vector3<f64>) -> Vector3<f64> {
         Vector3::from_fn(|i, _| sigma[i] * self.stream.normal())
-    }
-}
-
-/// `p` moved by `d` NED metres (small: first order in d/R).
-pub fn offset(p: &Geodetic, d: &Vector3<f64>) -> Geodetic {
-    let (rn, re) = earth::radii_m(p.lat_rad);
-    Geodetic {
-        lat_rad: p.lat_rad + d.x / (rn + p.height_m),
-        lon_rad: p.lon_rad + d.y / ((re + p.height_m) * p.lat_rad.cos()),
-        height_m: p.height_m - d.z,
     }
 }

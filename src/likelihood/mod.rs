@@ -153,6 +153,46 @@ pub struct Request {
     pub confidence: f64,
 }
 
+/// A search that cannot be asked of the filter's model.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum RequestError {
+    /// K named while the filter's bias is Gauss–Markov, which has no random walk.
+    #[error(
+        "--estimate {key}: K is the random walk's statistic, and the filter's bias model is \
+         gauss_markov; estimate it with bias_model = \"random_walk\" or \"constant\" in [filter]"
+    )]
+    RandomWalkOfGaussMarkov {
+        /// The key named.
+        key: &'static str,
+    },
+}
+
+impl Request {
+    /// The search `--estimate-noise [--estimate KEY,…]` asks for: the `named` keys in
+    /// [`Key::ALL`]'s order, or [`Key::defaults`] of the filter's `stats` when none is named.
+    ///
+    /// # Errors
+    /// [`RequestError`] when a key does not belong to the filter's bias model.
+    pub fn new(named: &[Key], confidence: f64, stats: &NoiseStats) -> Result<Self, RequestError> {
+        let keys: Vec<Key> = if named.is_empty() {
+            Key::defaults(stats)
+        } else {
+            Key::ALL.into_iter().filter(|k| named.contains(k)).collect()
+        };
+        if keys.contains(&Key::BiasRandomWalk)
+            && matches!(
+                stats.bias_model,
+                crate::state::BiasModel::GaussMarkov { .. }
+            )
+        {
+            return Err(RequestError::RandomWalkOfGaussMarkov {
+                key: Key::BiasRandomWalk.name(),
+            });
+        }
+        Ok(Request { keys, confidence })
+    }
+}
+
 /// The search's box for one statistic: the configured value (for K with no random walk
 /// configured, √(σ_b²/duration), the drift that would move the bias by its prior σ over the
 /// drive) times 10^±decades.

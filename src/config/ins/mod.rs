@@ -228,44 +228,47 @@ impl InsConfig {
         })
     }
 
-    /// The sensors the filter assumes.
+    /// The sensors the filter assumes: each `[filter]` key set, else the truth's.
     pub fn assumed(&self) -> AssumedSensors {
+        /// `$ty` with each key from `$filter` where set, else from `$truth`, and the `truth:`
+        /// keys (the rates) from `$truth` alone; every field is named, so the compiler sees a
+        /// new one left out.
+        macro_rules! over_truth {
+            ($filter:expr, $truth:expr, $ty:ident { truth: $($own:ident),*; $($key:ident),* $(,)? }) => {
+                $ty {
+                    $($own: $truth.$own,)*
+                    $($key: $filter.$key.unwrap_or($truth.$key),)*
+                }
+            };
+        }
         let f = &self.filter;
-        let t = &self.imu;
-        let imu = ImuConfig {
-            imu_rate_hz: t.imu_rate_hz,
-            gyro_arw_rad_per_sqrt_s: f
-                .gyro_arw_rad_per_sqrt_s
-                .unwrap_or(t.gyro_arw_rad_per_sqrt_s),
-            accel_vrw_m_s_per_sqrt_s: f
-                .accel_vrw_m_s_per_sqrt_s
-                .unwrap_or(t.accel_vrw_m_s_per_sqrt_s),
-            gyro_bias_model: f.gyro_bias_model.unwrap_or(t.gyro_bias_model),
-            gyro_bias_sigma_rad_s: f.gyro_bias_sigma_rad_s.unwrap_or(t.gyro_bias_sigma_rad_s),
-            gyro_bias_correlation_time_s: f
-                .gyro_bias_correlation_time_s
-                .unwrap_or(t.gyro_bias_correlation_time_s),
-            gyro_bias_random_walk_rad_s_per_sqrt_s: f
-                .gyro_bias_random_walk_rad_s_per_sqrt_s
-                .unwrap_or(t.gyro_bias_random_walk_rad_s_per_sqrt_s),
-            accel_bias_model: f.accel_bias_model.unwrap_or(t.accel_bias_model),
-            accel_bias_sigma_m_s2: f.accel_bias_sigma_m_s2.unwrap_or(t.accel_bias_sigma_m_s2),
-            accel_bias_correlation_time_s: f
-                .accel_bias_correlation_time_s
-                .unwrap_or(t.accel_bias_correlation_time_s),
-            accel_bias_random_walk_m_s2_per_sqrt_s: f
-                .accel_bias_random_walk_m_s2_per_sqrt_s
-                .unwrap_or(t.accel_bias_random_walk_m_s2_per_sqrt_s),
-        };
-        let g = &self.gnss;
-        let gnss = GnssConfig {
-            gnss_rate_hz: g.gnss_rate_hz,
-            gnss_lever_arm_m: f.gnss_lever_arm_m.unwrap_or(g.gnss_lever_arm_m),
-            gnss_position_sigma_m: f.gnss_position_sigma_m.unwrap_or(g.gnss_position_sigma_m),
-            gnss_velocity_sigma_m_s: f
-                .gnss_velocity_sigma_m_s
-                .unwrap_or(g.gnss_velocity_sigma_m_s),
-        };
+        let imu = over_truth!(
+            f,
+            self.imu,
+            ImuConfig {
+                truth: imu_rate_hz;
+                gyro_arw_rad_per_sqrt_s,
+                accel_vrw_m_s_per_sqrt_s,
+                gyro_bias_model,
+                gyro_bias_sigma_rad_s,
+                gyro_bias_correlation_time_s,
+                gyro_bias_random_walk_rad_s_per_sqrt_s,
+                accel_bias_model,
+                accel_bias_sigma_m_s2,
+                accel_bias_correlation_time_s,
+                accel_bias_random_walk_m_s2_per_sqrt_s,
+            }
+        );
+        let gnss = over_truth!(
+            f,
+            self.gnss,
+            GnssConfig {
+                truth: gnss_rate_hz;
+                gnss_lever_arm_m,
+                gnss_position_sigma_m,
+                gnss_velocity_sigma_m_s,
+            }
+        );
         AssumedSensors { imu, gnss }
     }
 }
