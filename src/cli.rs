@@ -119,6 +119,9 @@ impl Default for ReportArgs {
 pub struct EnsembleArgs {
     #[command(flatten)]
     pub model: ModelArgs,
+    /// Which study: the one-axis accelerometer (default) or the three-axis INS/GNSS filter.
+    #[arg(long = "model", value_enum, default_value_t = ModelKind::Accelerometer)]
+    pub kind: ModelKind,
     #[command(flatten)]
     pub case: CaseArgs,
     /// Number of realizations, overriding ensemble.realizations.

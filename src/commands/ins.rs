@@ -1,14 +1,18 @@
-//! The three-axis study's commands: `simulate --model ins --logs DIR`.
+//! The three-axis study's commands: `simulate --model ins --logs DIR` and `ensemble --model ins`.
 
 use anyhow::Result;
 
-use crate::cli::{ModelArgs, SimulateArgs};
+use crate::cli::{EnsembleArgs, ModelArgs, SimulateArgs};
+use accelcal::checks::{Budget, evaluate};
 use accelcal::config::ConfigText;
 use accelcal::config::ins::InsConfig;
 use accelcal::error::ConfigError;
+use accelcal::export;
+use accelcal::ins::ensemble::{self as ins_ensemble, Track};
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Study;
 use accelcal::output::{StagedFiles, check_directory};
+use accelcal::study::Progress;
 
 /// The three-axis logs a simulation writes.
 const IMU_FILE: &str = "imu.csv";
@@ -17,6 +21,11 @@ const TRUTH_FILE: &str = "truth.csv";
 
 /// The three-axis study named by `args` (`--config`, `--seed`), validated.
 pub(super) fn load_study(args: &ModelArgs) -> Result<Study, ConfigError> {
+    load(args, None).map(|(_, s)| s)
+}
+
+/// The configuration and study named by `args`, `realizations` overriding the file's.
+fn load(args: &ModelArgs, realizations: Option<u64>) -> Result<(InsConfig, Study), ConfigError> {
     let text = args.config.as_deref().map(ConfigText::read).transpose()?;
     let locate = |e: ConfigError| match &text {
         Some(t) => t.locate(e),
@@ -29,7 +38,70 @@ pub(super) fn load_study(args: &ModelArgs) -> Result<Study, ConfigError> {
     if let Some(s) = args.seed {
         config.ensemble.seed = s;
     }
-    Study::from_config(&config).map_err(locate)
+    if let Some(n) = realizations {
+        config.ensemble.realizations = n;
+    }
+    // A value set on the command line is not the file's: its error points at no line.
+    let study = Study::from_config(&config).map_err(|e| match &e {
+        ConfigError::Invalid { field, .. }
+            if *field == "ensemble.realizations" && realizations.is_some() =>
+        {
+            e
+        }
+        _ => locate(e),
+    })?;
+    Ok((config, study))
+}
+
+/// `ensemble --model ins`: N realizations of the drive, the check catalogue on each
+/// realization's own covariances, the JSON.
+pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
+    if args.case.truth.is_some() || args.case.accelerometer_output.is_some() {
+        return Err(ConfigError::invalid(
+            "--truth/--accelerometer-output",
+            "given",
+            "options of the one-axis model only",
+        )
+        .into());
+    }
+    if args.shard.is_some() {
+        return Err(ConfigError::invalid(
+            "--shard",
+            args.shard.as_deref().unwrap_or_default(),
+            "an option of the one-axis model only (the three-axis ensemble runs whole)",
+        )
+        .into());
+    }
+    let (config, study) = load(&args.model, args.realizations)?;
+    if let Some(path) = &args.json {
+        accelcal::output::check_file(path)?;
+    }
+    let start = std::time::Instant::now();
+    let track = Track::of(&study);
+    let n = study.realizations;
+    let mut bar = super::Bar::new(args.model.quiet);
+    bar.start("ins", n);
+    let sums = ins_ensemble::sums(&study, &track, 0..n, |done| bar.advance(done))?;
+    bar.finish();
+    let outcome = ins_ensemble::Outcome {
+        stats: sums.normalized.stats(ins_ensemble::constant_states(&study)),
+        calibration: sums.calibration(),
+    };
+    let verdicts = evaluate(&outcome.stats, &Budget::study(study.false_alarm_rate));
+    let elapsed_s = start.elapsed().as_secs_f64();
+    let doc = export::ins::document(&config, &outcome, &verdicts, elapsed_s);
+    super::write_json(args.json.as_deref(), |w| {
+        serde_json::to_writer_pretty(w, &doc).map_err(std::io::Error::from)
+    })?;
+    if args.json.is_some() {
+        super::say(&super::check_lines(
+            "three axes",
+            n,
+            n as f64 / elapsed_s,
+            &verdicts,
+        ))?;
+    }
+    Ok(())
 }
 
 /// `simulate --model ins`: one realization's IMU and GNSS logs and its truth.

@@ -4,7 +4,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use super::{Bar, StdoutError, check_memory, load_model, say, verdict_lines};
+use super::{Bar, check_memory, load_model, say, verdict_lines, write_json};
 use crate::cli::{CaseArgs, EnsembleArgs, MergeArgs, ReportArgs, SensitivityArgs};
 use accelcal::config::{Config, SensitivityConfig};
 use accelcal::ensemble::{Engine, Ensemble, EnsembleRun, EnsembleStats, Partition, Shard, partial};
@@ -73,6 +73,9 @@ fn reproduce_command(args: &ReportArgs) -> String {
 }
 
 pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
+    if args.kind == crate::cli::ModelKind::Ins {
+        return super::ins::run_ensemble(args);
+    }
     let model = load_model(&args.model, &args.case, args.realizations)?;
     check_memory(&model, Work::Ensemble, &args.model)?;
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
@@ -274,35 +277,6 @@ pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
     if args.json.is_some() && !args.quiet {
         let label = format!("{} (merged from {} shards)", model.case(), args.files.len());
         say(&verdict_lines(&label, &outcome.run, &outcome.verdicts))?;
-    }
-    Ok(())
-}
-
-/// Writes a JSON document as `serialize` makes it: to the file `path` (atomically, or in place
-/// when it is a device or a FIFO), else to standard output followed by a line end. The text is
-/// never held whole: at 4·10⁵ fixes an ensemble's is 1.6 GB.
-///
-/// # Errors
-/// [`accelcal::output::OutputError`] naming `path` (or [`StdoutError`]) with the operating
-/// system's error when a write fails; a file's earlier content is then untouched and no
-/// temporary is left.
-fn write_json(
-    path: Option<&Path>,
-    serialize: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<()> {
-    match path {
-        Some(path) => {
-            let mut file = AtomicFile::create(path)?;
-            serialize(file.writer()).map_err(|e| file.error(e))?;
-            file.commit()?;
-        }
-        None => {
-            let mut out = std::io::BufWriter::with_capacity(1 << 16, std::io::stdout().lock());
-            serialize(&mut out)
-                .and_then(|()| out.write_all(b"\n"))
-                .and_then(|()| out.flush())
-                .map_err(StdoutError)?;
-        }
     }
     Ok(())
 }

@@ -11,6 +11,7 @@
 mod bias;
 mod case;
 mod default_toml;
+mod false_alarm;
 pub mod ins;
 mod keys;
 mod sensitivity;
@@ -24,6 +25,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{ConfigError, Position};
 pub use case::{AccelerometerOutput, BiasModelKind, Case, TruthModel};
 pub use default_toml::DEFAULT_TOML;
+pub use false_alarm::{MIN_FALSE_ALARM_RATE, validate_false_alarm_rate};
 pub use sensitivity::SensitivityConfig;
 pub use source::{ConfigText, MAX_CONFIG_BYTES};
 pub use statistics::{FILTER_FLOOR, STATISTICS, Statistic};

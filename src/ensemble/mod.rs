@@ -19,7 +19,8 @@
 //!
 //! The files: `engine` sums a block with either engine, `kernel` (per-sample) and `epoch` simulate
 //! lane groups, `lane_sums` adds a fix across lanes, `tiles` adds the residual products in single
-//! precision, `layout` says which residual products are kept, `sums` and `stats` hold the sums and
+//! precision, `layout` says which residual products are kept, `normalized` sums realizations that each have
+//! their own covariance (an extended Kalman filter's), `sums` and `stats` hold the sums and
 //! the statistics made of them, `workers` runs the blocks in parallel, `partial` writes and merges
 //! shards.
 
@@ -29,6 +30,7 @@ pub mod kernel;
 mod lane_sums;
 mod layout;
 pub mod linear;
+pub mod normalized;
 pub mod partial;
 mod stats;
 mod sums;

@@ -136,7 +136,12 @@ impl<const N: usize, const M: usize> EnsembleStats<N, M> {
 /// constant: its one-pass variance Σx̂²/N − x̂̄² is then rounding, not spread.
 const CONSTANT_VAR_SHARE: f64 = 1e-24;
 
-fn stage_stats<const N: usize>(s: &StageSums<N>, p: &SMatrix<f64, N, N>, n: f64) -> StageStats<N> {
+/// The statistics of one stage's sums `s` over `n` realizations, the filter's covariance being `p`.
+pub(super) fn stage_stats<const N: usize>(
+    s: &StageSums<N>,
+    p: &SMatrix<f64, N, N>,
+    n: f64,
+) -> StageStats<N> {
     let mean_e = s.e / n;
     let mean_x = s.x / n;
     let ee = s.ee;

@@ -3,6 +3,7 @@
 //! is an edge of the library: the typed verdicts become the stable field names of the data
 //! contract.
 
+pub mod ins;
 pub mod noise;
 pub mod sensitivity;
 
@@ -13,7 +14,7 @@ use crate::config::{AccelerometerOutput, Config, TruthModel};
 use crate::ensemble::FixStats;
 use crate::filter::FilterSchedule;
 use crate::realization::Realization;
-use crate::state::ErrorState;
+use crate::state::{ErrorState, Variable};
 use crate::study::{CaseOutcome, StagedState, Study};
 
 // `FinalSigma` and the columns of `realization_csv` name the three states one by one.
@@ -81,6 +82,22 @@ pub struct CheckRecord {
 impl CheckRecord {
     /// The record of `c`; `fix_times_s` name the members' fixes.
     pub fn new(c: &Check, fix_times_s: &[f64]) -> Self {
+        Self::with_names(
+            c,
+            fix_times_s,
+            &ErrorState::VARIABLES,
+            &ErrorState::MEASURED,
+        )
+    }
+
+    /// The record of `c` for a model whose states and measurements are `states` and
+    /// `measurements`.
+    pub fn with_names(
+        c: &Check,
+        fix_times_s: &[f64],
+        states: &[Variable],
+        measurements: &[Variable],
+    ) -> Self {
         let worst = c.worst.map(|w| w.member);
         Self {
             id: c.id,
@@ -104,7 +121,7 @@ impl CheckRecord {
             worst_time_s: worst.map_or(f64::NAN, |m| fix_times_s[m.fix()]),
             worst_member: worst.map_or_else(
                 || "no member could be tested".to_string(),
-                |m| m.describe(fix_times_s),
+                |m| m.describe_with(fix_times_s, states, measurements),
             ),
         }
     }

@@ -1,18 +1,21 @@
 //! The three-axis Monte Carlo ensemble: N realizations of one drive, each with its own sensors
-//! and its own EKF, whose covariance depends on its own estimate. What the checks need is summed
-//! over the realizations per fix, each realization's errors normalized by its own covariance:
-//! NEES eᵀP⁻¹e before and after the update (χ²(15) each when the filter is consistent) and
-//! NIS νᵀS⁻¹ν (χ² of the fix's rows).
+//! and its own EKF, whose covariance depends on its own estimate. Each realization's errors,
+//! corrections and innovations at every fix are normalized by its own P and S
+//! ([`crate::ensemble::normalized`]) and summed: the check catalogue reads the sums as it reads
+//! the linear study's.
 //!
 //! The truth is computed once and shared (every realization drives the same road); each
-//! realization's random stream depends only on the seed and its index, and the sums are folded
-//! in index order, chunk by chunk: the same numbers on any thread count, memory flat in N.
+//! realization's random stream depends only on the seed and its index, and the realizations are
+//! folded in index order, chunk by chunk: the same numbers on any thread count, memory flat in N.
 
-use nalgebra::{SVector, UnitQuaternion, Vector3};
+use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 use rayon::prelude::*;
 
+use crate::ensemble::normalized::{FixInput, NormalizedFix, NormalizedSums, StageInput};
+use crate::ensemble::{EnsembleStats, ResidualLayout};
+
 use super::earth::offset;
-use super::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, Matrix15, POSITION, STATES, VELOCITY};
+use super::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, POSITION, STATES, VELOCITY};
 use super::filter::{Ekf, FilterError};
 use super::gnss;
 use super::logs::fix;
@@ -21,8 +24,88 @@ use super::sensors::Imu;
 use super::setup::Study;
 use super::truth::Truth;
 
-/// Realizations run side by side before their sums are folded in.
-const CHUNK: u64 = 64;
+/// Realizations run side by side before they are folded into the sums, in index order (each
+/// holds its normalized fixes until then: 2.5 MB for the default drive).
+const CHUNK: u64 = 16;
+
+/// The GNSS measurement's rows: position and velocity, NED.
+pub const MEASURED: usize = 6;
+
+/// The normalized sums of the three-axis ensemble.
+pub type Sums = NormalizedSums<STATES, MEASURED>;
+
+/// One realization's fixes, normalized by its own covariances, and its errors and σ's at the end.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Normalized {
+    /// Every fix, normalized.
+    pub fixes: Vec<NormalizedFix<STATES, MEASURED>>,
+    /// The a posteriori error at the last fix.
+    pub final_error: SVector<f64, STATES>,
+    /// The filter's a posteriori σ at the last fix.
+    pub final_sigma: SVector<f64, STATES>,
+}
+
+/// What the ensemble says of the calibration at the end of the drive, per error state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Calibration {
+    /// Realizations N.
+    pub realizations: u64,
+    /// The filter's σ at the last fix, root mean square over the ensemble.
+    pub filter_sigma: [f64; STATES],
+    /// The achieved error at the last fix, root mean square over the ensemble.
+    pub achieved_rms: [f64; STATES],
+    /// Realizations whose final |error| / σ is within the two-sided 95 % bound 1.96.
+    pub within_95: [u64; STATES],
+}
+
+/// The ensemble's sums: the normalized ones the checks read, and the raw ones at the end.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InsSums {
+    /// The normalized sums.
+    pub normalized: Sums,
+    /// Σ e² at the last fix.
+    pub sq_error: SVector<f64, STATES>,
+    /// Σ σ² at the last fix.
+    pub variance: SVector<f64, STATES>,
+    /// Realizations whose final |e|/σ ≤ 1.96, per state.
+    pub within_95: [u64; STATES],
+}
+
+impl InsSums {
+    /// Adds one realization.
+    pub fn add(&mut self, r: &Normalized) {
+        self.normalized.add(&r.fixes);
+        self.sq_error += r.final_error.component_mul(&r.final_error);
+        self.variance += r.final_sigma.component_mul(&r.final_sigma);
+        for (k, w) in self.within_95.iter_mut().enumerate() {
+            *w += u64::from((r.final_error[k] / r.final_sigma[k]).abs() <= Z95);
+        }
+    }
+
+    /// The calibration at the end of the drive.
+    pub fn calibration(&self) -> Calibration {
+        let n = self.normalized.sums.count;
+        let rms = |v: &SVector<f64, STATES>| std::array::from_fn(|k| (v[k] / n as f64).sqrt());
+        Calibration {
+            realizations: n,
+            filter_sigma: rms(&self.variance),
+            achieved_rms: rms(&self.sq_error),
+            within_95: self.within_95,
+        }
+    }
+}
+
+/// The two-sided 95 % bound of a standard normal score.
+pub const Z95: f64 = 1.959_963_984_540_054;
+
+/// The ensemble's statistics and its calibration figures.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The statistics of the normalized quantities, for the checks.
+    pub stats: EnsembleStats<STATES, MEASURED>,
+    /// The calibration at the end.
+    pub calibration: Calibration,
+}
 
 /// The drive's truth at every IMU step, shared by the realizations.
 pub struct Track {
@@ -46,31 +129,6 @@ impl Track {
     }
 }
 
-/// The ensemble's sums at one fix.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct FixSums {
-    /// The fix's time, s.
-    pub t_s: f64,
-    /// Σ NEES before the update.
-    pub nees_prior: f64,
-    /// Σ NEES after the update.
-    pub nees_post: f64,
-    /// Σ NIS.
-    pub nis: f64,
-    /// Σ of the innovations' rows (the NIS sum's degrees of freedom).
-    pub nis_dof: usize,
-}
-
-impl FixSums {
-    fn add(&mut self, other: &FixSums) {
-        self.t_s = other.t_s;
-        self.nees_prior += other.nees_prior;
-        self.nees_post += other.nees_post;
-        self.nis += other.nis;
-        self.nis_dof += other.nis_dof;
-    }
-}
-
 /// The error of `ekf` against the true state and biases, in the error state's coordinates.
 pub fn error(ekf: &Ekf, pva: &Pva, imu: &Imu) -> SVector<f64, STATES> {
     let mut e = SVector::<f64, STATES>::zeros();
@@ -87,18 +145,38 @@ pub fn error(ekf: &Ekf, pva: &Pva, imu: &Imu) -> SVector<f64, STATES> {
     e
 }
 
-/// eᵀP⁻¹e by a Cholesky factor of P.
-fn nees(e: &SVector<f64, STATES>, p: &Matrix15) -> Result<f64, FilterError> {
-    let chol = p.cholesky().ok_or(FilterError::Covariance)?;
-    Ok(e.dot(&chol.solve(e)))
+/// A realization that could not be filtered or normalized.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum RealizationError {
+    /// The filter stopped.
+    #[error("realization {index}: {source}")]
+    Filter {
+        /// The realization.
+        index: u64,
+        /// Why.
+        source: FilterError,
+    },
+    /// A covariance at a fix was not positive definite, or a fix had no velocity.
+    #[error("realization {index}: the covariance at fix {fix} is not positive definite")]
+    Covariance {
+        /// The realization.
+        index: u64,
+        /// The fix.
+        fix: usize,
+    },
 }
 
 /// Realization `index`: its filter started from the truth plus a draw of its prior, run over the
-/// track, with its NEES and NIS at every fix.
+/// track, with its errors, corrections and innovations at every fix normalized by its own
+/// covariances.
 ///
 /// # Errors
-/// [`FilterError`] when a covariance stops being positive definite.
-pub fn realization(study: &Study, track: &Track, index: u64) -> Result<Vec<FixSums>, FilterError> {
+/// [`RealizationError`] when a covariance stops being positive definite.
+pub fn realization(
+    study: &Study,
+    track: &Track,
+    index: u64,
+) -> Result<Normalized, RealizationError> {
     let drive = study.drive();
     let mut imu = study.imu(index);
     let s = &study.initial_sigma;
@@ -118,7 +196,7 @@ pub fn realization(study: &Study, track: &Track, index: u64) -> Result<Vec<FixSu
         study.filter_decay(),
         g.lever_arm_b_m,
     );
-    let dt = 1.0 / study.imu_rate_hz;
+    let filter = |source| RealizationError::Filter { index, source };
     let mut out = Vec::with_capacity(track.steps.len() / study.imu_steps_per_fix);
     for (k, (inc, pva)) in track.steps.iter().enumerate() {
         let raw = imu.read(inc);
@@ -126,48 +204,130 @@ pub fn realization(study: &Study, track: &Track, index: u64) -> Result<Vec<FixSu
         if (k + 1) % study.imu_steps_per_fix != 0 {
             continue;
         }
-        let t = (k + 1) as f64 * dt;
+        let t = (k + 1) as f64 / study.imu_rate_hz;
         let mut reading = fix(study, &drive, &mut imu, t, pva);
         // The filter weighs the fix with the σ's it assumes.
         reading.position_sigma_m = g.position_sigma_m;
         reading.velocity_sigma_m_s = g.velocity_sigma_m_s;
-        let nees_prior = nees(&error(&ekf, pva, &imu), &ekf.covariance)?;
-        let innovation = ekf.update(&reading)?;
-        let nees_post = nees(&error(&ekf, pva, &imu), &ekf.covariance)?;
-        out.push(FixSums {
-            t_s: t,
-            nees_prior,
-            nees_post,
-            nis: innovation.nis,
-            nis_dof: innovation.residual.len(),
-        });
+        let (e_prior, p_prior) = (error(&ekf, pva, &imu), ekf.covariance);
+        let innovation = ekf.update(&reading).map_err(filter)?;
+        let e_post = error(&ekf, pva, &imu);
+        let bad = RealizationError::Covariance {
+            index,
+            fix: out.len(),
+        };
+        if innovation.residual.len() != MEASURED {
+            return Err(bad);
+        }
+        let input = FixInput {
+            prior: StageInput {
+                error: e_prior,
+                // Closed loop: the error state is reset to zero after every fix.
+                estimate: SVector::zeros(),
+                covariance: p_prior,
+            },
+            post: StageInput {
+                error: e_post,
+                // The correction the update applied, K·ν: the error's change (to first order).
+                estimate: e_prior - e_post,
+                covariance: ekf.covariance,
+            },
+            residual: SVector::from_fn(|j, _| innovation.residual[j]),
+            residual_covariance: SMatrix::from_fn(|a, b| innovation.covariance[(a, b)]),
+        };
+        out.push(NormalizedFix::of(&input, out.len()).map_err(|_| bad)?);
     }
-    Ok(out)
+    let (e, p) = (
+        error(
+            &ekf,
+            track.steps.last().map_or(&track.start, |x| &x.1),
+            &imu,
+        ),
+        ekf.covariance,
+    );
+    Ok(Normalized {
+        fixes: out,
+        final_error: e,
+        final_sigma: SVector::from_fn(|k, _| p[(k, k)].sqrt()),
+    })
 }
 
-/// The sums over `realizations` realizations of `study` (indices 0 to N − 1), in index order.
+/// The fixes' times of `study`, s.
+pub fn fix_times_s(study: &Study, track: &Track) -> Vec<f64> {
+    (1..=track.steps.len() / study.imu_steps_per_fix)
+        .map(|i| (i * study.imu_steps_per_fix) as f64 / study.imu_rate_hz)
+        .collect()
+}
+
+/// The residual products the whiteness check reads: every pair of fixes up to 1 000 fixes, pairs
+/// at most 50 fixes apart beyond (the linear study's rule), or at most `max_lag` apart.
+pub fn layout(fixes: usize, max_lag: Option<usize>) -> ResidualLayout {
+    let lag = max_lag.or((fixes > 1000).then_some(50));
+    ResidualLayout::with_width(fixes, MEASURED, lag)
+}
+
+/// Empty sums for `study`'s ensemble.
+pub fn empty_sums(study: &Study, track: &Track) -> InsSums {
+    let times = fix_times_s(study, track);
+    let n = times.len();
+    let layout = layout(n, study.residual_max_lag);
+    InsSums {
+        normalized: NormalizedSums::new(times, &layout, [0, n.saturating_sub(1)]),
+        sq_error: SVector::zeros(),
+        variance: SVector::zeros(),
+        within_95: [0; STATES],
+    }
+}
+
+/// The sums over realizations `range` of `study`, folded in index order; `progress` is told how
+/// many are done after every chunk.
 ///
 /// # Errors
-/// The first realization's [`FilterError`], in index order.
-pub fn run(study: &Study, track: &Track, realizations: u64) -> Result<Vec<FixSums>, FilterError> {
-    let mut sums: Vec<FixSums> = Vec::new();
-    let mut first = 0;
-    while first < realizations {
-        let last = (first + CHUNK).min(realizations);
-        let chunk: Vec<Result<Vec<FixSums>, FilterError>> = (first..last)
+/// The first realization's [`RealizationError`], in index order.
+pub fn sums(
+    study: &Study,
+    track: &Track,
+    range: std::ops::Range<u64>,
+    mut progress: impl FnMut(u64),
+) -> Result<InsSums, RealizationError> {
+    let mut sums = empty_sums(study, track);
+    let mut first = range.start;
+    while first < range.end {
+        let last = (first + CHUNK).min(range.end);
+        let chunk: Vec<Result<Normalized, RealizationError>> = (first..last)
             .into_par_iter()
             .map(|l| realization(study, track, l))
             .collect();
         for r in chunk {
-            let r = r?;
-            if sums.is_empty() {
-                sums = vec![FixSums::default(); r.len()];
-            }
-            for (s, x) in sums.iter_mut().zip(&r) {
-                s.add(x);
-            }
+            sums.add(&r?);
         }
         first = last;
+        progress(first - range.start);
     }
     Ok(sums)
+}
+
+/// Which error states do not move between fixes: a bias whose truth and filter both hold it
+/// constant.
+pub fn constant_states(study: &Study) -> [bool; STATES] {
+    use super::sensors::BiasProcess::Constant;
+    let (t, f) = (&study.truth_imu, &study.filter_imu);
+    let gyro = matches!(t.gyro_bias, Constant { .. }) && matches!(f.gyro_bias, Constant { .. });
+    let accel = matches!(t.accel_bias, Constant { .. }) && matches!(f.accel_bias, Constant { .. });
+    std::array::from_fn(|k| {
+        (GYRO_BIAS..GYRO_BIAS + 3).contains(&k) && gyro
+            || (ACCEL_BIAS..ACCEL_BIAS + 3).contains(&k) && accel
+    })
+}
+
+/// The ensemble's statistics over `realizations` realizations of `study` (indices 0 to N − 1).
+///
+/// # Errors
+/// The first realization's [`RealizationError`], in index order.
+pub fn run(study: &Study, track: &Track, realizations: u64) -> Result<Outcome, RealizationError> {
+    let sums = sums(study, track, 0..realizations, |_| {})?;
+    Ok(Outcome {
+        stats: sums.normalized.stats(constant_states(study)),
+        calibration: sums.calibration(),
+    })
 }

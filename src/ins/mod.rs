@@ -16,6 +16,7 @@ pub mod filter;
 pub mod gnss;
 pub mod logs;
 pub mod mech;
+pub mod names;
 pub mod sensors;
 pub mod setup;
 pub mod truth;

@@ -48,6 +48,10 @@ pub struct Study {
     pub seed: u64,
     /// Realizations of the ensemble.
     pub realizations: u64,
+    /// The study-wide false-alarm rate of the checks.
+    pub false_alarm_rate: f64,
+    /// Largest lag of the residual whiteness check, in fixes (`None`: the default rule).
+    pub residual_max_lag: Option<usize>,
 }
 
 /// A sensor triad's bias process from its configured model.
@@ -116,6 +120,8 @@ impl Study {
             initial_sigma: [p, p, p, v, v, v, tilt, tilt, yaw],
             seed: c.ensemble.seed,
             realizations: c.ensemble.realizations,
+            false_alarm_rate: c.checks.false_alarm_rate,
+            residual_max_lag: c.checks.residual_max_lag.map(|l| l as usize),
         })
     }
 

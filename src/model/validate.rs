@@ -9,15 +9,12 @@ use super::{
 use crate::config::statistics::Range;
 use crate::config::{Config, STATISTICS, show};
 use crate::error::ConfigError;
-use crate::stats::MIN_ACCURATE_RATE;
 
 mod bias;
 mod calibrate;
 
+pub(crate) use crate::config::validate_false_alarm_rate;
 pub use calibrate::validate_calibration;
-
-/// The smallest accepted `checks.false_alarm_rate` (see [`validate_false_alarm_rate`]).
-const MIN_FALSE_ALARM_RATE: f64 = 1e-6;
 
 /// `x` rounded to the nearest whole number when it is one within [`WHOLE_TOL`].
 pub(super) fn whole(x: f64) -> Option<u64> {
@@ -106,30 +103,6 @@ pub(super) fn validate(c: &Config) -> Result<(), ConfigError> {
     }
     validate_sums_memory(c, grid.fixes)?;
     validate_residual_pair(c, &grid)
-}
-
-/// The study-wide false-alarm rate α must be in [[`MIN_FALSE_ALARM_RATE`], 0.5].
-///
-/// Each member of a check is tested at α over the number of checks and over its members, up to
-/// about 10⁷ members within the memory budget of the running sums; at α = 10⁻⁶ those shares stay
-/// above [`MIN_ACCURATE_RATE`], the smallest rate whose normal bound double precision computes
-/// accurately.
-fn validate_false_alarm_rate(alpha: f64) -> Result<(), ConfigError> {
-    if alpha.is_finite() && (MIN_FALSE_ALARM_RATE..=0.5).contains(&alpha) {
-        return Ok(());
-    }
-    Err(ConfigError::invalid(
-        "checks.false_alarm_rate",
-        show(alpha),
-        format!(
-            "must be a finite number in [{}, 0.5]: below {}, the share of each member of a large \
-             check falls under {}, where the normal quantile Φ⁻¹(1 − p/2) is no longer accurate \
-             in double precision",
-            show(MIN_FALSE_ALARM_RATE),
-            show(MIN_FALSE_ALARM_RATE),
-            show(MIN_ACCURATE_RATE)
-        ),
-    ))
 }
 
 /// The time grid a valid configuration has: accelerometer samples, samples per fix, fixes.

@@ -38,6 +38,8 @@ pub struct InsConfig {
     pub filter: InsFilterConfig,
     /// The Monte Carlo ensemble.
     pub ensemble: InsEnsembleConfig,
+    /// The statistical verdicts on it.
+    pub checks: InsChecksConfig,
 }
 
 /// The drive: the default drive's first `duration_s` seconds from a start on the ellipsoid.
@@ -198,6 +200,28 @@ impl Default for InsEnsembleConfig {
         InsEnsembleConfig {
             realizations: 1000,
             seed: 2017,
+        }
+    }
+}
+
+/// The statistical verdicts on the ensemble (the linear study's `[checks]` keys that apply).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InsChecksConfig {
+    /// Study-wide false-alarm rate: the probability that a consistent filter fails any check,
+    /// split evenly over the checks and their members (Bonferroni).
+    pub false_alarm_rate: f64,
+    /// Largest lag, in fixes, of the residual whiteness check. Left out, every pair of fixes is
+    /// tested while there are at most 1000 fixes, and pairs up to 50 fixes apart beyond.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residual_max_lag: Option<u32>,
+}
+
+impl Default for InsChecksConfig {
+    fn default() -> Self {
+        InsChecksConfig {
+            false_alarm_rate: 0.01,
+            residual_max_lag: None,
         }
     }
 }

@@ -89,6 +89,19 @@ impl InsConfig {
                 "at least 2",
             ));
         }
+        self.checks()
+    }
+
+    /// The checks' false-alarm rate and the whiteness check's lag.
+    fn checks(&self) -> Result<(), ConfigError> {
+        crate::config::validate_false_alarm_rate(self.checks.false_alarm_rate)?;
+        if self.checks.residual_max_lag == Some(0) {
+            return Err(ConfigError::invalid(
+                "checks.residual_max_lag",
+                0,
+                "a whole number of fixes ≥ 1 (or left out)",
+            ));
+        }
         Ok(())
     }
 
