@@ -100,8 +100,14 @@ fn bad_three_axis_requests_are_refused_and_nothing_is_clobbered() {
         "[checks]\nfalse_alarm_rate = 0.9\n",
     )
     .unwrap();
+    std::fs::write(
+        dir.path().join("fast.toml"),
+        "[gnss]\ngnss_rate_hz = 100.0\n",
+    )
+    .unwrap();
     std::fs::write(dir.path().join("old.json"), "kept").unwrap();
-    let cases: [&[&str]; 4] = [
+    let cases: [&[&str]; 5] = [
+        &["--config", "fast.toml"],
         &["--config", "bad.toml"],
         &["--config", "short.toml", "--realizations", "1"],
         &["--config", "short.toml", "--truth", "euler"],
@@ -114,7 +120,13 @@ fn bad_three_axis_requests_are_refused_and_nothing_is_clobbered() {
             "p.bin",
         ],
     ];
-    let expect = ["bad.toml:2", "ensemble.realizations", "one-axis", "--shard"];
+    let expect = [
+        "GiB",
+        "bad.toml:2",
+        "ensemble.realizations",
+        "one-axis",
+        "--shard",
+    ];
     for (args, word) in cases.iter().zip(expect) {
         let mut all = vec!["ensemble", "--model", "ins", "--json", "old.json"];
         all.extend_from_slice(args);

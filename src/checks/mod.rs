@@ -142,6 +142,9 @@ pub struct Check {
     pub failures: usize,
     /// The member farthest outside, relative to its band; `None` when there are no members.
     pub worst: Option<Worst>,
+    /// The outside member of the earliest fix (the first in member order among those of that
+    /// fix): when the check starts to fail. `None` when no member is outside.
+    pub first_failure: Option<MemberId>,
     /// The smallest N at which this check can fail.
     pub min_realizations: u64,
     /// Pass, fail or untestable.
@@ -300,6 +303,7 @@ pub fn judge(definition: &'static Definition, stats: &dyn Statistics, share: f64
         center,
         failures: 0,
         worst: None,
+        first_failure: None,
         min_realizations: definition.min_realizations(p),
         verdict: Verdict::Pass,
     };
@@ -307,6 +311,9 @@ pub fn judge(definition: &'static Definition, stats: &dyn Statistics, share: f64
     (definition.for_each_member)(stats, &mut |value, member| {
         if !(lower..=upper).contains(&value) {
             check.failures += 1;
+            if check.first_failure.is_none_or(|f| member.fix() < f.fix()) {
+                check.first_failure = Some(member);
+            }
         }
         let e = check.excursion(value);
         // NaN sorts above every number, so a non-finite member is the worst.

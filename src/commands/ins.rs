@@ -14,6 +14,11 @@ use accelcal::ins::setup::Study;
 use accelcal::output::{StagedFiles, check_directory};
 use accelcal::study::Progress;
 
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// The most memory a three-axis ensemble may hold.
+const MAX_ENSEMBLE_BYTES: f64 = 2.0 * GIB;
+
 /// The three-axis logs a simulation writes.
 const IMU_FILE: &str = "imu.csv";
 const GNSS_FILE: &str = "gnss.csv";
@@ -73,6 +78,21 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         .into());
     }
     let (config, study) = load(&args.model, args.realizations)?;
+    let bytes = ins_ensemble::memory_bytes(&study);
+    if bytes > MAX_ENSEMBLE_BYTES {
+        let fixes = study.duration_s * study.imu_rate_hz / study.imu_steps_per_fix as f64;
+        return Err(ConfigError::invalid(
+            "gnss.gnss_rate_hz",
+            config.gnss.gnss_rate_hz,
+            format!(
+                "{fixes:.0} fixes would hold {:.1} GiB in the ensemble's sums (at most {:.0} GiB): \
+                 a lower GNSS rate, a shorter drive, or checks.residual_max_lag",
+                bytes / GIB,
+                MAX_ENSEMBLE_BYTES / GIB
+            ),
+        )
+        .into());
+    }
     if let Some(path) = &args.json {
         accelcal::output::check_file(path)?;
     }
@@ -94,12 +114,13 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         serde_json::to_writer_pretty(w, &doc).map_err(std::io::Error::from)
     })?;
     if args.json.is_some() {
-        super::say(&super::check_lines(
-            "three axes",
-            n,
-            n as f64 / elapsed_s,
-            &verdicts,
-        ))?;
+        let mut lines = super::check_lines("three axes", n, n as f64 / elapsed_s, &verdicts);
+        for c in &doc.summary.checks {
+            if let Some(first) = &c.first_failure_member {
+                lines.push_str(&format!("  {} fails from {first}\n", c.id.name()));
+            }
+        }
+        super::say(&lines)?;
     }
     Ok(())
 }

@@ -77,6 +77,11 @@ pub struct CheckRecord {
     pub worst_time_s: f64,
     /// The worst member in words.
     pub worst_member: String,
+    /// When the check starts to fail: the time of the earliest fix with a member outside, s;
+    /// null when none is.
+    pub first_failure_time_s: Option<f64>,
+    /// That member in words; null when none is outside.
+    pub first_failure_member: Option<String>,
 }
 
 impl CheckRecord {
@@ -123,6 +128,10 @@ impl CheckRecord {
                 || "no member could be tested".to_string(),
                 |m| m.describe_with(fix_times_s, states, measurements),
             ),
+            first_failure_time_s: c.first_failure.map(|m| fix_times_s[m.fix()]),
+            first_failure_member: c
+                .first_failure
+                .map(|m| m.describe_with(fix_times_s, states, measurements)),
         }
     }
 }

@@ -266,6 +266,17 @@ pub fn layout(fixes: usize, max_lag: Option<usize>) -> ResidualLayout {
     ResidualLayout::with_width(fixes, MEASURED, lag)
 }
 
+/// The memory an ensemble of `study` holds, bytes: a chunk of realizations' normalized fixes,
+/// the sums per fix and the residual products.
+pub fn memory_bytes(study: &Study) -> f64 {
+    let fixes = (study.duration_s * study.imu_rate_hz / study.imu_steps_per_fix as f64).floor();
+    let record = std::mem::size_of::<NormalizedFix<STATES, MEASURED>>() as f64;
+    let per_fix = std::mem::size_of::<crate::ensemble::FixSums<STATES>>() as f64
+        + 2.0 * (STATES * STATES * 8) as f64;
+    let products = layout(fixes as usize, study.residual_max_lag).len() as f64 * 8.0;
+    CHUNK as f64 * fixes * record + fixes * per_fix + products
+}
+
 /// Empty sums for `study`'s ensemble.
 pub fn empty_sums(study: &Study, track: &Track) -> InsSums {
     let times = fix_times_s(study, track);
