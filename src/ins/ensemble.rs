@@ -259,11 +259,16 @@ pub fn fix_times_s(study: &Study, track: &Track) -> Vec<f64> {
         .collect()
 }
 
-/// The residual products the whiteness check reads: every pair of fixes up to 1 000 fixes, pairs
-/// at most 50 fixes apart beyond (the linear study's rule), or at most `max_lag` apart.
+/// The residual products the whiteness check reads by default: pairs of fixes at most this many
+/// fixes apart. A GNSS error correlated over seconds, or a mis-modelled dynamics, shows within
+/// tens of fixes; the Bonferroni bound of every pair of 600 fixes (6.5·10⁶ members) would dilute
+/// it, and their products would cost as much as the filters.
+pub const DEFAULT_MAX_LAG: usize = 30;
+
+/// The residual products the whiteness check reads: pairs of fixes at most `max_lag` apart
+/// ([`DEFAULT_MAX_LAG`] when `None`; a lag of the fixes' count or more keeps every pair).
 pub fn layout(fixes: usize, max_lag: Option<usize>) -> ResidualLayout {
-    let lag = max_lag.or((fixes > 1000).then_some(50));
-    ResidualLayout::with_width(fixes, MEASURED, lag)
+    ResidualLayout::with_width(fixes, MEASURED, Some(max_lag.unwrap_or(DEFAULT_MAX_LAG)))
 }
 
 /// The memory an ensemble of `study` holds, bytes: a chunk of realizations' normalized fixes,

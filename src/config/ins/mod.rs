@@ -211,8 +211,8 @@ pub struct InsChecksConfig {
     /// Study-wide false-alarm rate: the probability that a consistent filter fails any check,
     /// split evenly over the checks and their members (Bonferroni).
     pub false_alarm_rate: f64,
-    /// Largest lag, in fixes, of the residual whiteness check. Left out, every pair of fixes is
-    /// tested while there are at most 1000 fixes, and pairs up to 50 fixes apart beyond.
+    /// Largest lag, in fixes, of the residual whiteness check. Left out, 30; a lag of the
+    /// drive's fix count or more tests every pair.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residual_max_lag: Option<u32>,
 }
@@ -221,7 +221,8 @@ impl Default for InsChecksConfig {
     fn default() -> Self {
         InsChecksConfig {
             false_alarm_rate: 0.01,
-            residual_max_lag: None,
+            // ins::ensemble::DEFAULT_MAX_LAG, which a file without the key gets too.
+            residual_max_lag: Some(30),
         }
     }
 }
