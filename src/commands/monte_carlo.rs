@@ -28,6 +28,7 @@ pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
     let study = Study::run(&model, &mut bar)?
         .with_sensitivity(&mut bar)?
         .with_drift(&mut bar)?
+        .with_ins(&mut bar)?
         .with_noise(study::noise::NOISE_DRIVES, &mut bar)?
         .with_real_drive()?;
     let static_noise = accelcal::allan::section::report_coverage()?;

@@ -166,17 +166,32 @@ pub enum RealizationError {
     },
 }
 
-/// Realization `index`: its filter started from the truth plus a draw of its prior, run over the
-/// track, with its errors, corrections and innovations at every fix normalized by its own
-/// covariances.
+/// What one realization's filter saw at one fix, after its update.
+pub struct FixView<'a> {
+    /// The fix's time, s.
+    pub t_s: f64,
+    /// The fix's index.
+    pub fix: usize,
+    /// The errors before and after the update, the correction, P and S.
+    pub input: FixInput<STATES, MEASURED>,
+    /// The filter after the update.
+    pub ekf: &'a Ekf,
+    /// The true IMU now (its biases).
+    pub imu: &'a Imu,
+}
+
+/// Runs realization `index` of `study` over `track` — its filter started from the truth plus a
+/// draw of its prior — calling `on_fix` after every update; returns the filter and the IMU at
+/// the end.
 ///
 /// # Errors
-/// [`RealizationError`] when a covariance stops being positive definite.
-pub fn realization(
+/// [`RealizationError`] when a covariance stops being positive definite, or `on_fix`'s.
+pub fn filter_realization(
     study: &Study,
     track: &Track,
     index: u64,
-) -> Result<Normalized, RealizationError> {
+    mut on_fix: impl FnMut(&FixView) -> Result<(), RealizationError>,
+) -> Result<(Ekf, Imu), RealizationError> {
     let drive = study.drive();
     let mut imu = study.imu(index);
     let s = &study.initial_sigma;
@@ -197,7 +212,7 @@ pub fn realization(
         g.lever_arm_b_m,
     );
     let filter = |source| RealizationError::Filter { index, source };
-    let mut out = Vec::with_capacity(track.steps.len() / study.imu_steps_per_fix);
+    let mut fixes = 0;
     for (k, (inc, pva)) in track.steps.iter().enumerate() {
         let raw = imu.read(inc);
         ekf.propagate(&raw);
@@ -212,12 +227,8 @@ pub fn realization(
         let (e_prior, p_prior) = (error(&ekf, pva, &imu), ekf.covariance);
         let innovation = ekf.update(&reading).map_err(filter)?;
         let e_post = error(&ekf, pva, &imu);
-        let bad = RealizationError::Covariance {
-            index,
-            fix: out.len(),
-        };
         if innovation.residual.len() != MEASURED {
-            return Err(bad);
+            return Err(RealizationError::Covariance { index, fix: fixes });
         }
         let input = FixInput {
             prior: StageInput {
@@ -235,19 +246,39 @@ pub fn realization(
             residual: SVector::from_fn(|j, _| innovation.residual[j]),
             residual_covariance: SMatrix::from_fn(|a, b| innovation.covariance[(a, b)]),
         };
-        out.push(NormalizedFix::of(&input, out.len()).map_err(|_| bad)?);
+        on_fix(&FixView {
+            t_s: t,
+            fix: fixes,
+            input,
+            ekf: &ekf,
+            imu: &imu,
+        })?;
+        fixes += 1;
     }
-    let (e, p) = (
-        error(
-            &ekf,
-            track.steps.last().map_or(&track.start, |x| &x.1),
-            &imu,
-        ),
-        ekf.covariance,
-    );
+    Ok((ekf, imu))
+}
+
+/// Realization `index`, its errors, corrections and innovations at every fix normalized by its
+/// own covariances.
+///
+/// # Errors
+/// [`RealizationError`] when a covariance stops being positive definite.
+pub fn realization(
+    study: &Study,
+    track: &Track,
+    index: u64,
+) -> Result<Normalized, RealizationError> {
+    let mut out = Vec::with_capacity(track.steps.len() / study.imu_steps_per_fix);
+    let (ekf, imu) = filter_realization(study, track, index, |v| {
+        let bad = RealizationError::Covariance { index, fix: v.fix };
+        out.push(NormalizedFix::of(&v.input, v.fix).map_err(|_| bad)?);
+        Ok(())
+    })?;
+    let end = track.steps.last().map_or(&track.start, |x| &x.1);
+    let p = ekf.covariance;
     Ok(Normalized {
         fixes: out,
-        final_error: e,
+        final_error: error(&ekf, end, &imu),
         final_sigma: SVector::from_fn(|k, _| p[(k, k)].sqrt()),
     })
 }

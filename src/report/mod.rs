@@ -25,6 +25,7 @@ pub mod estimate;
 pub mod figures;
 pub mod findings;
 pub mod html;
+pub mod ins;
 pub mod json;
 pub mod kind;
 pub mod labels;

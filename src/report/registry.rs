@@ -9,7 +9,7 @@
 use super::kind::SectionKind;
 #[cfg(doc)]
 use super::kind::SectionView;
-use super::{drift, noise, real_drive, standard, static_noise};
+use super::{drift, ins, noise, real_drive, standard, static_noise};
 
 /// The sections of the report, in reading order (subsections of the results after the results).
 pub const SECTIONS: &[&dyn SectionKind] = &[
@@ -25,6 +25,7 @@ pub const SECTIONS: &[&dyn SectionKind] = &[
     &drift::Drift,
     &noise::Noise,
     &real_drive::RealDrive,
+    &ins::Ins,
     &standard::Conclusions,
     &standard::Appendix,
 ];

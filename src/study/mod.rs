@@ -10,6 +10,7 @@ pub mod correlated;
 pub mod drift;
 pub mod drive;
 pub mod identify;
+pub mod ins;
 pub mod noise;
 
 use crate::checks::{self, Budget, Verdicts};
@@ -105,6 +106,8 @@ pub struct Study {
     pub noise: Option<noise::NoiseStudy>,
     /// The white noise's identifiability on two drives, run with [`Study::with_noise`].
     pub white_noise: Option<identify::WhiteNoiseDrives>,
+    /// The three-axis study, when it was run ([`Study::with_ins`]).
+    pub ins: Option<ins::InsStudy>,
 }
 
 impl Study {
@@ -152,6 +155,7 @@ impl Study {
             real_drive: None,
             noise: None,
             white_noise: None,
+            ins: None,
         })
     }
 
@@ -175,6 +179,20 @@ impl Study {
     /// [`FilterError`] when a filter's covariance stops being positive definite.
     pub fn with_drift(mut self, progress: &mut dyn Progress) -> Result<Self, FilterError> {
         self.drift = drift::run(&self.model.config, progress)?;
+        Ok(self)
+    }
+
+    /// The study with the three-axis study of the default three-axis file ([`ins::run`],
+    /// [`ins::REPORT_REALIZATIONS`] realizations per ensemble).
+    ///
+    /// # Errors
+    /// [`crate::ins::ensemble::RealizationError`] when a filter's covariance breaks down.
+    pub fn with_ins(
+        mut self,
+        progress: &mut dyn Progress,
+    ) -> Result<Self, crate::ins::ensemble::RealizationError> {
+        let config = crate::config::ins::InsConfig::default();
+        self.ins = Some(ins::run(&config, ins::REPORT_REALIZATIONS, progress)?);
         Ok(self)
     }
 

@@ -1,0 +1,182 @@
+//! The three-axis study for the report: the default drive, one realization's biases and attitude
+//! errors against the truth, an ensemble judged by the check catalogue on each realization's own
+//! covariance, and negative controls — filters that are wrong in a known way — judged the same.
+
+use crate::checks::{Budget, Verdicts, evaluate};
+use crate::config::ins::InsConfig;
+use crate::ins::ensemble::{
+    self, Calibration, RealizationError, Track, constant_states, filter_realization,
+};
+use crate::ins::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS};
+use crate::ins::gnss::ned_difference_m;
+use crate::ins::setup::Study;
+use crate::progress::Progress;
+
+/// Realizations of each ensemble in the report.
+pub const REPORT_REALIZATIONS: u64 = 100;
+
+/// A filter wrong in a known way, and what the checks said of it.
+#[derive(Clone, Debug)]
+pub struct Control {
+    /// What is wrong, in words ("assumes half the gyro ARW").
+    pub what: &'static str,
+    /// The checks' verdicts on its ensemble.
+    pub verdicts: Verdicts,
+    /// The fixes' times, s (for the members' words).
+    pub times_s: Vec<f64>,
+}
+
+/// One realization at every fix: the six biases' estimates with their σ and truth, and the
+/// attitude errors with their σ, after the update.
+#[derive(Clone, Debug, Default)]
+pub struct Trace {
+    /// The fixes' times, s.
+    pub t_s: Vec<f64>,
+    /// Gyro x, y, z (rad/s) then accelerometer x, y, z (m/s²) bias estimates.
+    pub bias: Vec<[f64; 6]>,
+    /// Their σ's.
+    pub bias_sigma: Vec<[f64; 6]>,
+    /// The true biases.
+    pub bias_truth: Vec<[f64; 6]>,
+    /// Attitude errors about north, east, down, rad.
+    pub attitude_error: Vec<[f64; 3]>,
+    /// Their σ's.
+    pub attitude_sigma: Vec<[f64; 3]>,
+}
+
+/// The three-axis study.
+#[derive(Clone, Debug)]
+pub struct InsStudy {
+    /// Its configuration (the default three-axis file).
+    pub config: InsConfig,
+    /// Realizations of each ensemble.
+    pub realizations: u64,
+    /// The track every second: north, east (m from the start) and height (m).
+    pub track: Vec<[f64; 4]>,
+    /// Realization 0.
+    pub trace: Trace,
+    /// The consistent filter's verdicts.
+    pub verdicts: Verdicts,
+    /// The fixes' times, s.
+    pub times_s: Vec<f64>,
+    /// The calibration at the end of the drive.
+    pub calibration: Calibration,
+    /// The negative controls.
+    pub controls: Vec<Control>,
+}
+
+/// The verdicts and calibration of `realizations` realizations of `study`.
+fn judged(
+    study: &Study,
+    track: &Track,
+    realizations: u64,
+    progress: &mut dyn Progress,
+    label: &str,
+) -> Result<(Verdicts, Calibration, Vec<f64>), RealizationError> {
+    progress.start(label, realizations);
+    let sums = ensemble::sums(study, track, 0..realizations, |done| progress.advance(done))?;
+    progress.finish();
+    let stats = sums.normalized.stats(constant_states(study));
+    let verdicts = evaluate(&stats, &Budget::study(study.false_alarm_rate));
+    Ok((verdicts, sums.calibration(), sums.normalized.times_s))
+}
+
+/// Realization 0 of `study`, every fix.
+fn trace(study: &Study, track: &Track) -> Result<Trace, RealizationError> {
+    let mut t = Trace::default();
+    filter_realization(study, track, 0, |v| {
+        let p = &v.ekf.covariance;
+        let sigma = |k: usize| p[(k, k)].sqrt();
+        let (g, a) = (v.ekf.gyro_bias_rad_s, v.ekf.accel_bias_m_s2);
+        let (tg, ta) = (v.imu.gyro_bias_rad_s, v.imu.accel_bias_m_s2);
+        t.t_s.push(v.t_s);
+        t.bias.push([g.x, g.y, g.z, a.x, a.y, a.z]);
+        t.bias_truth.push([tg.x, tg.y, tg.z, ta.x, ta.y, ta.z]);
+        t.bias_sigma.push(std::array::from_fn(|i| {
+            sigma(if i < 3 {
+                GYRO_BIAS + i
+            } else {
+                ACCEL_BIAS + i - 3
+            })
+        }));
+        let e = &v.input.post.error;
+        t.attitude_error
+            .push(std::array::from_fn(|i| e[ATTITUDE + i]));
+        t.attitude_sigma
+            .push(std::array::from_fn(|i| sigma(ATTITUDE + i)));
+        Ok(())
+    })?;
+    Ok(t)
+}
+
+/// The default drive every second: north, east from the start and height, m, at time t.
+fn track_every_second(study: &Study, track: &Track) -> Vec<[f64; 4]> {
+    let per_s = study.imu_rate_hz.round() as usize;
+    let start = &track.start.position;
+    std::iter::once((0, &track.start))
+        .chain(track.steps.iter().enumerate().map(|(k, s)| (k + 1, &s.1)))
+        .filter(|(k, _)| k % per_s == 0)
+        .map(|(k, pva)| {
+            let d = ned_difference_m(&pva.position, start);
+            [
+                k as f64 / study.imu_rate_hz,
+                d.x,
+                d.y,
+                pva.position.height_m,
+            ]
+        })
+        .collect()
+}
+
+/// A negative control: what is wrong, and the edit of the file that makes it so.
+pub type ControlEdit = (&'static str, fn(&mut InsConfig));
+
+/// The negative controls: each edit of the default file and what it makes wrong.
+pub const CONTROLS: [ControlEdit; 3] = [
+    ("assumes half the gyros' angle random walk", |c| {
+        c.filter.gyro_arw_rad_per_sqrt_s = Some(c.imu.gyro_arw_rad_per_sqrt_s / 2.0);
+    }),
+    ("leaves the antenna's lever arm out", |c| {
+        c.filter.gnss_lever_arm_m = Some([0.0; 3]);
+    }),
+    ("starts with a 30° heading σ", |c| {
+        c.initial.yaw_sigma_deg = 30.0;
+    }),
+];
+
+/// Runs the three-axis study of `config` with `realizations` per ensemble.
+///
+/// # Errors
+/// [`RealizationError`] when a filter's covariance stops being positive definite.
+pub fn run(
+    config: &InsConfig,
+    realizations: u64,
+    progress: &mut dyn Progress,
+) -> Result<InsStudy, RealizationError> {
+    let study = Study::from_config(config).expect("a valid three-axis configuration");
+    let track = Track::of(&study);
+    let (verdicts, calibration, times_s) =
+        judged(&study, &track, realizations, progress, "3-axis")?;
+    let mut controls = Vec::new();
+    for (what, edit) in CONTROLS {
+        let mut c = config.clone();
+        edit(&mut c);
+        let s = Study::from_config(&c).expect("a valid control");
+        let (verdicts, _, times_s) = judged(&s, &track, realizations, progress, "control")?;
+        controls.push(Control {
+            what,
+            verdicts,
+            times_s,
+        });
+    }
+    Ok(InsStudy {
+        config: config.clone(),
+        realizations,
+        track: track_every_second(&study, &track),
+        trace: trace(&study, &track)?,
+        verdicts,
+        times_s,
+        calibration,
+        controls,
+    })
+}
