@@ -245,7 +245,7 @@ pub fn analyse(y: &[f64], tau0_s: f64, confidence: f64) -> Result<Analysis, Alla
     let departures = reading::departures(&points, &fit);
     let features = reading::features(&points, &departures, &fit);
     let (reading, terms) = if fit.goodness.rejected {
-        let read = reading::ieee952(&points, &terms, confidence);
+        let read = reading::ieee952(&points, &terms, y.len(), confidence);
         (Reading::Ieee952, read)
     } else {
         (Reading::Fit, fit.terms.clone())

@@ -7,6 +7,10 @@ use super::fit::{Fit, Term, TermEstimate, whisker_floor};
 use super::{AllanPoint, FitPoint};
 use crate::stats::{Tail, chi_squared_quantile};
 
+mod rate_walk;
+
+pub use rate_walk::{LineReading, Usable, rate_walk_line};
+
 /// Which reading the reported terms come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Reading {
@@ -167,19 +171,25 @@ fn unresolved(term: Term, upper: f64) -> TermEstimate {
 }
 
 /// The terms read off the curve (IEEE Std 952-1997, annex C, fig. C.2): B = σ_min/0.664 from the
-/// minimum; every other term from the line of its slope through the points whose local slope is
-/// within ¼ of it (left of the minimum for Q and N, right of it for K and R) and whose σ² is at
-/// least twice the minimum's — N read at τ = 1 s, K at τ = 3 s, i.e. θ = (σ²(τ) − σ²_min)/c(τ)
-/// averaged in log over those points, EDF-weighted (the floor σ²_min taken off each point so
-/// that the points near the minimum do not lift the asymptote).
-/// Intervals: χ² with the smallest EDF among the points a term comes from — the widest of
-/// their own intervals, a conservative choice: the points share their data, and their spread about
-/// the line is the misfit the reading ignores (with the largest EDF instead, K's interval covered
-/// 87 of 100 sinusoid logs, below the 95 % band; with the smallest, 96). A term with no such
-/// points is unresolved, bounded by the tightest upper whisker, and never below what a lower
-/// whisker demands given the other terms.
-pub fn ieee952(points: &[AllanPoint], terms: &[Term], confidence: f64) -> Vec<TermEstimate> {
-    let usable: Vec<(usize, &AllanPoint, f64, (f64, f64))> = points
+/// minimum; K by [`rate_walk_line`], the +½ line fitted to every point right of the minimum it
+/// dominates; every other term from the line of its slope through the points whose local slope
+/// is within ¼ of it (left of the minimum for Q and N, right of it for R) and whose σ² is at
+/// least twice the minimum's — N read at τ = 1 s, i.e. θ = (σ²(τ) − σ²_min)/c(τ) averaged in
+/// log over those points, EDF-weighted (the floor σ²_min taken off each point so that the points
+/// near the minimum do not lift the asymptote).
+/// Intervals of B, N, Q, R: χ² with the smallest EDF among the points a term comes from — the
+/// widest of their own intervals, a conservative choice: the points share their data, and their
+/// spread about the line is the misfit the reading ignores. A term with no such points is
+/// unresolved, bounded by the tightest upper whisker, and never below what a lower whisker
+/// demands given the other terms. `samples` is the log's length (for the correlation of the
+/// estimates across τ).
+pub fn ieee952(
+    points: &[AllanPoint],
+    terms: &[Term],
+    samples: usize,
+    confidence: f64,
+) -> Vec<TermEstimate> {
+    let usable: Vec<Usable> = points
         .iter()
         .enumerate()
         .filter_map(|(i, p)| Some((i, p, p.edf?, p.interval?)))
@@ -194,6 +204,13 @@ pub fn ieee952(points: &[AllanPoint], terms: &[Term], confidence: f64) -> Vec<Te
         .iter()
         .find(|u| u.0 == minimum)
         .map_or(0.0, |u| u.1.adev * u.1.adev);
+    let tightest_bound = |c: &dyn Fn(f64) -> f64| {
+        usable
+            .iter()
+            .map(|u| u.3.1 * u.3.1 / c(u.1.tau_s))
+            .fold(f64::INFINITY, f64::min)
+            .sqrt()
+    };
     let mut out: Vec<TermEstimate> = terms
         .iter()
         .map(|&term| {
@@ -206,32 +223,28 @@ pub fn ieee952(points: &[AllanPoint], terms: &[Term], confidence: f64) -> Vec<Te
                     None => unresolved(term, f64::INFINITY),
                 };
             }
-            let side = |i: usize| match term.slope() < 0.0 {
-                true => i < minimum,
-                false => i > minimum,
-            };
-            let chosen: Vec<_> = usable
-                .iter()
-                .filter(|u| side(u.0) && (slopes[u.0] - term.slope()).abs() <= 0.25)
-                .filter(|u| u.1.adev * u.1.adev >= 2.0 * floor)
-                .collect();
-            if chosen.is_empty() {
-                let bound = usable
-                    .iter()
-                    .map(|u| u.3.1 * u.3.1 / c(u.1.tau_s))
-                    .fold(f64::INFINITY, f64::min);
-                return unresolved(term, bound.sqrt());
+            if term == Term::AccelerationRandomWalk {
+                // Read below, once N is known.
+                return unresolved(term, f64::INFINITY);
             }
-            let weight: f64 = chosen.iter().map(|u| u.2).sum();
-            let log_theta: f64 = chosen
-                .iter()
-                .map(|u| u.2 * ((u.1.adev * u.1.adev - floor) / c(u.1.tau_s)).ln())
-                .sum::<f64>()
-                / weight;
-            let nu = chosen.iter().map(|u| u.2).fold(f64::INFINITY, f64::min);
-            read_term(term, log_theta.exp(), nu, confidence)
+            slope_reading(term, &usable, &slopes, minimum, floor, confidence)
+                .unwrap_or_else(|| unresolved(term, tightest_bound(&c)))
         })
         .collect();
+    let n_squared = out
+        .iter()
+        .find(|t| t.term == Term::VelocityRandomWalk && t.value.is_some())
+        .map_or(0.0, |t| t.squared);
+    if let Some(k) = out
+        .iter_mut()
+        .find(|t| t.term == Term::AccelerationRandomWalk)
+    {
+        let tau0_s = points[0].tau_s / points[0].m as f64;
+        *k = match rate_walk_line(&usable, minimum, n_squared, samples, tau0_s) {
+            Some(l) => line_term(k.term, l, confidence),
+            None => unresolved(k.term, tightest_bound(&|t| k.term.coefficient(t))),
+        };
+    }
     let fit_points: Vec<FitPoint> = usable
         .iter()
         .map(|u| FitPoint {
@@ -249,6 +262,55 @@ pub fn ieee952(points: &[AllanPoint], terms: &[Term], confidence: f64) -> Vec<Te
         }
     }
     out
+}
+
+/// The term of a line reading with its interval: the value √θ̂ and the scaled-χ² interval of
+/// ν = 2θ̂²/Var(θ̂) degrees of freedom (Satterthwaite 1946), as the fit's terms
+/// (`fit::term_interval`'s resolved branch) — a value whenever the curve shows the line, its
+/// interval as wide as the few degrees of freedom of the long τ make it.
+fn line_term(term: Term, l: LineReading, confidence: f64) -> TermEstimate {
+    let sigma = l.variance.max(0.0).sqrt();
+    let nu = 2.0 * l.theta * l.theta / l.variance;
+    TermEstimate {
+        squared_sigma: sigma,
+        squared_sigma_nominal: sigma,
+        ..read_term(term, l.theta, nu, confidence)
+    }
+}
+
+/// θ read on the line of `term`'s slope as IEEE 952 does (see [`ieee952`]): the EDF-weighted log
+/// mean of (σ̂² − floor)/c(τ) over the points on the term's side of the minimum whose local slope
+/// is within ¼ of the term's and whose σ̂² is at least twice the floor; χ² with their smallest
+/// EDF. `None` without such points.
+fn slope_reading(
+    term: Term,
+    usable: &[Usable],
+    slopes: &[f64],
+    minimum: usize,
+    floor: f64,
+    confidence: f64,
+) -> Option<TermEstimate> {
+    let side = |i: usize| match term.slope() < 0.0 {
+        true => i < minimum,
+        false => i > minimum,
+    };
+    let chosen: Vec<_> = usable
+        .iter()
+        .filter(|u| side(u.0) && (slopes[u.0] - term.slope()).abs() <= 0.25)
+        .filter(|u| u.1.adev * u.1.adev >= 2.0 * floor)
+        .collect();
+    if chosen.is_empty() {
+        return None;
+    }
+    let c = |tau: f64| term.coefficient(tau);
+    let weight: f64 = chosen.iter().map(|u| u.2).sum();
+    let log_theta: f64 = chosen
+        .iter()
+        .map(|u| u.2 * ((u.1.adev * u.1.adev - floor) / c(u.1.tau_s)).ln())
+        .sum::<f64>()
+        / weight;
+    let nu = chosen.iter().map(|u| u.2).fold(f64::INFINITY, f64::min);
+    Some(read_term(term, log_theta.exp(), nu, confidence))
 }
 
 /// The τ where the fitted curve leaves the estimates' intervals.
