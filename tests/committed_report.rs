@@ -35,7 +35,7 @@ fn diff(a: &Value, b: &Value, path: &str) -> Option<String> {
     }
 }
 
-/// The default study with its sensitivity, its drifting bias and its noise statistics, as `cargo run --release` writes it; run once.
+/// The default study with its sensitivity, its drifting bias, the three-axis study and its noise statistics, as `cargo run --release` writes it; run once.
 fn default_study() -> &'static Study {
     static STUDY: std::sync::OnceLock<Study> = std::sync::OnceLock::new();
     STUDY.get_or_init(|| {
@@ -44,6 +44,8 @@ fn default_study() -> &'static Study {
             .with_sensitivity(&mut Silent)
             .unwrap()
             .with_drift(&mut Silent)
+            .unwrap()
+            .with_ins(&mut Silent)
             .unwrap()
             .with_noise(accelcal::study::noise::NOISE_DRIVES, &mut Silent)
             .unwrap()
