@@ -51,3 +51,30 @@ pub fn process_noise(phi: &Matrix15, noise: &NoiseDensities, dt: f64) -> Matrix1
     // Symmetric to the last bit, as a covariance must be.
     (q + q.transpose()) * 0.5
 }
+
+/// Φ over an interval T of several IMU steps, F held at its mean over them: the matrix
+/// exponential to third order, Φ = I + A + A²/2 + A³/6 with A = F·T (Groves §3.2.3, eq. 3.34's
+/// power series). Third order because the longest chain of the error dynamics, δb_g → δψ → δv →
+/// δr, has three links: its leading term, −\[f^n×\]·C·T³/6 from δb_g into δr, is kept.
+pub fn transition_third_order(f: &Matrix15, t: f64) -> Matrix15 {
+    let a = f * t;
+    let a2 = a * a;
+    Matrix15::identity() + a + a2 * 0.5 + (a2 * a) * (1.0 / 6.0)
+}
+
+/// Q_d = ∫₀^T e^(Fs)·S·e^(Fᵀs) ds over an interval T, by the power series of Van Loan's integral
+/// (Van Loan 1978, eq. 1.3, expanded): Q_d = Σ_{k=0}^{4} M_k·T^(k+1)/(k+1)! with M₀ = S and
+/// M_k = F·M_(k−1) + M_(k−1)·Fᵀ. Four terms past S carry the angle random walk through
+/// δψ → δv → δr (its T⁵/20 term) and the velocity random walk into δr (T³/3).
+pub fn process_noise_series(f: &Matrix15, noise: &NoiseDensities, t: f64) -> Matrix15 {
+    let mut m = Matrix15::from_diagonal(&nalgebra::SVector::from(noise.diagonal()));
+    let mut factor = t;
+    let mut q = m * factor;
+    for k in 1..=4 {
+        let fm = f * m;
+        m = fm + fm.transpose();
+        factor *= t / (k + 1) as f64;
+        q += m * factor;
+    }
+    (q + q.transpose()) * 0.5
+}
