@@ -1,7 +1,8 @@
 //! The three-axis ensemble's speed on the default drive (600 s at 200 Hz, 600 fixes): one
 //! realization's time with the covariance propagated per covariance interval (what
 //! `ins::ensemble` runs) and per IMU step through dense 15×15 products (the reference), each the
-//! median of repeated runs with the minimum and maximum; what the sensors and the mechanization
+//! median of repeated runs with the minimum and maximum, in the thread's CPU time (the machine
+//! may be shared); what the sensors and the mechanization
 //! alone cost; and optionally a whole ensemble through `ins::ensemble::run`.
 //!
 //! Run with `cargo bench --bench ins` (options: `-- --realizations N --repeats R --ensemble M
@@ -37,16 +38,29 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-/// The median rate (realizations/s) of `once`, a run of `n` realizations, on one thread.
+/// This thread's CPU time, s: on a machine shared with other work, what a run cost rather than
+/// how long it waited.
+fn thread_cpu_s() -> f64 {
+    let mut t = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `t` is a valid timespec for the call to fill.
+    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) };
+    t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
+}
+
+/// The median rate (realizations per CPU second) of `once`, a run of `n` realizations, on one
+/// thread.
 fn measure(label: &str, repeats: usize, n: u64, mut once: impl FnMut(u64)) -> f64 {
     once(0);
     let mut rates: Vec<f64> = (0..repeats)
         .map(|r| {
-            let t = Instant::now();
+            let t = thread_cpu_s();
             for l in 0..n {
                 once(r as u64 * n + l);
             }
-            n as f64 / t.elapsed().as_secs_f64()
+            n as f64 / (thread_cpu_s() - t)
         })
         .collect();
     let lo = rates.iter().cloned().fold(f64::INFINITY, f64::min);
@@ -156,6 +170,7 @@ fn main() {
         let t = Instant::now();
         let sums = ensemble::run(&study, &track, m).unwrap();
         let run_s = t.elapsed().as_secs_f64();
+        // Wall time: the figure the ensemble's user waits for.
         println!(
             "ensemble of {m} on {} threads: {run_s:.1} s ({:.1} ms a realization), {} fixes",
             rayon::current_num_threads(),

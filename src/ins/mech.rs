@@ -52,8 +52,8 @@ fn nav_rate(p: &Geodetic, v: &Vector3<f64>) -> Vector3<f64> {
 /// `before` over the step before (on the first step, `now` again: exact for constant rates).
 pub fn step(pva: &Pva, before: &Increment, now: &Increment) -> Pva {
     let velocity = velocity_update(pva, before, now);
-    let position = position_update(pva, &velocity, now.dt_s);
-    let attitude = attitude_update(pva, &position, &velocity, before, now);
+    let (position, zeta) = position_update(pva, &velocity, now.dt_s);
+    let attitude = attitude_update(pva, &zeta, before, now);
     Pva {
         position,
         velocity_ned_m_s: velocity,
@@ -77,9 +77,11 @@ fn velocity_update(pva: &Pva, before: &Increment, now: &Increment) -> Vector3<f6
     let dv_nav = pva.attitude * (dv + rotation + sculling);
     let v0 = pva.velocity_ned_m_s;
     let increment = |p: &Geodetic, v: &Vector3<f64>| {
-        let zeta = nav_rate(p, v) * dt;
+        // ω_ie^n and ω_en^n once each for both the frame's turn and the Coriolis term.
+        let (w_ie, w_en) = (earth_rate_ned(p.lat_rad), transport_rate_ned(p, v));
+        let zeta = (w_ie + w_en) * dt;
         let specific = dv_nav - 0.5 * zeta.cross(&dv_nav);
-        let coriolis = (2.0 * earth_rate_ned(p.lat_rad) + transport_rate_ned(p, v)).cross(v);
+        let coriolis = (2.0 * w_ie + w_en).cross(v);
         specific + (gravity_ned(p) - coriolis) * dt
     };
     // The midpoint extrapolated with the frame rates at t_{k−1}, then the increment again there.
@@ -88,13 +90,14 @@ fn velocity_update(pva: &Pva, before: &Increment, now: &Increment) -> Vector3<f6
     v0 + increment(&p_mid, &v_mid)
 }
 
-/// The position at t_k from the mean velocity over the step.
+/// The position at t_k from the mean velocity over the step, and the navigation frame's turn
+/// ζ = ω_in^n·Δt over the step (at the midpoint, for the attitude update too).
 ///
 /// # Formula
 /// C_n^e(t_k) = C_e(k−1)^e(k)·C_n^e(t_{k−1})·C_n(k)^n(k−1): the Earth frame turned by −ω_ie·Δt
 /// about its z axis, the navigation frame by ζ = ω_in^n·Δt (the rates at the midpoint); h_k =
 /// h_{k−1} − v̄_D·Δt (Savage 1998 part 2, the position update; Shin 2005 §2.2).
-fn position_update(pva: &Pva, v_now: &Vector3<f64>, dt: f64) -> Geodetic {
+fn position_update(pva: &Pva, v_now: &Vector3<f64>, dt: f64) -> (Geodetic, Vector3<f64>) {
     let v_mean = 0.5 * (pva.velocity_ned_m_s + v_now);
     let p_mid = advance(&pva.position, &v_mean, 0.5 * dt);
     let zeta = nav_rate(&p_mid, &v_mean) * dt;
@@ -103,11 +106,12 @@ fn position_update(pva: &Pva, v_now: &Vector3<f64>, dt: f64) -> Geodetic {
         * UnitQuaternion::from_scaled_axis(zeta);
     q_ne.renormalize();
     let (lat_rad, lon_rad) = earth::lat_lon_of(&q_ne);
-    Geodetic {
+    let position = Geodetic {
         lat_rad,
         lon_rad,
         height_m: pva.position.height_m - v_mean.z * dt,
-    }
+    };
+    (position, zeta)
 }
 
 /// The attitude at t_k.
@@ -115,19 +119,16 @@ fn position_update(pva: &Pva, v_now: &Vector3<f64>, dt: f64) -> Geodetic {
 /// # Formula
 /// q_b^n(t_k) = q_n(k−1)^n(k) ⊗ q_b^n(t_{k−1}) ⊗ q_b(k)^b(k−1): the body turned by the rotation
 /// vector φ = Δθ_k + Δθ_{k−1} × Δθ_k/12 (two-sample coning for equal steps, Savage 1998 part 1),
-/// the navigation frame by −ω_in^n·Δt at the midpoint (Shin 2005 §2.2).
+/// the navigation frame by ζ = ω_in^n·Δt at the midpoint (Shin 2005 §2.2), the position
+/// update's: its midpoint and the mean velocity are the interval's, as Shin's recomputed ones.
 fn attitude_update(
     pva: &Pva,
-    p_now: &Geodetic,
-    v_now: &Vector3<f64>,
+    zeta: &Vector3<f64>,
     before: &Increment,
     now: &Increment,
 ) -> UnitQuaternion<f64> {
-    let p_mid = midpoint(&pva.position, p_now);
-    let v_mid = 0.5 * (pva.velocity_ned_m_s + v_now);
-    let zeta = nav_rate(&p_mid, &v_mid) * now.dt_s;
     let phi = now.dtheta_rad + before.dtheta_rad.cross(&now.dtheta_rad) / 12.0;
-    let mut q = UnitQuaternion::from_scaled_axis(-zeta)
+    let mut q = UnitQuaternion::from_scaled_axis(-*zeta)
         * pva.attitude
         * UnitQuaternion::from_scaled_axis(phi);
     q.renormalize();
@@ -146,20 +147,5 @@ fn advance(p: &Geodetic, v: &Vector3<f64>, dt: f64) -> Geodetic {
         lat_rad: p.lat_rad + r.x,
         lon_rad: p.lon_rad + r.y,
         height_m: p.height_m + r.z,
-    }
-}
-
-/// The midpoint of two nearby positions (longitude across ±π handled).
-fn midpoint(a: &Geodetic, b: &Geodetic) -> Geodetic {
-    let mut dlon = b.lon_rad - a.lon_rad;
-    if dlon > std::f64::consts::PI {
-        dlon -= std::f64::consts::TAU;
-    } else if dlon < -std::f64::consts::PI {
-        dlon += std::f64::consts::TAU;
-    }
-    Geodetic {
-        lat_rad: 0.5 * (a.lat_rad + b.lat_rad),
-        lon_rad: a.lon_rad + 0.5 * dlon,
-        height_m: 0.5 * (a.height_m + b.height_m),
     }
 }

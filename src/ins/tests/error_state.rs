@@ -371,3 +371,49 @@ fn interval_phi_and_q_match_van_loan_over_a_covariance_interval() {
         );
     }
 }
+
+#[test]
+fn the_block_sparse_products_equal_the_dense_ones() {
+    use crate::ins::discrete::{self, DYNAMICS_BLOCKS};
+    let (truth, f, _, decay) = scene();
+    let pva = Pva {
+        position: truth.p,
+        velocity_ned_m_s: truth.v,
+        attitude: UnitQuaternion::from_rotation_matrix(
+            &nalgebra::Rotation3::from_matrix_unchecked(truth.c),
+        ),
+    };
+    let big_f = error_state::dynamics(&pva, &(f - truth.ba), &decay);
+    // F holds nothing outside the pattern.
+    for (r, row) in (0..STATES).step_by(3).enumerate() {
+        for column in (0..STATES).step_by(3) {
+            let listed = DYNAMICS_BLOCKS[r].1.contains(&column);
+            let block = big_f.fixed_view::<3, 3>(row, column).norm();
+            assert!(
+                listed || block == 0.0,
+                "F({row}, {column}) outside the pattern"
+            );
+        }
+    }
+    let x = Matrix15::from_fn(|i, j| ((i * 7 + j * 3) % 11) as f64 - 5.0);
+    let p = x * x.transpose() + Matrix15::identity();
+    let close = |a: &Matrix15, b: &Matrix15| (a - b).norm() <= 1e-13 * b.norm();
+    assert!(close(&discrete::dynamics_times(&big_f, &x), &(big_f * x)));
+    let phi = discrete::transition_third_order(&big_f, 0.2);
+    let dense = Matrix15::identity()
+        + big_f * 0.2
+        + (big_f * 0.2).pow(2) / 2.0
+        + (big_f * 0.2).pow(3) / 6.0;
+    assert!(close(&phi, &dense));
+    assert!(close(
+        &discrete::transition_congruence(&phi, &p),
+        &(phi * p * phi.transpose())
+    ));
+    // Negative control: a block outside the pattern is not multiplied.
+    let mut outside = big_f;
+    outside.fixed_view_mut::<3, 3>(0, ATTITUDE).fill(1.0);
+    assert!(!close(
+        &discrete::dynamics_times(&outside, &x),
+        &(outside * x)
+    ));
+}
