@@ -65,7 +65,8 @@ pub enum Propagation {
 }
 
 /// The covariance interval [`Ekf::new`] takes: 0.2 s (40 steps at 200 Hz), 5 intervals per fix
-/// at 1 Hz. P at every fix of the default drive stays within 1.4·10⁻³ (whitened Frobenius) of the
+/// at 1 Hz (at most: the largest divisor of the steps between fixes; before the first fix, each
+/// step). P at every fix of the default drive stays within 1.4·10⁻³ (whitened Frobenius) of the
 /// per-step reference, a third of the bound `tests/propagation.rs` derives.
 pub const DEFAULT_COVARIANCE_INTERVAL_S: f64 = 0.2;
 
@@ -97,8 +98,9 @@ pub struct Ekf {
     /// The accelerometer bias estimate, m/s².
     pub accel_bias_m_s2: Vector3<f64>,
     /// The error state's covariance P: current after each update and after the step that ends a
-    /// covariance interval (with [`Propagation::Interval`], a fix falls on an interval's end when
-    /// the interval divides the time between fixes; [`Ekf::flush`] brings it up to date).
+    /// covariance interval. With [`Propagation::Interval`] the intervals divide the time between
+    /// the last two fixes, so with evenly spaced fixes P is current at each; [`Ekf::flush`]
+    /// brings it up to date anywhere.
     pub covariance: Matrix15,
     /// The noise densities the filter assumes.
     pub noise: NoiseDensities,
@@ -110,6 +112,10 @@ pub struct Ekf {
     propagation: Propagation,
     /// The steps not yet in P.
     pending: Option<Pending>,
+    /// IMU steps since the last update.
+    steps_since_update: usize,
+    /// IMU steps between the last two updates (from the start for the first).
+    fix_period_steps: Option<usize>,
     /// The previous step's compensated increments (for sculling and coning).
     before: Option<Increment>,
 }
@@ -136,6 +142,8 @@ impl Ekf {
                 interval_s: DEFAULT_COVARIANCE_INTERVAL_S,
             },
             pending: None,
+            steps_since_update: 0,
+            fix_period_steps: None,
             before: None,
         }
     }
@@ -178,6 +186,7 @@ impl Ekf {
         self.gyro_bias_rad_s *= (-self.decay.gyro_per_s * now.dt_s).exp();
         self.accel_bias_m_s2 *= (-self.decay.accel_per_s * now.dt_s).exp();
         self.before = Some(now);
+        self.steps_since_update += 1;
         if self.pending.as_ref().is_some_and(|p| p.steps == p.target) {
             self.flush();
         }
@@ -186,9 +195,16 @@ impl Ekf {
     /// The step from the solution now with specific force `f_b` over `dt` added to the interval.
     fn gather(&mut self, f_b: &Vector3<f64>, dt: f64, interval_s: f64) {
         let c = *self.pva.attitude.to_rotation_matrix().matrix();
+        let nominal = ((interval_s / dt).round() as usize).max(1);
+        // Intervals that tile the time between fixes, so that a fix ends one and P is current
+        // when it is read before the update: the largest divisor of the fix period up to the
+        // nominal interval; one step until the first fix has shown the period.
+        let target = self.fix_period_steps.map_or(1, |m| {
+            (1..=nominal.min(m)).rev().find(|d| m % d == 0).unwrap_or(1)
+        });
         let pending = self.pending.get_or_insert_with(|| Pending {
             steps: 0,
-            target: ((interval_s / dt).round() as usize).max(1),
+            target,
             t_s: 0.0,
             c_sum: Matrix3::zeros(),
             f_n_sum: Vector3::zeros(),
@@ -224,6 +240,8 @@ impl Ekf {
     /// [`FilterError::Innovation`] when S is not positive definite.
     pub fn update(&mut self, fix: &Fix) -> Result<Innovation, FilterError> {
         self.flush();
+        self.fix_period_steps = Some(self.steps_since_update);
+        self.steps_since_update = 0;
         let omega = self
             .before
             .map_or(Vector3::zeros(), |b| b.dtheta_rad / b.dt_s);

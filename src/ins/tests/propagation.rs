@@ -94,3 +94,58 @@ fn p_at_every_fix_stays_within_the_bound_of_the_per_step_reference() {
         "the bound missed a 1 s interval: {per_fix:e}"
     );
 }
+
+/// At every fix of `duration_s` of the drive with fixes at `gnss_rate_hz`: whether P before the
+/// update was current (flushing it changes nothing), and whether P `offset` steps after each fix
+/// was.
+fn current_at_fixes(gnss_rate_hz: f64, offset: usize) -> (bool, bool) {
+    let mut c = InsConfig::default();
+    c.drive.duration_s = 20.0;
+    c.gnss.gnss_rate_hz = gnss_rate_hz;
+    let study = Study::from_config(&c).unwrap();
+    let track = Track::of(&study);
+    let drive = study.drive();
+    let mut imu = study.imu(0);
+    let g = &study.filter_gnss;
+    let mut ekf = Ekf::new(
+        track.start,
+        study.prior(),
+        study.filter_noise(),
+        study.filter_decay(),
+        g.lever_arm_b_m,
+    );
+    let (mut at_fix, mut after) = (true, true);
+    let current = |ekf: &Ekf| {
+        let mut flushed = ekf.clone();
+        flushed.flush();
+        flushed.covariance == ekf.covariance
+    };
+    let per_fix = study.imu_steps_per_fix;
+    for (k, (inc, pva)) in track.steps.iter().enumerate() {
+        ekf.propagate(&imu.read(inc));
+        if (k + 1) % per_fix == offset && k + 1 > per_fix {
+            after &= current(&ekf);
+        }
+        if (k + 1) % per_fix != 0 {
+            continue;
+        }
+        at_fix &= current(&ekf);
+        let t = (k + 1) as f64 / study.imu_rate_hz;
+        ekf.update(&fix(&study, &drive, &mut imu, t, pva)).unwrap();
+    }
+    (at_fix, after)
+}
+
+#[test]
+fn p_is_current_at_every_fix_whatever_the_gnss_rate() {
+    // 200, 100, 25 and 8 IMU steps between fixes: intervals of 40, 25, 25 and 8 steps.
+    for rate in [1.0, 2.0, 8.0, 25.0] {
+        assert!(current_at_fixes(rate, 0).0, "P stale at a {rate} Hz fix");
+    }
+    // Negative control: 7 steps after a 1 Hz fix an interval is pending, and flushing it
+    // changes P.
+    assert!(
+        !current_at_fixes(1.0, 7).1,
+        "the comparison missed a pending interval"
+    );
+}
