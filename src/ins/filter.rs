@@ -195,16 +195,19 @@ impl Ekf {
     /// The step from the solution now with specific force `f_b` over `dt` added to the interval.
     fn gather(&mut self, f_b: &Vector3<f64>, dt: f64, interval_s: f64) {
         let c = *self.pva.attitude.to_rotation_matrix().matrix();
-        let nominal = ((interval_s / dt).round() as usize).max(1);
+        let period = self.fix_period_steps;
         // Intervals that tile the time between fixes, so that a fix ends one and P is current
         // when it is read before the update: the largest divisor of the fix period up to the
         // nominal interval; one step until the first fix has shown the period.
-        let target = self.fix_period_steps.map_or(1, |m| {
-            (1..=nominal.min(m)).rev().find(|d| m % d == 0).unwrap_or(1)
-        });
+        let target = || {
+            let nominal = ((interval_s / dt).round() as usize).max(1);
+            period.map_or(1, |m| {
+                (1..=nominal.min(m)).rev().find(|d| m % d == 0).unwrap_or(1)
+            })
+        };
         let pending = self.pending.get_or_insert_with(|| Pending {
             steps: 0,
-            target,
+            target: target(),
             t_s: 0.0,
             c_sum: Matrix3::zeros(),
             f_n_sum: Vector3::zeros(),
