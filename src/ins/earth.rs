@@ -44,7 +44,11 @@ pub struct Geodetic {
 /// # Formula
 /// R_N = a(1 − e²)/(1 − e² sin²L)^{3/2}, R_E = a/√(1 − e² sin²L) (Groves eqs. 2.105, 2.106).
 pub fn radii_m(lat_rad: f64) -> (f64, f64) {
-    let s = lat_rad.sin();
+    radii_of_sin(lat_rad.sin())
+}
+
+/// [`radii_m`] from sin L.
+fn radii_of_sin(s: f64) -> (f64, f64) {
     let w2 = 1.0 - ECCENTRICITY_SQUARED * s * s;
     let w = w2.sqrt();
     let transverse = SEMI_MAJOR_AXIS_M / w;
@@ -62,11 +66,14 @@ pub fn radii_m(lat_rad: f64) -> (f64, f64) {
 /// (about 8·10⁻⁹·h·sin 2L m/s², Groves ch. 2) is left out, as in Shin (2005) and KF-GINS; the
 /// simulated truth uses this same field, so the mechanization's tests are exact.
 pub fn normal_gravity_m_s2(p: &Geodetic) -> f64 {
-    let s2 = p.lat_rad.sin().powi(2);
+    gravity_of_sin2(p.lat_rad.sin().powi(2), p.height_m)
+}
+
+/// [`normal_gravity_m_s2`] from sin²L and h.
+fn gravity_of_sin2(s2: f64, h: f64) -> f64 {
     let gamma0 =
         GRAVITY_EQUATOR_M_S2 * (1.0 + SOMIGLIANA_K * s2) / (1.0 - ECCENTRICITY_SQUARED * s2).sqrt();
     let a = SEMI_MAJOR_AXIS_M;
-    let h = p.height_m;
     gamma0
         * (1.0 - 2.0 / a * (1.0 + FLATTENING + GRAVITY_RATIO_M - 2.0 * FLATTENING * s2) * h
             + 3.0 * h * h / (a * a))
@@ -82,11 +89,12 @@ pub fn gravity_ned(p: &Geodetic) -> Vector3<f64> {
 /// # Formula
 /// ω_ie^n = ω_ie (cos L, 0, −sin L) (Groves ch. 2, the Earth rate in local-navigation axes).
 pub fn earth_rate_ned(lat_rad: f64) -> Vector3<f64> {
-    Vector3::new(
-        ROTATION_RATE_RAD_S * lat_rad.cos(),
-        0.0,
-        -ROTATION_RATE_RAD_S * lat_rad.sin(),
-    )
+    earth_rate_of(lat_rad.sin(), lat_rad.cos())
+}
+
+/// [`earth_rate_ned`] from sin L and cos L.
+fn earth_rate_of(s: f64, c: f64) -> Vector3<f64> {
+    Vector3::new(ROTATION_RATE_RAD_S * c, 0.0, -ROTATION_RATE_RAD_S * s)
 }
 
 /// The transport rate ω_en^n: how fast the NED frame turns over the curved Earth as the vehicle
@@ -97,11 +105,12 @@ pub fn earth_rate_ned(lat_rad: f64) -> Vector3<f64> {
 pub fn transport_rate_ned(p: &Geodetic, v_ned: &Vector3<f64>) -> Vector3<f64> {
     let (rn, re) = radii_m(p.lat_rad);
     let h = p.height_m;
-    Vector3::new(
-        v_ned.y / (re + h),
-        -v_ned.x / (rn + h),
-        -v_ned.y * p.lat_rad.tan() / (re + h),
-    )
+    transport_rate_of(rn + h, re + h, p.lat_rad.tan(), v_ned)
+}
+
+/// [`transport_rate_ned`] from R_N + h, R_E + h and tan L.
+fn transport_rate_of(rn_h: f64, re_h: f64, tan: f64, v_ned: &Vector3<f64>) -> Vector3<f64> {
+    Vector3::new(v_ned.y / re_h, -v_ned.x / rn_h, -v_ned.y * tan / re_h)
 }
 
 /// `p` moved by `d_ned_m` metres north, east and down (first order in d/R: the lever arm, a
@@ -123,11 +132,63 @@ pub fn offset(p: &Geodetic, d_ned_m: &Vector3<f64>) -> Geodetic {
 pub fn geodetic_rate(p: &Geodetic, v_ned: &Vector3<f64>) -> Vector3<f64> {
     let (rn, re) = radii_m(p.lat_rad);
     let h = p.height_m;
-    Vector3::new(
-        v_ned.x / (rn + h),
-        v_ned.y / ((re + h) * p.lat_rad.cos()),
-        -v_ned.z,
-    )
+    geodetic_rate_of(rn + h, re + h, p.lat_rad.cos(), v_ned)
+}
+
+/// [`geodetic_rate`] from R_N + h, R_E + h and cos L.
+fn geodetic_rate_of(rn_h: f64, re_h: f64, c: f64, v_ned: &Vector3<f64>) -> Vector3<f64> {
+    Vector3::new(v_ned.x / rn_h, v_ned.y / (re_h * c), -v_ned.z)
+}
+
+/// The Earth at one point, from one sine and cosine of its latitude: what the free functions
+/// give ([`earth_rate_ned`], [`transport_rate_ned`], [`geodetic_rate`], [`gravity_ned`]), by
+/// the same formulas, for a caller that asks several of them at a point (the mechanization asks
+/// them at three points a step).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Local {
+    sin_lat: f64,
+    cos_lat: f64,
+    /// R_N + h, m.
+    rn_h: f64,
+    /// R_E + h, m.
+    re_h: f64,
+    /// Normal gravity γ, m/s².
+    gravity_m_s2: f64,
+}
+
+impl Local {
+    /// The Earth at `p`.
+    pub fn at(p: &Geodetic) -> Self {
+        let (s, c) = p.lat_rad.sin_cos();
+        let (rn, re) = radii_of_sin(s);
+        Local {
+            sin_lat: s,
+            cos_lat: c,
+            rn_h: rn + p.height_m,
+            re_h: re + p.height_m,
+            gravity_m_s2: gravity_of_sin2(s * s, p.height_m),
+        }
+    }
+
+    /// ω_ie^n, rad/s.
+    pub fn earth_rate_ned(&self) -> Vector3<f64> {
+        earth_rate_of(self.sin_lat, self.cos_lat)
+    }
+
+    /// ω_en^n for a velocity `v_ned`, rad/s.
+    pub fn transport_rate_ned(&self, v_ned: &Vector3<f64>) -> Vector3<f64> {
+        transport_rate_of(self.rn_h, self.re_h, self.sin_lat / self.cos_lat, v_ned)
+    }
+
+    /// (dL/dt, dλ/dt, dh/dt) for a velocity `v_ned`.
+    pub fn geodetic_rate(&self, v_ned: &Vector3<f64>) -> Vector3<f64> {
+        geodetic_rate_of(self.rn_h, self.re_h, self.cos_lat, v_ned)
+    }
+
+    /// Normal gravity in NED, m/s².
+    pub fn gravity_ned(&self) -> Vector3<f64> {
+        Vector3::new(0.0, 0.0, self.gravity_m_s2)
+    }
 }
 
 /// The attitude of the NED frame at `p` with respect to the Earth-fixed (ECEF) frame, q_n^e:

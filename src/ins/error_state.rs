@@ -105,9 +105,22 @@ fn rate_jacobians(p: &Geodetic, v: &Vector3<f64>) -> RateJacobians {
 /// The error dynamics F at the navigation solution `pva` with the compensated specific force
 /// `f_b` (body axes, m/s²).
 pub fn dynamics(pva: &Pva, f_b: &Vector3<f64>, decay: &BiasDecay) -> Matrix15 {
+    let c = *pva.attitude.to_rotation_matrix().matrix();
+    dynamics_with(pva, &c, &(c * f_b), decay)
+}
+
+/// F with the attitude's blocks from `c` (C_b^n) and the specific force's from `f_n` (NED):
+/// F's entries are linear in C_b^n and f^n, so F averaged over several IMU steps is this with
+/// their means (Groves §14.2.4's blocks; the position- and velocity-dependent ones from `pva`).
+pub fn dynamics_with(
+    pva: &Pva,
+    c: &Matrix3<f64>,
+    f_n: &Vector3<f64>,
+    decay: &BiasDecay,
+) -> Matrix15 {
+    let c = *c;
     let p = &pva.position;
     let v = pva.velocity_ned_m_s;
-    let c = *pva.attitude.to_rotation_matrix().matrix();
     let (rn0, re0) = earth::radii_m(p.lat_rad);
     let (drn, dre) = earth::radii_rate_m_per_rad(p.lat_rad);
     let (rn, re) = (rn0 + p.height_m, re0 + p.height_m);
@@ -132,7 +145,6 @@ pub fn dynamics(pva: &Pva, f_b: &Vector3<f64>, decay: &BiasDecay) -> Matrix15 {
     let (dg_dlat, dg_dh) = earth::gravity_gradient(p);
     let gravity_p = Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, dg_dlat, 0.0, dg_dh);
     let sv = skew(&v);
-    let f_n = c * f_b;
 
     let mut f = Matrix15::zeros();
     let mut set = |row: usize, col: usize, m: Matrix3<f64>| {
@@ -147,7 +159,7 @@ pub fn dynamics(pva: &Pva, f_b: &Vector3<f64>, decay: &BiasDecay) -> Matrix15 {
     // v̇ = C f + g − Ω × v with Ω = 2ω_ie + ω_en: −Ω × v = [v×]Ω.
     set(VELOCITY, POSITION, (gravity_p + sv * j.coriolis_p) * t_inv);
     set(VELOCITY, VELOCITY, -skew(&coriolis) + sv * j.nav_rate_v);
-    set(VELOCITY, ATTITUDE, -skew(&f_n));
+    set(VELOCITY, ATTITUDE, -skew(f_n));
     set(VELOCITY, ACCEL_BIAS, -c);
     // δψ̇ = C δω_ib^b − δω_in^n − ω_in^n × δψ (Groves §14.2.4).
     set(ATTITUDE, POSITION, -j.nav_rate_p * t_inv);

@@ -97,10 +97,40 @@ pub struct ImuModel {
     pub accel_bias: BiasProcess,
 }
 
+/// What one step of a given length draws with: the white noises' σ's and the biases' (φ, σ_η),
+/// computed once for the IMU's step rather than at every step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct StepScales {
+    /// The step, s.
+    dt_s: f64,
+    /// ARW·√Δt, rad.
+    angle_sigma: f64,
+    /// VRW·√Δt, m/s.
+    velocity_sigma: f64,
+    /// The gyro biases' (φ, σ_η).
+    gyro_bias: (f64, f64),
+    /// The accelerometer biases' (φ, σ_η).
+    accel_bias: (f64, f64),
+}
+
+impl StepScales {
+    fn of(model: &ImuModel, dt: f64) -> Self {
+        StepScales {
+            dt_s: dt,
+            angle_sigma: model.gyro_arw_rad_per_sqrt_s * dt.sqrt(),
+            velocity_sigma: model.accel_vrw_m_s_per_sqrt_s * dt.sqrt(),
+            gyro_bias: model.gyro_bias.step(dt),
+            accel_bias: model.accel_bias.step(dt),
+        }
+    }
+}
+
 /// One realization's IMU: its random stream and its biases now.
 pub struct Imu {
     model: ImuModel,
     stream: Stream,
+    /// The last step's scales.
+    scales: Option<StepScales>,
     /// The gyro biases now, rad/s.
     pub gyro_bias_rad_s: Vector3<f64>,
     /// The accelerometer biases now, m/s².
@@ -119,6 +149,7 @@ impl Imu {
         Imu {
             model,
             stream,
+            scales: None,
             gyro_bias_rad_s,
             accel_bias_m_s2,
         }
@@ -127,16 +158,19 @@ impl Imu {
     /// What the IMU outputs for the true increments `truth` (its biases then step on).
     pub fn read(&mut self, truth: &Increment) -> Increment {
         let dt = truth.dt_s;
+        let k = match self.scales {
+            Some(k) if k.dt_s == dt => k,
+            _ => *self.scales.insert(StepScales::of(&self.model, dt)),
+        };
         let s = &mut self.stream;
-        let arw = self.model.gyro_arw_rad_per_sqrt_s * dt.sqrt();
-        let vrw = self.model.accel_vrw_m_s_per_sqrt_s * dt.sqrt();
+        let (arw, vrw) = (k.angle_sigma, k.velocity_sigma);
         let dtheta = truth.dtheta_rad
             + self.gyro_bias_rad_s * dt
             + Vector3::from_fn(|_, _| arw * s.normal());
         let dvel =
             truth.dvel_m_s + self.accel_bias_m_s2 * dt + Vector3::from_fn(|_, _| vrw * s.normal());
-        let (phi_g, eta_g) = self.model.gyro_bias.step(dt);
-        let (phi_a, eta_a) = self.model.accel_bias.step(dt);
+        let (phi_g, eta_g) = k.gyro_bias;
+        let (phi_a, eta_a) = k.accel_bias;
         self.gyro_bias_rad_s =
             self.gyro_bias_rad_s * phi_g + Vector3::from_fn(|_, _| eta_g * s.normal());
         self.accel_bias_m_s2 =

@@ -307,3 +307,113 @@ fn h_is_the_jacobian_of_the_antenna_s_position_and_velocity() {
         "the comparison missed the lever arm: {missed:e}"
     );
 }
+
+#[test]
+fn interval_phi_and_q_match_van_loan_over_a_covariance_interval() {
+    use crate::ins::discrete::{self, NoiseDensities};
+    use crate::ins::filter::DEFAULT_COVARIANCE_INTERVAL_S;
+    let (truth, f, _, decay) = scene();
+    let pva = Pva {
+        position: truth.p,
+        velocity_ned_m_s: truth.v,
+        attitude: UnitQuaternion::from_rotation_matrix(
+            &nalgebra::Rotation3::from_matrix_unchecked(truth.c),
+        ),
+    };
+    let big_f = error_state::dynamics(&pva, &(f - truth.ba), &decay);
+    let noise = NoiseDensities {
+        accel_vrw_m_s_per_sqrt_s: 0.1 / 60.0,
+        gyro_arw_rad_per_sqrt_s: 0.1_f64.to_radians() / 60.0,
+        gyro_bias_density: 2.0 * (50.0_f64 / 3600.0).to_radians().powi(2) / 3600.0,
+        accel_bias_density: 2.0 * (0.25e-3 * 9.8_f64).powi(2) / 1800.0,
+    };
+    let s = Matrix15::from_diagonal(&nalgebra::SVector::from(noise.diagonal()));
+    for t in [
+        DEFAULT_COVARIANCE_INTERVAL_S,
+        2.0 * DEFAULT_COVARIANCE_INTERVAL_S,
+    ] {
+        let (phi_exact, q_exact) = van_loan(&big_f, &s, t);
+        let phi = discrete::transition_third_order(&big_f, t);
+        let q = discrete::process_noise_series(&big_f, &noise, t);
+        // Remainders, A = FT, a = ‖A‖: Φ's, Σ_(k≥4) A^k/k!, is at most ‖A⁴‖e^a/24; Q_d's,
+        // Σ_(k≥5) M_k·T^(k+1)/(k+1)! with ‖M_(k+1)‖ ≤ 2‖F‖‖M_k‖, at most ‖M₅‖T⁶e^(2a)/720.
+        let a_mat = big_f * t;
+        let a = a_mat.norm();
+        let a2 = a_mat * a_mat;
+        let phi_bound = (a2 * a2).norm() * a.exp() / 24.0;
+        let mut m = s;
+        for _ in 0..5 {
+            let fm = big_f * m;
+            m = fm + fm.transpose();
+        }
+        let q_bound = m.norm() * t.powi(6) * (2.0 * a).exp() / 720.0 / q_exact.norm();
+        // Measured at 0.1 s: ‖FT‖ = 1.4, Φ 1.8·10⁻⁸ against 7.5·10⁻⁸ (second order: 2.3·10⁻³),
+        // Q_d 1.8·10⁻¹⁰ against 3.1·10⁻⁹ (the trapezoid: 1.7·10⁻³).
+        let phi_error = (phi - phi_exact).norm();
+        let q_error = (q - q_exact).norm() / q_exact.norm();
+        assert!(
+            phi_error <= phi_bound,
+            "Φ {phi_error:e} beyond {phi_bound:e}"
+        );
+        assert!(q_error <= q_bound, "Q_d {q_error:e} beyond {q_bound:e}");
+        // Negative controls: the second-order Φ and the trapezoidal Q_d over the interval.
+        let second = discrete::transition(&big_f, t);
+        let second_error = (second - phi_exact).norm();
+        assert!(
+            second_error > phi_bound,
+            "second order passed: {second_error:e}"
+        );
+        let trapezoid = discrete::process_noise(&phi, &noise, t);
+        let trapezoid_error = (trapezoid - q_exact).norm() / q_exact.norm();
+        assert!(
+            trapezoid_error > q_bound,
+            "the trapezoid passed: {trapezoid_error:e}"
+        );
+    }
+}
+
+#[test]
+fn the_block_sparse_products_equal_the_dense_ones() {
+    use crate::ins::discrete::{self, DYNAMICS_BLOCKS};
+    let (truth, f, _, decay) = scene();
+    let pva = Pva {
+        position: truth.p,
+        velocity_ned_m_s: truth.v,
+        attitude: UnitQuaternion::from_rotation_matrix(
+            &nalgebra::Rotation3::from_matrix_unchecked(truth.c),
+        ),
+    };
+    let big_f = error_state::dynamics(&pva, &(f - truth.ba), &decay);
+    // F holds nothing outside the pattern.
+    for (r, row) in (0..STATES).step_by(3).enumerate() {
+        for column in (0..STATES).step_by(3) {
+            let listed = DYNAMICS_BLOCKS[r].1.contains(&column);
+            let block = big_f.fixed_view::<3, 3>(row, column).norm();
+            assert!(
+                listed || block == 0.0,
+                "F({row}, {column}) outside the pattern"
+            );
+        }
+    }
+    let x = Matrix15::from_fn(|i, j| ((i * 7 + j * 3) % 11) as f64 - 5.0);
+    let p = x * x.transpose() + Matrix15::identity();
+    let close = |a: &Matrix15, b: &Matrix15| (a - b).norm() <= 1e-13 * b.norm();
+    assert!(close(&discrete::dynamics_times(&big_f, &x), &(big_f * x)));
+    let phi = discrete::transition_third_order(&big_f, 0.2);
+    let dense = Matrix15::identity()
+        + big_f * 0.2
+        + (big_f * 0.2).pow(2) / 2.0
+        + (big_f * 0.2).pow(3) / 6.0;
+    assert!(close(&phi, &dense));
+    assert!(close(
+        &discrete::transition_congruence(&phi, &p),
+        &(phi * p * phi.transpose())
+    ));
+    // Negative control: a block outside the pattern is not multiplied.
+    let mut outside = big_f;
+    outside.fixed_view_mut::<3, 3>(0, ATTITUDE).fill(1.0);
+    assert!(!close(
+        &discrete::dynamics_times(&outside, &x),
+        &(outside * x)
+    ));
+}

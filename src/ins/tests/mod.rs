@@ -5,3 +5,4 @@ mod ensemble;
 mod error_state;
 mod logs;
 mod mechanization;
+mod propagation;
