@@ -115,7 +115,8 @@ fn panel(area: &Area<'_>, s: &TraceSeries<'_>, bottom: bool) -> Result<(), super
     let (lo, hi) = extent(all).unwrap_or((-1.0, 1.0));
     let pad = 0.05 * (hi - lo).max(f64::MIN_POSITIVE);
     let t = extent(s.t_s.iter().copied()).unwrap_or((0.0, 1.0));
-    let y = Axis::linear("", s.unit, (lo - pad, hi + pad), 5);
+    let name = if s.truth.is_some() { "bias" } else { "error" };
+    let y = Axis::linear(name, s.unit, (lo - pad, hi + pad), 5);
     let x = Axis::linear("time", "s", (0.0, t.1), 4);
     let y_area = y_label_area(&[&y]);
     let p = Panel::new(area, &s.title, x, y, Layout::titled(y_area, bottom))?;
