@@ -38,7 +38,7 @@ const LINE_PASSES: usize = 6;
 /// θ̂ = Σ g_i σ̂²_i + const (the minimum's g = −Σ_j g_j), so Var(θ̂) = gᵀΣg with Σ_ij =
 /// ρ_ij √(V_i V_j), V_i = 2σ⁴_i/edf_i and ρ the correlation of the exact covariance of the
 /// estimates for white rate noise at the minimum's level and a rate random walk of θ̂
-/// ([`super::covariance`]); N̂'s own error is left out (its points have EDFs in the thousands).
+/// ([`crate::allan::covariance`]); N̂'s own error is left out (its points have EDFs in the thousands).
 /// `None` when no point right of the minimum rises above the floor.
 pub fn rate_walk_line(
     usable: &[Usable],
