@@ -154,11 +154,19 @@ pub struct Local {
     re_h: f64,
     /// Normal gravity γ, m/s².
     gravity_m_s2: f64,
+    /// The Earth's rotation rate this point turns with, rad/s: [`ROTATION_RATE_RAD_S`], or 0
+    /// for a mechanization that leaves it out (a negative control).
+    rotation_rad_s: f64,
 }
 
 impl Local {
     /// The Earth at `p`.
     pub fn at(p: &Geodetic) -> Self {
+        Self::rotating_at(p, ROTATION_RATE_RAD_S)
+    }
+
+    /// The Earth at `p`, turning at `rotation_rad_s` (0: a non-rotating Earth).
+    pub fn rotating_at(p: &Geodetic, rotation_rad_s: f64) -> Self {
         let (s, c) = p.lat_rad.sin_cos();
         let (rn, re) = radii_of_sin(s);
         Local {
@@ -167,12 +175,19 @@ impl Local {
             rn_h: rn + p.height_m,
             re_h: re + p.height_m,
             gravity_m_s2: gravity_of_sin2(s * s, p.height_m),
+            rotation_rad_s,
         }
     }
 
-    /// ω_ie^n, rad/s.
+    /// The rotation rate this point turns with, rad/s.
+    pub fn rotation_rad_s(&self) -> f64 {
+        self.rotation_rad_s
+    }
+
+    /// ω_ie^n, rad/s (Groves eq. 5.41).
     pub fn earth_rate_ned(&self) -> Vector3<f64> {
-        earth_rate_of(self.sin_lat, self.cos_lat)
+        let w = self.rotation_rad_s;
+        Vector3::new(w * self.cos_lat, 0.0, -w * self.sin_lat)
     }
 
     /// ω_en^n for a velocity `v_ned`, rad/s.

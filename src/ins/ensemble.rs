@@ -210,7 +210,8 @@ pub fn filter_realization(
         study.filter_noise(),
         study.filter_decay(),
         g.lever_arm_b_m,
-    );
+    )
+    .with_earth_rotation(study.filter_earth_rotation_rad_s);
     let filter = |source| RealizationError::Filter { index, source };
     let mut fixes = 0;
     for (k, (inc, pva)) in track.steps.iter().enumerate() {

@@ -64,13 +64,12 @@ struct RateJacobians {
 /// With R_n = R_N + h, R_e = R_E + h, ω = ω_ie: ω_in^n = (ω cos L + v_E/R_e, −v_N/R_n,
 /// −ω sin L − v_E tan L/R_e) (Groves §5.4), differentiated term by term; the radii's rates from
 /// [`earth::radii_rate_m_per_rad`].
-fn rate_jacobians(p: &Geodetic, v: &Vector3<f64>) -> RateJacobians {
+fn rate_jacobians(p: &Geodetic, v: &Vector3<f64>, w: f64) -> RateJacobians {
     let (rn0, re0) = earth::radii_m(p.lat_rad);
     let (drn, dre) = earth::radii_rate_m_per_rad(p.lat_rad);
     let (rn, re) = (rn0 + p.height_m, re0 + p.height_m);
     let (sl, cl) = p.lat_rad.sin_cos();
     let tl = sl / cl;
-    let w = earth::ROTATION_RATE_RAD_S;
     let (vn, ve) = (v.x, v.y);
     // Transport rate ω_en^n = (v_E/R_e, −v_N/R_n, −v_E tan L/R_e) by L and h.
     let en_lat = Vector3::new(
@@ -118,6 +117,18 @@ pub fn dynamics_with(
     f_n: &Vector3<f64>,
     decay: &BiasDecay,
 ) -> Matrix15 {
+    dynamics_rotating(pva, c, f_n, decay, earth::ROTATION_RATE_RAD_S)
+}
+
+/// [`dynamics_with`] on an Earth turning at `rotation_rad_s` (0: the error dynamics of a
+/// mechanization that leaves the Earth's rate out).
+pub fn dynamics_rotating(
+    pva: &Pva,
+    c: &Matrix3<f64>,
+    f_n: &Vector3<f64>,
+    decay: &BiasDecay,
+    rotation_rad_s: f64,
+) -> Matrix15 {
     let c = *c;
     let p = &pva.position;
     let v = pva.velocity_ned_m_s;
@@ -125,7 +136,7 @@ pub fn dynamics_with(
     let (drn, dre) = earth::radii_rate_m_per_rad(p.lat_rad);
     let (rn, re) = (rn0 + p.height_m, re0 + p.height_m);
     let (sl, cl) = p.lat_rad.sin_cos();
-    let j = rate_jacobians(p, &v);
+    let j = rate_jacobians(p, &v, rotation_rad_s);
 
     // NED metres from curvilinear errors: δr = T·δp, and T's rate along the solution.
     let t = Matrix3::from_diagonal(&Vector3::new(rn, re * cl, -1.0));
@@ -138,7 +149,8 @@ pub fn dynamics_with(
         0.0,
     ));
 
-    let w_ie = earth::earth_rate_ned(p.lat_rad);
+    // Scaled by exactly 1 on the rotating Earth: the same bits as the free function.
+    let w_ie = earth::earth_rate_ned(p.lat_rad) * (rotation_rad_s / earth::ROTATION_RATE_RAD_S);
     let w_en = earth::transport_rate_ned(p, &v);
     let w_in = w_ie + w_en;
     let coriolis = 2.0 * w_ie + w_en;

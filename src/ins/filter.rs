@@ -108,6 +108,9 @@ pub struct Ekf {
     pub decay: BiasDecay,
     /// The antenna's lever arm in body axes, m.
     pub lever_arm_b_m: Vector3<f64>,
+    /// The Earth's rotation rate the mechanization and F use, rad/s (0 in the negative control
+    /// of a filter that leaves it out).
+    pub earth_rotation_rad_s: f64,
     /// How the covariance is propagated.
     propagation: Propagation,
     /// The steps not yet in P.
@@ -138,6 +141,7 @@ impl Ekf {
             noise,
             decay,
             lever_arm_b_m,
+            earth_rotation_rad_s: super::earth::ROTATION_RATE_RAD_S,
             propagation: Propagation::Interval {
                 interval_s: DEFAULT_COVARIANCE_INTERVAL_S,
             },
@@ -153,6 +157,15 @@ impl Ekf {
     pub fn with_propagation(mut self, propagation: Propagation) -> Self {
         self.flush();
         self.propagation = propagation;
+        self
+    }
+
+    /// The same filter on an Earth turning at `rotation_rad_s` (0: it leaves the Earth's rate
+    /// out of its mechanization and of F).
+    #[must_use]
+    pub fn with_earth_rotation(mut self, rotation_rad_s: f64) -> Self {
+        self.flush();
+        self.earth_rotation_rad_s = rotation_rad_s;
         self
     }
 
@@ -175,14 +188,21 @@ impl Ekf {
         let f_b = now.dvel_m_s / now.dt_s;
         match self.propagation {
             Propagation::Dense => {
-                let big_f = error_state::dynamics(&self.pva, &f_b, &self.decay);
+                let c = *self.pva.attitude.to_rotation_matrix().matrix();
+                let big_f = error_state::dynamics_rotating(
+                    &self.pva,
+                    &c,
+                    &(c * f_b),
+                    &self.decay,
+                    self.earth_rotation_rad_s,
+                );
                 let phi = discrete::transition(&big_f, now.dt_s);
                 let q = discrete::process_noise(&phi, &self.noise, now.dt_s);
                 self.covariance = phi * self.covariance * phi.transpose() + q;
             }
             Propagation::Interval { interval_s } => self.gather(&f_b, now.dt_s, interval_s),
         }
-        self.pva = mech::step(&self.pva, &before, &now);
+        self.pva = mech::step_rotating(&self.pva, &before, &now, self.earth_rotation_rad_s);
         self.gyro_bias_rad_s *= (-self.decay.gyro_per_s * now.dt_s).exp();
         self.accel_bias_m_s2 *= (-self.decay.accel_per_s * now.dt_s).exp();
         self.before = Some(now);
@@ -229,8 +249,13 @@ impl Ekf {
             return;
         };
         let n = p.steps as f64;
-        let big_f =
-            error_state::dynamics_with(&p.middle, &(p.c_sum / n), &(p.f_n_sum / n), &self.decay);
+        let big_f = error_state::dynamics_rotating(
+            &p.middle,
+            &(p.c_sum / n),
+            &(p.f_n_sum / n),
+            &self.decay,
+            self.earth_rotation_rad_s,
+        );
         let phi = discrete::transition_third_order(&big_f, p.t_s);
         let q = discrete::process_noise_series(&big_f, &self.noise, p.t_s);
         self.covariance = discrete::transition_congruence(&phi, &self.covariance) + q;

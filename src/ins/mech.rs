@@ -49,8 +49,14 @@ fn nav_rate(e: &Local, v: &Vector3<f64>) -> Vector3<f64> {
 /// One mechanization step from `pva` at t_{k−1} with the increments `now` over [t_{k−1}, t_k] and
 /// `before` over the step before (on the first step, `now` again: exact for constant rates).
 pub fn step(pva: &Pva, before: &Increment, now: &Increment) -> Pva {
+    step_rotating(pva, before, now, earth::ROTATION_RATE_RAD_S)
+}
+
+/// [`step`] on an Earth turning at `rotation_rad_s` (0: a mechanization that leaves the Earth's
+/// rate out, the negative control of a filter that forgets it).
+pub fn step_rotating(pva: &Pva, before: &Increment, now: &Increment, rotation_rad_s: f64) -> Pva {
     // The Earth at t_{k−1}'s position, for the velocity's and the position's first evaluation.
-    let start = Local::at(&pva.position);
+    let start = Local::rotating_at(&pva.position, rotation_rad_s);
     let velocity = velocity_update(pva, &start, before, now);
     let (position, zeta) = position_update(pva, &start, &velocity, now.dt_s);
     let attitude = attitude_update(pva, &zeta, before, now);
@@ -87,7 +93,7 @@ fn velocity_update(pva: &Pva, start: &Local, before: &Increment, now: &Increment
     // The midpoint extrapolated with the frame rates at t_{k−1}, then the increment again there.
     let v_mid = v0 + 0.5 * increment(start, &v0);
     let p_mid = advance(&pva.position, start, &v_mid, 0.5 * dt);
-    v0 + increment(&Local::at(&p_mid), &v_mid)
+    v0 + increment(&Local::rotating_at(&p_mid, start.rotation_rad_s()), &v_mid)
 }
 
 /// The position at t_k from the mean velocity over the step, and the navigation frame's turn
@@ -105,8 +111,9 @@ fn position_update(
 ) -> (Geodetic, Vector3<f64>) {
     let v_mean = 0.5 * (pva.velocity_ned_m_s + v_now);
     let p_mid = advance(&pva.position, start, &v_mean, 0.5 * dt);
-    let zeta = nav_rate(&Local::at(&p_mid), &v_mean) * dt;
-    let mut q_ne = earth_turn(-dt)
+    let w = start.rotation_rad_s();
+    let zeta = nav_rate(&Local::rotating_at(&p_mid, w), &v_mean) * dt;
+    let mut q_ne = earth_turn(-dt, w)
         * nav_to_earth(pva.position.lat_rad, pva.position.lon_rad)
         * rotation(&zeta);
     q_ne.renormalize();
@@ -139,8 +146,8 @@ fn attitude_update(
 }
 
 /// The Earth frame's turn over `dt` seconds about its z axis, as C_e(t)^e(t+dt) for dt < 0.
-fn earth_turn(dt: f64) -> UnitQuaternion<f64> {
-    rotation(&Vector3::new(0.0, 0.0, earth::ROTATION_RATE_RAD_S * dt))
+fn earth_turn(dt: f64, rotation_rad_s: f64) -> UnitQuaternion<f64> {
+    rotation(&Vector3::new(0.0, 0.0, rotation_rad_s * dt))
 }
 
 /// The largest (θ/2)² [`rotation`] takes by its series: θ = 10⁻² rad, where the first term left

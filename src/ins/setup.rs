@@ -52,6 +52,9 @@ pub struct Study {
     pub false_alarm_rate: f64,
     /// Largest lag of the residual whiteness check, in fixes (`None`: the default rule).
     pub residual_max_lag: Option<usize>,
+    /// The Earth's rotation rate the filter's mechanization uses, rad/s: the true one, or 0 in
+    /// the negative control of a filter that leaves it out.
+    pub filter_earth_rotation_rad_s: f64,
 }
 
 /// A sensor triad's bias process from its configured model.
@@ -122,6 +125,7 @@ impl Study {
             realizations: c.ensemble.realizations,
             false_alarm_rate: c.checks.false_alarm_rate,
             residual_max_lag: c.checks.residual_max_lag.map(|l| l as usize),
+            filter_earth_rotation_rad_s: super::earth::ROTATION_RATE_RAD_S,
         })
     }
 

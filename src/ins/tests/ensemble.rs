@@ -74,3 +74,18 @@ fn a_consistent_filter_passes_and_one_without_its_lever_arm_fails() {
         "the lever arm's absence went unseen"
     );
 }
+
+#[test]
+fn a_filter_that_leaves_the_earth_rate_out_fails() {
+    // The missing ω_ie (12 °/h about the body axes as the car turns) and Coriolis term (about
+    // 0.2 mg at 15 m/s) look like biases that change with heading: over the whole drive the
+    // filter cannot absorb them.
+    let mut s = study(600.0, |_| {});
+    s.filter_earth_rotation_rad_s = 0.0;
+    let v = verdicts(&s, 48);
+    let failed: Vec<_> = v.failed().map(|c| c.definition.title).collect();
+    assert!(
+        failed.contains(&"NEES"),
+        "the Earth's rate went unseen: {failed:?}"
+    );
+}
