@@ -77,7 +77,11 @@ pub fn read_imu_log(source: &dyn LogSource) -> Result<ImuSamples, LogError> {
             source.name(),
             1,
             LogProblem::MissingColumn {
-                column: if has_time { Channel::Ax.column() } else { "t_s" },
+                column: if has_time {
+                    Channel::Ax.column()
+                } else {
+                    "t_s"
+                },
                 found: echo(header.trim()),
                 header: expected_header(),
             },
