@@ -299,8 +299,15 @@ fn bias_keys(imu: &ImuAnalysis, sensor: Sensor, prefix: &str, unit: &str, k_unit
             .map(|c| &c.analysis);
         let tau_b = a.map_or(f64::NAN, correlation_time_s);
         let sigma_b = b.value / GAUSS_MARKOV_PEAK_RATIO;
+        // The three-axis study accepts τ_b from 1 s (config::ins::validate).
+        let short = if tau_b < 1.0 {
+            "# τ_b is below the 1 s the study accepts: the minimum is a vibration's, not a bias's\n\
+             # (is the log static?); the study refuses this file until it is set.\n"
+        } else {
+            ""
+        };
         format!(
-            "# B = {} {} on {} dominates: a Gauss–Markov bias, σ_b = B/{GAUSS_MARKOV_PEAK_RATIO}, τ_b = τ_min/1.89.\n\
+            "# B = {} {} on {} dominates: a Gauss–Markov bias, σ_b = B/{GAUSS_MARKOV_PEAK_RATIO}, τ_b = τ_min/1.89.\n{short}\
              {prefix}_bias_model = \"gauss_markov\"\n{prefix}_bias_sigma_{unit} = {}\n\
              {prefix}_bias_correlation_time_s = {}\n",
             sig(b.value, 4),
