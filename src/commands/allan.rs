@@ -128,7 +128,17 @@ fn run_imu(args: &AllanArgs, path: &std::path::Path) -> Result<()> {
     all.extend(axis_files.iter().map(String::as_str));
     accelcal::output::check_directory(&args.out, &all)?;
     note("reading the log…");
-    let log = read_imu_log(&LogFile::new(path))?;
+    let log = if imu::bag::is_recording(path) {
+        imu::bag::read_recording(path, args.topic.as_deref())?
+    } else if args.topic.is_some() {
+        return Err(super::logs::UsageError(format!(
+            "--topic names a topic of an MCAP file or a ROS 2 bag; {} is read as CSV",
+            path.display()
+        ))
+        .into());
+    } else {
+        read_imu_log(&LogFile::new(path))?
+    };
     note("computing the Allan deviation and fitting the noise terms of every channel…");
     let a = imu::analyse_imu(&log, args.confidence).with_context(|| path.display().to_string())?;
     let name = path.display().to_string();
@@ -139,7 +149,7 @@ fn run_imu(args: &AllanArgs, path: &std::path::Path) -> Result<()> {
         args.out.display()
     );
     let mut files: Vec<(String, String)> = vec![
-        (JSON_FILE.to_string(), imu::export::allan_json(&a, &name)),
+        (JSON_FILE.to_string(), imu::export::allan_json(&a)),
         (TOML_FILE.to_string(), imu::export::noise_toml(&a, &name)),
         (YAML_FILE.to_string(), imu::export::imu_yaml(&a, &name)),
         (

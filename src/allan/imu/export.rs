@@ -57,10 +57,11 @@ fn largest_record(l: &Largest) -> Value {
     })
 }
 
-/// `allan.json` of the IMU: `channels` (each channel's record, [`channel_record`]) and
+/// `allan.json` of the IMU (without the log's name, so that a bag, its MCAP and its CSV export
+/// give the same bytes): `channels` (each channel's record, [`channel_record`]) and
 /// `sensors` (per sensor, each term's largest value across its axes, the axis it comes from,
 /// whether it is an upper bound, and that axis's reading).
-pub fn allan_json(imu: &ImuAnalysis, source: &str) -> String {
+pub fn allan_json(imu: &ImuAnalysis) -> String {
     let channels: Map<String, Value> = imu
         .channels
         .iter()
@@ -87,7 +88,6 @@ pub fn allan_json(imu: &ImuAnalysis, source: &str) -> String {
         sensors.insert(sensor.key().to_string(), Value::Object(s));
     }
     let record = json!({
-        "source": source,
         "samples": imu.samples,
         "sample_period_s": imu.sample_period_s,
         "confidence": imu.confidence,

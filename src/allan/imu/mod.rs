@@ -8,8 +8,9 @@
 //! random walk (rad/s/√s) (IEEE Std 952-1997, annex C; the accelerometer's names are those of
 //! IEEE Std 1293-2018).
 //!
-//! [`read`] reads the log; [`export`] writes its files.
+//! [`read`] reads a CSV log, [`bag`] an MCAP file or a ROS 2 bag; [`export`] writes the files.
 
+pub mod bag;
 pub mod export;
 pub mod read;
 
