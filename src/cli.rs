@@ -364,7 +364,7 @@ pub struct AllanArgs {
     pub accel: Option<PathBuf>,
     /// A static six-channel IMU log: CSV with t_s and any of ax_m_s2, ay_m_s2, az_m_s2,
     /// gx_rad_s, gy_rad_s, gz_rad_s; an MCAP file or a ROS 2 bag directory (storage mcap) of
-    /// sensor_msgs/msg/Imu. Every channel analysed.
+    /// sensor_msgs/msg/Imu, or a ROS 1 bag of sensor_msgs/Imu. Every channel analysed.
     #[arg(long, value_name = "FILE", conflicts_with = "column")]
     pub imu: Option<PathBuf>,
     /// The IMU topic of an MCAP file or ROS 2 bag (with --imu; needed when it has several).

@@ -10,6 +10,8 @@ rosbags:
   frame id (another CDR alignment) and a second Imu topic /imu2;
 - imu.csv: its CSV export, t_s = (sec - sec0) + nanosec * 1e-9 and every value as repr writes it
   (shortest round trip);
+- imu.bag, imu_lz4.bag, imu_bz2.bag: ROS 1 bags of the same messages written by rosbags (plain,
+  lz4 and bz2 chunks), topic /imu and /temperature;
 - nan.mcap (a NaN in angular_velocity.y of message 7), back.mcap (message 9's stamp before
   message 8's) and other.mcap (a Temperature topic alone).
 """
@@ -19,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 from mcap.writer import CompressionType, Writer as McapWriter
+from rosbags.rosbag1 import Writer as Bag1Writer
 from rosbags.rosbag2 import StoragePlugin, Writer as BagWriter
 from rosbags.typesys import Stores, get_typestore
 
@@ -117,6 +120,38 @@ def write_mcap(path, stamps, acc, gyr, topics=("/imu", "/imu2"), temperature=Fal
         w.finish()
 
 
+def write_bag1(path, stamps, acc, gyr, compression=None):
+    ts = get_typestore(Stores.ROS1_NOETIC)
+    t = ts.types
+    w = Bag1Writer(path)
+    if compression is not None:
+        w.set_compression(compression)
+    with w:
+        imu = w.add_connection("/imu", IMU, typestore=ts)
+        temp = w.add_connection("/temperature", TEMPERATURE, typestore=ts)
+        for i, s in enumerate(stamps):
+            header = t["std_msgs/msg/Header"](
+                seq=i,
+                stamp=t["builtin_interfaces/msg/Time"](sec=s[0], nanosec=s[1]),
+                frame_id="imu_link",
+            )
+            msg = t[IMU](
+                header=header,
+                orientation=t["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
+                orientation_covariance=np.zeros(9),
+                angular_velocity=t["geometry_msgs/msg/Vector3"](x=gyr[i][0], y=gyr[i][1], z=gyr[i][2]),
+                angular_velocity_covariance=np.zeros(9),
+                linear_acceleration=t["geometry_msgs/msg/Vector3"](
+                    x=acc[i][0], y=acc[i][1], z=acc[i][2]
+                ),
+                linear_acceleration_covariance=np.zeros(9),
+            )
+            w.write(imu, nanoseconds(s), bytes(ts.serialize_ros1(msg, IMU)))
+            if i % 100 == 0:
+                tmsg = t[TEMPERATURE](header=header, temperature=25.0, variance=0.0)
+                w.write(temp, nanoseconds(s), bytes(ts.serialize_ros1(tmsg, TEMPERATURE)))
+
+
 def write_csv(path, stamps, acc, gyr):
     lines = ["t_s,ax_m_s2,ay_m_s2,az_m_s2,gx_rad_s,gy_rad_s,gz_rad_s"]
     sec0 = stamps[0][0]
@@ -134,6 +169,9 @@ def main():
     write_bag(out / "bag", stamps, acc, gyr)
     write_mcap(out / "imu.mcap", stamps, acc, gyr, temperature=True)
     write_csv(out / "imu.csv", stamps, acc, gyr)
+    write_bag1(out / "imu.bag", stamps, acc, gyr)
+    write_bag1(out / "imu_lz4.bag", stamps, acc, gyr, Bag1Writer.CompressionFormat.LZ4)
+    write_bag1(out / "imu_bz2.bag", stamps[:50], acc, gyr, Bag1Writer.CompressionFormat.BZ2)
     bad = gyr.copy()
     bad[7, 1] = float("nan")
     write_mcap(out / "nan.mcap", stamps[:50], acc, bad, topics=("/imu",))

@@ -1,8 +1,8 @@
-//! `accelcal allan --imu` on ROS 2 recordings made by the ROS tools' own Python packages
-//! (`tests/allan_imu_bag.py`: rosbags writes the bag and the CDR, mcap the MCAP file): a ROS 2
-//! bag directory with MCAP storage, an MCAP file (lz4 chunks, two Imu topics with another frame
-//! id, hence another CDR alignment) and the CSV export of the same messages give the same
-//! allan.json byte for byte; bad containers and messages exit with 2 naming the file, the topic
+//! `accelcal allan --imu` on ROS recordings made by the ROS tools' own Python packages
+//! (`tests/allan_imu_bag.py`: rosbags writes the bags and the messages, mcap the MCAP file): a
+//! ROS 2 bag directory with MCAP storage, an MCAP file (lz4 chunks, two Imu topics with another
+//! frame id, hence another CDR alignment), ROS 1 bags (plain and lz4 chunks) and the CSV export
+//! of the same messages give the same allan.json byte for byte; bad containers and messages exit with 2 naming the file, the topic
 //! and the message.
 //!
 //! The packages come from PyPI: `.ci/run` installs `mcap` and `rosbags` into its virtual
@@ -96,6 +96,7 @@ fn a_bag_its_mcap_and_its_csv_give_the_same_allan_json() {
         "the bag and the MCAP file differ"
     );
     assert!(bag == csv, "the bag and its CSV export differ");
+    ros1_bags(d, &csv);
     let json: serde_json::Value = serde_json::from_slice(&bag).unwrap();
     assert_eq!(json["samples"], 20_000);
     assert_eq!(json["channels"].as_object().unwrap().len(), 6);
@@ -130,6 +131,75 @@ fn a_bag_its_mcap_and_its_csv_give_the_same_allan_json() {
     );
 
     bad_containers_are_refused(d);
+    mutations_never_panic(d);
+}
+
+/// Bytes of the MCAP file and the ROS 1 bag changed at random (a byte flipped, a stretch cut
+/// out, the end cut off; 24 each from a fixed seed): every run ends with 0 or 2, never a panic.
+fn mutations_never_panic(d: &Path) {
+    let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut next = |n: usize| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % n as u64) as usize
+    };
+    for name in ["imu.mcap", "imu.bag"] {
+        let bytes = std::fs::read(d.join(name)).unwrap();
+        for k in 0..24 {
+            let mut b = bytes.clone();
+            let at = next(b.len());
+            match k % 3 {
+                0 => b[at] ^= 1 << next(8),
+                1 => {
+                    let len = next(4096).min(b.len() - at);
+                    b.drain(at..at + len);
+                }
+                _ => b.truncate(at),
+            }
+            let path = d.join(format!("mutated-{k}-{name}"));
+            std::fs::write(&path, &b).unwrap();
+            let out = d.join(format!("m-{k}-{name}"));
+            let o = allan(&[
+                "--imu",
+                path.to_str().unwrap(),
+                "--topic",
+                "/imu",
+                "--out",
+                out.to_str().unwrap(),
+                "-q",
+            ]);
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert!(
+                matches!(o.status.code(), Some(0 | 2)) && !err.contains("panicked"),
+                "{name} mutation {k} at byte {at}: {:?} {err}",
+                o.status.code()
+            );
+        }
+    }
+}
+
+/// ROS 1 bags of the same messages (plain and lz4 chunks) give the CSV's allan.json; bz2 chunks
+/// and a truncated bag are refused with the byte offset of the record.
+fn ros1_bags(d: &Path, csv: &[u8]) {
+    for bag in ["imu.bag", "imu_lz4.bag"] {
+        let json = allan_json(&d.join(bag), None, &d.join(format!("o-{bag}")));
+        assert!(json == csv, "{bag} and the CSV export differ");
+    }
+    refused(
+        &d.join("imu_bz2.bag"),
+        None,
+        &[
+            "imu_bz2.bag",
+            "the chunk at byte",
+            "bz2",
+            "expected none or lz4",
+        ],
+    );
+    let bytes = std::fs::read(d.join("imu.bag")).unwrap();
+    let truncated = d.join("truncated.bag");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
+    refused(&truncated, None, &["truncated.bag", "byte", "cut short"]);
 }
 
 /// Containers the mcap crate refuses (truncated, a chunk whose CRC does not match, an unknown

@@ -101,17 +101,26 @@ pub fn decode_imu(data: &[u8]) -> Result<ImuMessage, String> {
 
 /// The messages of every `Imu` topic of one recording, and every topic's type.
 #[derive(Default)]
-struct Topics {
-    imu: BTreeMap<String, Vec<ImuMessage>>,
-    types: BTreeMap<String, String>,
+pub(super) struct Topics {
+    /// Each `Imu` topic's messages in the recording's order.
+    pub imu: BTreeMap<String, Vec<ImuMessage>>,
+    /// Every topic's type.
+    pub types: BTreeMap<String, String>,
 }
 
-fn unreadable(file: &str, message: String) -> LogError {
+pub(super) fn unreadable(file: &str, message: String) -> LogError {
     LogError::of_file(file, LogProblem::Unreadable { message })
 }
 
-/// Reads the messages of one MCAP file into `topics`.
+/// The longest record the MCAP reader accepts, bytes: a corrupt length then is an error, where
+/// `mcap::MessageStream` (0.26, no limit) panics on a length near 2⁶⁴.
+const RECORD_LIMIT: usize = 1 << 30;
+
+/// Reads the messages of one MCAP file into `topics`: the `mcap` crate's linear reader (chunks
+/// decompressed, their CRCs checked, records no longer than [`RECORD_LIMIT`]).
 fn read_mcap(path: &Path, topics: &mut Topics) -> Result<(), LogError> {
+    use mcap::records::Record;
+    use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| unreadable(&file, e.to_string()))?;
     if !bytes.starts_with(MCAP_MAGIC) {
@@ -120,30 +129,61 @@ fn read_mcap(path: &Path, topics: &mut Topics) -> Result<(), LogError> {
             "expected an MCAP file (its magic bytes)".into(),
         ));
     }
-    // Chunk CRCs are checked (a CRC of 0 means the writer left it out, as the format allows).
-    let stream = mcap::MessageStream::new_with_options(
-        &bytes,
-        mcap::read::Options::ValidateChunkCrcs.into(),
-    )
-    .map_err(|e| unreadable(&file, format!("not a readable MCAP file: {e}")))?;
-    for (index, message) in stream.enumerate() {
-        let m = message
-            .map_err(|e| unreadable(&file, format!("MCAP message {index} cannot be read: {e}")))?;
-        let c = &m.channel;
-        let kind = c.schema.as_ref().map_or("(no schema)", |s| s.name.as_str());
-        topics
-            .types
-            .entry(c.topic.clone())
-            .or_insert_with(|| kind.to_string());
-        if kind != IMU_TYPE {
-            continue;
+    let mut reader = LinearReader::new_with_options(
+        LinearReaderOptions::default()
+            .with_validate_chunk_crcs(true)
+            .with_record_length_limit(RECORD_LIMIT),
+    );
+    let mut rest = bytes.as_slice();
+    let mut schemas: BTreeMap<u16, String> = BTreeMap::new();
+    let mut channels: BTreeMap<u16, (String, String)> = BTreeMap::new();
+    let mut index = 0usize;
+    let broken = |index: usize, e: &dyn std::fmt::Display| {
+        unreadable(
+            &file,
+            format!("not a readable MCAP file at message {index}: {e}"),
+        )
+    };
+    while let Some(event) = reader.next_event() {
+        let (opcode, data) = match event.map_err(|e| broken(index, &e))? {
+            LinearReadEvent::ReadRequest(need) => {
+                let len = need.min(rest.len());
+                reader.insert(len).copy_from_slice(&rest[..len]);
+                reader.notify_read(len);
+                rest = &rest[len..];
+                continue;
+            }
+            LinearReadEvent::Record { opcode, data } => (opcode, data),
+        };
+        match mcap::parse_record(opcode, data).map_err(|e| broken(index, &e))? {
+            Record::Schema { header, .. } => {
+                schemas.insert(header.id, header.name);
+            }
+            Record::Channel(c) => {
+                let kind = schemas
+                    .get(&c.schema_id)
+                    .cloned()
+                    .unwrap_or_else(|| "(no schema)".to_string());
+                topics.types.entry(c.topic.clone()).or_insert(kind.clone());
+                channels.insert(c.id, (c.topic, kind));
+            }
+            Record::Message { header, data } => {
+                index += 1;
+                let Some((topic, kind)) = channels.get(&header.channel_id) else {
+                    let e = format!("channel {} is not defined before it", header.channel_id);
+                    return Err(broken(index - 1, &e));
+                };
+                if kind != IMU_TYPE {
+                    continue;
+                }
+                let list = topics.imu.entry(topic.clone()).or_default();
+                let decoded = decode_imu(&data).map_err(|e| {
+                    unreadable(&format!("{file}, topic {topic}, message {}", list.len()), e)
+                })?;
+                list.push(decoded);
+            }
+            _ => {}
         }
-        let list = topics.imu.entry(c.topic.clone()).or_default();
-        let decoded = decode_imu(&m.data).map_err(|e| {
-            let at = format!("{file}, topic {}, message {}", c.topic, list.len());
-            unreadable(&at, e)
-        })?;
-        list.push(decoded);
     }
     Ok(())
 }
@@ -191,13 +231,16 @@ pub fn is_recording(path: &Path) -> bool {
     if !std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
         return false;
     }
+    if super::rosbag1::is_ros1(path) {
+        return true;
+    }
     let mut head = [0u8; 8];
     std::fs::File::open(path)
         .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
         .is_ok_and(|()| head == MCAP_MAGIC)
 }
 
-/// Reads the IMU of the MCAP file or ROS 2 bag directory `path`: the one `Imu` topic, or
+/// Reads the IMU of the MCAP file, ROS 2 bag directory or ROS 1 bag `path`: the one `Imu` topic, or
 /// `topic` when given (needed when there are several).
 ///
 /// # Errors
@@ -214,8 +257,17 @@ pub fn read_recording(path: &Path, topic: Option<&str>) -> Result<ImuSamples, Lo
     };
     let mut topics = Topics::default();
     for f in &files {
-        read_mcap(f, &mut topics)?;
+        if f.is_file() && super::rosbag1::is_ros1(f) {
+            super::rosbag1::read_ros1(f, &mut topics)?;
+        } else {
+            read_mcap(f, &mut topics)?;
+        }
     }
+    let imu_type = if files.iter().any(|f| super::rosbag1::is_ros1(f)) {
+        super::rosbag1::IMU_TYPE
+    } else {
+        IMU_TYPE
+    };
     let listing = || {
         let all: Vec<String> = topics
             .types
@@ -234,7 +286,7 @@ pub fn read_recording(path: &Path, topic: Option<&str>) -> Result<ImuSamples, Lo
             None => {
                 return Err(unreadable(
                     &name,
-                    format!("no {IMU_TYPE} topic {t}; {}", listing()),
+                    format!("no {imu_type} topic {t}; {}", listing()),
                 ));
             }
         },
@@ -246,14 +298,14 @@ pub fn read_recording(path: &Path, topic: Option<&str>) -> Result<ImuSamples, Lo
             0 => {
                 return Err(unreadable(
                     &name,
-                    format!("no {IMU_TYPE} topic; {}", listing()),
+                    format!("no {imu_type} topic; {}", listing()),
                 ));
             }
             _ => {
                 return Err(unreadable(
                     &name,
                     format!(
-                        "several {IMU_TYPE} topics: choose one with --topic; {}",
+                        "several {imu_type} topics: choose one with --topic; {}",
                         listing()
                     ),
                 ));

@@ -13,6 +13,7 @@
 pub mod bag;
 pub mod export;
 pub mod read;
+pub mod rosbag1;
 
 use thiserror::Error;
 
