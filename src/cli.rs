@@ -360,14 +360,24 @@ fn engine_parser() -> impl TypedValueParser<Value = Engine> {
 
 /// Options of `allan`.
 #[derive(Debug, Args)]
+#[command(group(ArgGroup::new("log").required(true).args(["accel", "imu"])))]
 pub struct AllanArgs {
     /// The static accelerometer log: CSV with a column t_s and the axis column.
     #[arg(long, value_name = "FILE")]
-    pub accel: PathBuf,
-    /// The axis column to analyse.
+    pub accel: Option<PathBuf>,
+    /// A static six-channel IMU log: CSV with t_s and any of ax_m_s2, ay_m_s2, az_m_s2,
+    /// gx_rad_s, gy_rad_s, gz_rad_s; an MCAP file or a ROS 2 bag directory (storage mcap) of
+    /// sensor_msgs/msg/Imu, or a ROS 1 bag of sensor_msgs/Imu. Every channel analysed.
+    #[arg(long, value_name = "FILE", conflicts_with = "column")]
+    pub imu: Option<PathBuf>,
+    /// The IMU topic of an MCAP file or ROS 2 bag (with --imu; needed when it has several).
+    #[arg(long, value_name = "NAME", requires = "imu")]
+    pub topic: Option<String>,
+    /// The axis column to analyse (with --accel).
     #[arg(long, value_name = "NAME", default_value = "accel_m_s2")]
     pub column: String,
-    /// Directory that receives allan.json, noise.toml, imu.yaml and index.html.
+    /// Directory that receives allan.json, noise.toml, imu.yaml and index.html (with --imu also
+    /// noise_<column>.toml for each accelerometer axis).
     #[arg(long, value_name = "DIR", default_value = "allan")]
     pub out: PathBuf,
     /// Confidence of the two-sided intervals, in (0, 1).

@@ -197,7 +197,7 @@ pub fn allan_json(a: &Analysis) -> String {
 }
 
 /// A number as TOML or YAML reads it back: shortest round trip.
-fn num(x: f64) -> String {
+pub(crate) fn num(x: f64) -> String {
     let s = format!("{x:?}");
     if s.contains('.') || s.contains('e') {
         s
@@ -208,7 +208,7 @@ fn num(x: f64) -> String {
 
 /// `x` rounded to ten significant digits: a rate from a median step carries the time stamps'
 /// rounding (10⁻¹¹ s on a day-long log), which a configuration should not.
-fn ten_digits(x: f64) -> f64 {
+pub(crate) fn ten_digits(x: f64) -> f64 {
     format!("{x:.9e}").parse().unwrap_or(x)
 }
 

@@ -25,6 +25,7 @@ pub mod edf;
 pub mod export;
 pub mod fit;
 pub mod goodness;
+pub mod imu;
 pub mod log;
 pub mod nnls;
 pub mod noise_id;

@@ -1,15 +1,18 @@
-//! `accelcal allan`: the noise terms of a static accelerometer log.
+//! `accelcal allan`: the noise terms of a static accelerometer log (`--accel`), or of every
+//! channel of a static IMU log (`--imu`).
 
 use std::io::{IsTerminal, Write as _};
 
 use anyhow::{Context, Result};
 
 use crate::cli::AllanArgs;
+use accelcal::allan::imu::{self, Channel, ImuAnalysis, Sensor, read::read_imu_log};
 use accelcal::allan::{self, Term, export, log::read_static_log};
 use accelcal::format::{count, interval_digits, sig};
 use accelcal::logs::read::LogFile;
 use accelcal::output::StagedFiles;
 use accelcal::report::allan as page;
+use accelcal::report::allan_imu as imu_page;
 
 const JSON_FILE: &str = "allan.json";
 const TOML_FILE: &str = "noise.toml";
@@ -25,18 +28,24 @@ pub(super) fn run_allan(args: &AllanArgs) -> Result<()> {
             eprintln!("{text}");
         }
     };
+    let accel = match (&args.accel, &args.imu) {
+        (_, Some(path)) => return run_imu(args, path),
+        (Some(path), None) => path,
+        // clap requires one of the two.
+        (None, None) => anyhow::bail!("allan needs --accel FILE or --imu FILE"),
+    };
     // An output that cannot be written is refused before the log is read.
     accelcal::output::check_directory(&args.out, &[JSON_FILE, TOML_FILE, YAML_FILE, PAGE_FILE])?;
-    let source = LogFile::new(&args.accel);
+    let source = LogFile::new(accel);
     // The reader names its columns with static strings; one name per run is leaked on purpose.
     let column: &'static str = Box::leak(args.column.clone().into_boxed_str());
     note("reading the log…");
     let log = read_static_log(&source, column)?;
     note("computing the Allan deviation and fitting the noise terms…");
     let a = allan::analyse(&log.values, log.sample_period_s, args.confidence)
-        .with_context(|| format!("{} (column {column})", args.accel.display()))?;
-    let name = format!("{} (column {column})", args.accel.display());
-    let html = page::render(&a, &name, &command(args))?;
+        .with_context(|| format!("{} (column {column})", accel.display()))?;
+    let name = format!("{} (column {column})", accel.display());
+    let html = page::render(&a, &name, &command(args, accel))?;
     let files: [(&str, String); 4] = [
         (JSON_FILE, export::allan_json(&a)),
         (TOML_FILE, export::noise_toml(&a, &name)),
@@ -56,8 +65,9 @@ pub(super) fn run_allan(args: &AllanArgs) -> Result<()> {
     Ok(())
 }
 
-fn summary(a: &allan::Analysis, out: &std::path::Path) -> String {
-    let term = |t: Term, unit: &str| match a.term(t) {
+/// A term as the printed line gives it: the estimate with its interval, or its bound.
+fn term_text(a: &allan::Analysis, t: Term, unit: &str) -> String {
+    match a.term(t) {
         Some(e) => match (e.value, e.lower) {
             (Some(v), Some(lo)) => {
                 let d = interval_digits(v, lo, e.upper, 3);
@@ -67,7 +77,11 @@ fn summary(a: &allan::Analysis, out: &std::path::Path) -> String {
             _ => format!("unresolved (≤ {} {unit})", sig(e.upper, 3)),
         },
         None => "not fitted".to_string(),
-    };
+    }
+}
+
+fn summary(a: &allan::Analysis, out: &std::path::Path) -> String {
+    let term = |t: Term, unit: &str| term_text(a, t, unit);
     let ramp = a
         .term(Term::RateRamp)
         .filter(|t| t.value.is_some())
@@ -88,12 +102,123 @@ fn summary(a: &allan::Analysis, out: &std::path::Path) -> String {
 }
 
 /// The command line that reproduces the analysis.
-fn command(args: &AllanArgs) -> String {
+fn command(args: &AllanArgs, accel: &std::path::Path) -> String {
     format!(
         "accelcal allan --accel {} --column {} --confidence {} --out {}",
-        args.accel.display(),
+        accel.display(),
         args.column,
         args.confidence,
         args.out.display()
     )
+}
+
+/// `allan --imu`: every channel of the log, the files of the IMU and one line per channel.
+fn run_imu(args: &AllanArgs, path: &std::path::Path) -> Result<()> {
+    let note = |text: &str| {
+        if !args.quiet && std::io::stderr().is_terminal() {
+            eprintln!("{text}");
+        }
+    };
+    let axis_files: Vec<String> = Channel::ALL
+        .into_iter()
+        .filter(|c| c.sensor() == Sensor::Accelerometer)
+        .map(imu::export::axis_toml_file)
+        .collect();
+    let mut all: Vec<&str> = vec![JSON_FILE, TOML_FILE, YAML_FILE, PAGE_FILE];
+    all.extend(axis_files.iter().map(String::as_str));
+    accelcal::output::check_directory(&args.out, &all)?;
+    note("reading the log…");
+    let log = if imu::bag::is_recording(path) {
+        imu::bag::read_recording(path, args.topic.as_deref())?
+    } else if args.topic.is_some() {
+        return Err(super::logs::UsageError(format!(
+            "--topic names a topic of an MCAP file or a ROS 2 bag; {} is read as CSV",
+            path.display()
+        ))
+        .into());
+    } else {
+        read_imu_log(&LogFile::new(path))?
+    };
+    note("computing the Allan deviation and fitting the noise terms of every channel…");
+    let a = imu::analyse_imu(&log, args.confidence).with_context(|| path.display().to_string())?;
+    let name = path.display().to_string();
+    let command = format!(
+        "accelcal allan --imu {} --confidence {} --out {}",
+        name,
+        args.confidence,
+        args.out.display()
+    );
+    let mut files: Vec<(String, String)> = vec![
+        (JSON_FILE.to_string(), imu::export::allan_json(&a)),
+        (TOML_FILE.to_string(), imu::export::noise_toml(&a, &name)),
+        (YAML_FILE.to_string(), imu::export::imu_yaml(&a, &name)),
+        (
+            PAGE_FILE.to_string(),
+            imu_page::render(&a, &name, &command)?,
+        ),
+    ];
+    for c in a.of(Sensor::Accelerometer) {
+        let axis = format!("{name} (column {})", c.channel.column());
+        files.push((
+            imu::export::axis_toml_file(c.channel),
+            export::noise_toml(&c.analysis, &axis),
+        ));
+    }
+    let names: Vec<&str> = files.iter().map(|f| f.0.as_str()).collect();
+    let mut staged = StagedFiles::create(&args.out, &names)?;
+    for (file, text) in &files {
+        staged
+            .writer(file)
+            .write_all(text.as_bytes())
+            .with_context(|| format!("cannot write {}", args.out.join(file).display()))?;
+    }
+    staged.commit()?;
+    super::say(&imu_summary(&a, &args.out))?;
+    Ok(())
+}
+
+/// The printed lines of `allan --imu`: the extent, one line per channel, each sensor's keys.
+fn imu_summary(a: &ImuAnalysis, out: &std::path::Path) -> String {
+    let mut s = format!(
+        "{} samples per channel, τ₀ = {} s ({} % intervals):\n",
+        count(a.samples as u64),
+        sig(a.sample_period_s, 6),
+        sig(100.0 * a.confidence, 3)
+    );
+    for c in &a.channels {
+        let sensor = c.channel.sensor();
+        let unit = |t| sensor.term_unit(t);
+        let t = |term| term_text(&c.analysis, term, unit(term));
+        s.push_str(&format!(
+            "  {}: N = {}, B = {}, K = {}; {}\n",
+            c.channel.column(),
+            t(Term::VelocityRandomWalk),
+            t(Term::BiasInstability),
+            t(Term::AccelerationRandomWalk),
+            page::verdict_sentence(&c.analysis)
+        ));
+    }
+    for sensor in Sensor::ALL {
+        let largest = |term| {
+            a.largest(sensor, term).map_or(String::new(), |l| {
+                let bound = if l.upper_bound { "≤ " } else { "" };
+                format!(
+                    "{bound}{} {} ({})",
+                    sig(l.value, 4),
+                    sensor.term_unit(term),
+                    l.channel.column()
+                )
+            })
+        };
+        if a.of(sensor).next().is_some() {
+            s.push_str(&format!(
+                "imu.yaml {}: noise density {}, random walk {} (the largest of the axes)\n",
+                sensor.key(),
+                largest(Term::VelocityRandomWalk),
+                largest(Term::AccelerationRandomWalk)
+            ));
+        }
+    }
+    s.push_str(&format!("written to {}\n", out.display()));
+    s
 }

@@ -51,6 +51,8 @@ pub struct AllanSeries {
     pub terms: Vec<TermCurve>,
     /// The fitted sum over the stretches of τ where it holds, (τ s, σ m/s²) each.
     pub sum: Vec<Vec<(f64, f64)>>,
+    /// The unit of σ(τ) on the axis: m/s² for an accelerometer, rad/s for a gyro.
+    pub unit: &'static str,
 }
 
 /// The Allan deviation against τ, log–log: dots with interval whiskers, the terms' lines and
@@ -65,7 +67,7 @@ pub fn allan_deviation(s: &AllanSeries) -> PlotResult {
     let highs = s.marks.iter().map(|m| m.interval.map_or(m.adev, |i| i.1));
     let y = Axis::log10(
         "Allan deviation σ(τ)",
-        "m/s²",
+        s.unit,
         extent(lows.chain(highs).filter(|v| *v > 0.0)).unwrap_or((0.1, 10.0)),
     );
     let y_area_px = y_label_area(&[&y]);

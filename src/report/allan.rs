@@ -77,6 +77,7 @@ pub fn series(a: &Analysis) -> AllanSeries {
                     .collect()
             })
             .collect(),
+        unit: "m/s²",
     }
 }
 

@@ -15,6 +15,7 @@
 //! page of a calibration.
 
 pub mod allan;
+pub mod allan_imu;
 pub mod calibration;
 pub mod calibration_diagnosis;
 mod calibration_figures;
