@@ -23,6 +23,19 @@ use std::time::{Duration, Instant};
 
 /// Wall-clock limit of one run: every input is tiny, so a run this long is a hang.
 const LIMIT: Duration = Duration::from_secs(20);
+/// The limit of a `report` run: whatever its configuration's size, a valid one also simulates
+/// 100 static logs and the three-axis study's five ensembles of the 600 s drive (about 25 s on
+/// the one thread a run gets here).
+const REPORT_LIMIT: Duration = Duration::from_secs(120);
+
+/// The limit of a run with `args`.
+fn limit_of(args: &[String]) -> Duration {
+    if args.first().map(String::as_str) == Some("report") {
+        REPORT_LIMIT
+    } else {
+        LIMIT
+    }
+}
 /// Address-space cap of one run, bytes.
 const MEMORY_CAP: u64 = 2 << 30;
 
@@ -290,6 +303,8 @@ fn set_key(text: &str, table: &str, key: &str, value: &str) -> String {
 struct Ended {
     code: Option<i32>,
     hung: bool,
+    /// The limit it ran under.
+    limit: Duration,
     stderr: String,
 }
 
@@ -318,11 +333,12 @@ fn run_capped(dir: &Path, args: &[String], capped: bool) -> Ended {
         .spawn()
         .expect("the binary runs");
     let start = Instant::now();
+    let limit = limit_of(args);
     let (code, hung) = loop {
         if let Some(status) = child.try_wait().unwrap() {
             break (status.code(), false);
         }
-        if start.elapsed() > LIMIT {
+        if start.elapsed() > limit {
             child.kill().unwrap();
             child.wait().unwrap();
             break (None, true);
@@ -333,6 +349,7 @@ fn run_capped(dir: &Path, args: &[String], capped: bool) -> Ended {
     Ended {
         code,
         hung,
+        limit,
         stderr: String::from_utf8_lossy(&bytes[..bytes.len().min(4000)]).into_owned(),
     }
 }
@@ -340,7 +357,7 @@ fn run_capped(dir: &Path, args: &[String], capped: bool) -> Ended {
 /// What is wrong with `ended`, if anything: an exit code other than 0 and 2, a panic, a hang.
 fn fault(ended: &Ended) -> Option<String> {
     if ended.hung {
-        return Some(format!("no end within {} s", LIMIT.as_secs()));
+        return Some(format!("no end within {} s", ended.limit.as_secs()));
     }
     if ended.stderr.contains("panicked") {
         return Some("panic".into());
@@ -863,8 +880,13 @@ fn the_judge_fails_what_it_must() {
     let ended = |code, hung, stderr: &str| Ended {
         code,
         hung,
+        limit: LIMIT,
         stderr: stderr.to_string(),
     };
+    // A report gets its own, longer limit; every other command the short one.
+    let args = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    assert_eq!(limit_of(&args(&["report", "-q"])), REPORT_LIMIT);
+    assert_eq!(limit_of(&args(&["ensemble", "-q"])), LIMIT);
     assert!(fault(&ended(Some(0), false, "")).is_none());
     assert!(fault(&ended(Some(2), false, "error: bad")).is_none());
     assert!(fault(&ended(Some(101), false, "")).is_some());
