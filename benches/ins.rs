@@ -14,11 +14,10 @@ use std::time::Instant;
 
 use accelcal::config::ins::InsConfig;
 use accelcal::ins::ensemble::{self, Track, error};
-use accelcal::ins::filter::{Ekf, Propagation};
+use accelcal::ins::filter::Propagation;
 use accelcal::ins::logs::fix;
 use accelcal::ins::mech;
 use accelcal::ins::setup::Study;
-use nalgebra::{UnitQuaternion, Vector3};
 
 fn arg(name: &str) -> Option<String> {
     let args: Vec<String> = std::env::args().collect();
@@ -77,25 +76,9 @@ fn measure(label: &str, repeats: usize, n: u64, mut once: impl FnMut(u64)) -> f6
 /// as `propagation` says; the sum of its NEES before each update and NIS.
 fn realization(study: &Study, track: &Track, index: u64, propagation: Propagation) -> f64 {
     let drive = study.drive();
-    let mut imu = study.imu(index);
-    let s = &study.initial_sigma;
-    let dr = imu.normals(&Vector3::new(s[0], s[1], s[2]));
-    let dv = imu.normals(&Vector3::new(s[3], s[4], s[5]));
-    let dpsi = imu.normals(&Vector3::new(s[6], s[7], s[8]));
-    let start = mech::Pva {
-        position: accelcal::ins::earth::offset(&track.start.position, &dr),
-        velocity_ned_m_s: track.start.velocity_ned_m_s + dv,
-        attitude: UnitQuaternion::from_scaled_axis(dpsi) * track.start.attitude,
-    };
+    let (mut imu, ekf) = accelcal::ins::ensemble::start(study, track, index);
+    let mut ekf = ekf.with_propagation(propagation);
     let g = &study.filter_gnss;
-    let mut ekf = Ekf::new(
-        start,
-        study.prior(),
-        study.filter_noise(),
-        study.filter_decay(),
-        g.lever_arm_b_m,
-    )
-    .with_propagation(propagation);
     let dt = 1.0 / study.imu_rate_hz;
     let mut sum = 0.0;
     for (k, (inc, pva)) in track.steps.iter().enumerate() {

@@ -155,26 +155,10 @@ pub fn read_static_log(
             },
         ));
     };
-    let (lo, hi) = (
-        ACCEPTED_STEP_RATIO.0 * median_s,
-        ACCEPTED_STEP_RATIO.1 * median_s,
-    );
-    if let Some(i) = times
-        .par_windows(2)
-        .position_first(|w| !(lo..=hi).contains(&(w[1] - w[0])))
-    {
-        let (previous_s, t_s) = (times[i], times[i + 1]);
-        let step_s = t_s - previous_s;
-        let problem = LogProblem::Gap {
-            previous_s,
-            t_s,
-            step_s,
-            ratio: step_s / median_s,
-            median_s,
-        };
+    if let Some((i, problem)) = first_gap(&times, median_s) {
         return Err(LogError::at(
             source.name(),
-            line_of(source, column, i + 1)?,
+            line_of(source, column, i)?,
             problem,
         ));
     }
@@ -182,6 +166,29 @@ pub fn read_static_log(
         values,
         sample_period_s: median_s,
     })
+}
+
+/// The first sample whose step from the one before leaves [`ACCEPTED_STEP_RATIO`] of the median
+/// step `median_s`: its index and the problem, or `None` when every step is within.
+pub(crate) fn first_gap(times: &[f64], median_s: f64) -> Option<(usize, LogProblem)> {
+    use rayon::prelude::*;
+    let (lo, hi) = (
+        ACCEPTED_STEP_RATIO.0 * median_s,
+        ACCEPTED_STEP_RATIO.1 * median_s,
+    );
+    let i = times
+        .par_windows(2)
+        .position_first(|w| !(lo..=hi).contains(&(w[1] - w[0])))?;
+    let (previous_s, t_s) = (times[i], times[i + 1]);
+    let step_s = t_s - previous_s;
+    let problem = LogProblem::Gap {
+        previous_s,
+        t_s,
+        step_s,
+        ratio: step_s / median_s,
+        median_s,
+    };
+    Some((i + 1, problem))
 }
 
 /// The median of the steps between consecutive `times` (the mean of the two middle ones for an

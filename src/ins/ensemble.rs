@@ -180,6 +180,31 @@ pub struct FixView<'a> {
     pub imu: &'a Imu,
 }
 
+/// Realization `index`'s true IMU (its prior's draws taken from its stream) and its filter,
+/// started from the truth plus a draw of its prior: position, velocity and attitude errors of
+/// the study's initial σ's, the biases' prior from the filter's model.
+pub fn start(study: &Study, track: &Track, index: u64) -> (Imu, Ekf) {
+    let mut imu = study.imu(index);
+    let s = &study.initial_sigma;
+    let dr = imu.normals(&Vector3::new(s[0], s[1], s[2]));
+    let dv = imu.normals(&Vector3::new(s[3], s[4], s[5]));
+    let dpsi = imu.normals(&Vector3::new(s[6], s[7], s[8]));
+    let start = Pva {
+        position: offset(&track.start.position, &dr),
+        velocity_ned_m_s: track.start.velocity_ned_m_s + dv,
+        attitude: UnitQuaternion::from_scaled_axis(dpsi) * track.start.attitude,
+    };
+    let ekf = Ekf::new(
+        start,
+        study.prior(),
+        study.filter_noise(),
+        study.filter_decay(),
+        study.filter_gnss.lever_arm_b_m,
+    )
+    .with_earth_rotation(study.filter_earth_rotation_rad_s);
+    (imu, ekf)
+}
+
 /// Runs realization `index` of `study` over `track` — its filter started from the truth plus a
 /// draw of its prior — calling `on_fix` after every update; returns the filter and the IMU at
 /// the end.
@@ -193,25 +218,8 @@ pub fn filter_realization(
     mut on_fix: impl FnMut(&FixView) -> Result<(), RealizationError>,
 ) -> Result<(Ekf, Imu), RealizationError> {
     let drive = study.drive();
-    let mut imu = study.imu(index);
-    let s = &study.initial_sigma;
-    let dr = imu.normals(&Vector3::new(s[0], s[1], s[2]));
-    let dv = imu.normals(&Vector3::new(s[3], s[4], s[5]));
-    let dpsi = imu.normals(&Vector3::new(s[6], s[7], s[8]));
-    let start = Pva {
-        position: offset(&track.start.position, &dr),
-        velocity_ned_m_s: track.start.velocity_ned_m_s + dv,
-        attitude: UnitQuaternion::from_scaled_axis(dpsi) * track.start.attitude,
-    };
+    let (mut imu, mut ekf) = start(study, track, index);
     let g = &study.filter_gnss;
-    let mut ekf = Ekf::new(
-        start,
-        study.prior(),
-        study.filter_noise(),
-        study.filter_decay(),
-        g.lever_arm_b_m,
-    )
-    .with_earth_rotation(study.filter_earth_rotation_rad_s);
     let filter = |source| RealizationError::Filter { index, source };
     let mut fixes = 0;
     for (k, (inc, pva)) in track.steps.iter().enumerate() {

@@ -12,8 +12,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::{Channel, ImuSamples};
-use crate::allan::log::median_step;
-use crate::logs::steps::ACCEPTED_STEP_RATIO;
+use crate::allan::log::{first_gap, median_step};
 use crate::logs::{LogError, LogProblem};
 
 /// The first bytes of an MCAP file.
@@ -353,24 +352,8 @@ fn samples(file: &str, topic: &str, messages: &[ImuMessage]) -> Result<ImuSample
             problem,
         ));
     };
-    let (lo, hi) = (
-        ACCEPTED_STEP_RATIO.0 * median_s,
-        ACCEPTED_STEP_RATIO.1 * median_s,
-    );
-    if let Some(i) = times
-        .windows(2)
-        .position(|w| !(lo..=hi).contains(&(w[1] - w[0])))
-    {
-        let (previous_s, t_s) = (times[i], times[i + 1]);
-        let step_s = t_s - previous_s;
-        let problem = LogProblem::Gap {
-            previous_s,
-            t_s,
-            step_s,
-            ratio: step_s / median_s,
-            median_s,
-        };
-        return Err(LogError::of_file(&at(i + 1), problem));
+    if let Some((i, problem)) = first_gap(&times, median_s) {
+        return Err(LogError::of_file(&at(i), problem));
     }
     Ok(ImuSamples {
         channels,

@@ -1,13 +1,10 @@
 //! The covariance propagated once per interval against the per-step dense reference.
 
-use nalgebra::{UnitQuaternion, Vector3};
-
 use crate::config::ins::InsConfig;
 use crate::ins::ensemble::Track;
 use crate::ins::error_state::Matrix15;
 use crate::ins::filter::{DEFAULT_COVARIANCE_INTERVAL_S, Ekf, Propagation};
 use crate::ins::logs::fix;
-use crate::ins::mech::Pva;
 use crate::ins::setup::Study;
 
 /// P before each update of realization `index`, its covariance propagated as `propagation` says.
@@ -18,25 +15,9 @@ fn covariances(
     propagation: Propagation,
 ) -> Vec<Matrix15> {
     let drive = study.drive();
-    let mut imu = study.imu(index);
-    let s = &study.initial_sigma;
-    let dr = imu.normals(&Vector3::new(s[0], s[1], s[2]));
-    let dv = imu.normals(&Vector3::new(s[3], s[4], s[5]));
-    let dpsi = imu.normals(&Vector3::new(s[6], s[7], s[8]));
-    let start = Pva {
-        position: crate::ins::earth::offset(&track.start.position, &dr),
-        velocity_ned_m_s: track.start.velocity_ned_m_s + dv,
-        attitude: UnitQuaternion::from_scaled_axis(dpsi) * track.start.attitude,
-    };
+    let (mut imu, ekf) = crate::ins::ensemble::start(study, track, index);
+    let mut ekf = ekf.with_propagation(propagation);
     let g = &study.filter_gnss;
-    let mut ekf = Ekf::new(
-        start,
-        study.prior(),
-        study.filter_noise(),
-        study.filter_decay(),
-        g.lever_arm_b_m,
-    )
-    .with_propagation(propagation);
     let dt = 1.0 / study.imu_rate_hz;
     let mut out = Vec::new();
     for (k, (inc, pva)) in track.steps.iter().enumerate() {
