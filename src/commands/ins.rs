@@ -103,10 +103,7 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
     bar.start("ins", n);
     let sums = ins_ensemble::sums(&study, &track, 0..n, |done| bar.advance(done))?;
     bar.finish();
-    let outcome = ins_ensemble::Outcome {
-        stats: sums.normalized.stats(ins_ensemble::constant_states(&study)),
-        calibration: sums.calibration(),
-    };
+    let outcome = sums.outcome(&study);
     let verdicts = evaluate(&outcome.stats, &Budget::study(study.false_alarm_rate));
     let elapsed_s = start.elapsed().as_secs_f64();
     let doc = export::ins::document(&config, &outcome, &verdicts, elapsed_s);

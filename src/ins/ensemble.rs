@@ -82,6 +82,14 @@ impl InsSums {
         }
     }
 
+    /// The statistics the checks read and the calibration, for the ensemble of `study`.
+    pub fn outcome(&self, study: &Study) -> Outcome {
+        Outcome {
+            stats: self.normalized.stats(constant_states(study)),
+            calibration: self.calibration(),
+        }
+    }
+
     /// The calibration at the end of the drive.
     pub fn calibration(&self) -> Calibration {
         let n = self.normalized.sums.count;
@@ -381,9 +389,5 @@ pub fn constant_states(study: &Study) -> [bool; STATES] {
 /// # Errors
 /// The first realization's [`RealizationError`], in index order.
 pub fn run(study: &Study, track: &Track, realizations: u64) -> Result<Outcome, RealizationError> {
-    let sums = sums(study, track, 0..realizations, |_| {})?;
-    Ok(Outcome {
-        stats: sums.normalized.stats(constant_states(study)),
-        calibration: sums.calibration(),
-    })
+    Ok(sums(study, track, 0..realizations, |_| {})?.outcome(study))
 }

@@ -4,9 +4,7 @@
 
 use crate::checks::{Budget, Verdicts, evaluate};
 use crate::config::ins::InsConfig;
-use crate::ins::ensemble::{
-    self, Calibration, RealizationError, Track, constant_states, filter_realization,
-};
+use crate::ins::ensemble::{self, Calibration, RealizationError, Track, filter_realization};
 use crate::ins::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS};
 use crate::ins::gnss::ned_difference_m;
 use crate::ins::setup::Study;
@@ -76,9 +74,9 @@ fn judged(
     progress.start(label, realizations);
     let sums = ensemble::sums(study, track, 0..realizations, |done| progress.advance(done))?;
     progress.finish();
-    let stats = sums.normalized.stats(constant_states(study));
-    let verdicts = evaluate(&stats, &Budget::study(study.false_alarm_rate));
-    Ok((verdicts, sums.calibration(), sums.normalized.times_s))
+    let outcome = sums.outcome(study);
+    let verdicts = evaluate(&outcome.stats, &Budget::study(study.false_alarm_rate));
+    Ok((verdicts, outcome.calibration, sums.normalized.times_s))
 }
 
 /// Realization 0 of `study`, every fix.
