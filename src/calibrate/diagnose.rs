@@ -12,7 +12,7 @@
 
 mod bias;
 mod sentences;
-mod whiteness;
+pub mod whiteness;
 
 use serde::Serialize;
 use statrs::distribution::{Binomial, DiscreteCDF};

@@ -21,6 +21,7 @@
 
 pub mod diagnose;
 mod forward;
+pub mod imu;
 mod integration;
 mod intervals;
 mod nis;
@@ -48,7 +49,7 @@ use crate::logs::{GpsFix, LogError};
 use crate::model::{Model, NoiseStats, filter_stats, validate_calibration};
 use crate::state::{StateMatrix, StateVector};
 use forward::FilteredFix;
-pub use nis::{NisTest, nis_test};
+pub use nis::{NisTest, nis_test, nis_test_rows};
 pub use pass::NOMINAL_TOLERANCE;
 use scan::Scan;
 use smoother::SmoothedFix;

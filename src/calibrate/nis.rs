@@ -77,6 +77,39 @@ pub fn nis_test(nis: &[f64], false_alarm_rate: f64) -> NisTest {
     }
 }
 
+/// [`nis_test`] of fixes that measure different numbers of components: fix i's NIS is χ²(m_i)
+/// with m_i = `rows[i]`, the sum χ²(Σ m_i); each fix is held to the band of its own m_i, and the
+/// per-fix band reported is that of the most common m.
+pub fn nis_test_rows(nis: &[f64], rows: &[usize], false_alarm_rate: f64) -> NisTest {
+    let mut t = nis_test(nis, false_alarm_rate);
+    let n = nis.len();
+    t.dof = rows.iter().map(|&m| m as u64).sum();
+    (t.lower, t.upper) = if n == 0 {
+        (0.0, 0.0)
+    } else {
+        chi_squared_band(t.dof as f64, 1.0, false_alarm_rate)
+    };
+    t.verdict = if n > 0 && (t.lower..=t.upper).contains(&t.sum) {
+        "pass"
+    } else {
+        "fail"
+    };
+    let band = |m: usize| chi_squared_band(m as f64, 1.0, false_alarm_rate);
+    t.outside_per_fix = nis
+        .iter()
+        .zip(rows)
+        .filter(|&(e, &m)| {
+            let (lo, hi) = band(m);
+            !(lo..=hi).contains(e)
+        })
+        .count();
+    let modal = (1..=6)
+        .max_by_key(|m| rows.iter().filter(|&&r| r == *m).count())
+        .unwrap_or(MEASUREMENT_DIM as usize);
+    (t.per_fix_lower, t.per_fix_upper) = band(modal);
+    t
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -122,7 +122,10 @@ pub(super) fn run_calibrate(args: &CalibrateArgs) -> Result<()> {
             eprintln!("{text}");
         }
     };
-    let (accel, gps) = (LogFile::new(&args.accel), LogFile::new(&args.gps));
+    let (Some(accel), Some(gps)) = (&args.accel, &args.gps) else {
+        unreachable!("clap requires --accel and --gps without --imu and --gnss")
+    };
+    let (accel, gps) = (LogFile::new(accel), LogFile::new(gps));
     if args.every_sample && !accel.rereadable() {
         return Err(CalibrateError::Log(LogError::of_file(
             accel.name(),
@@ -296,8 +299,8 @@ fn nis_place(sum: f64, lower: f64, upper: f64) -> &'static str {
 fn calibrate_command(args: &CalibrateArgs) -> String {
     let mut s = format!(
         "accelcal calibrate --accel {} --gps {}",
-        args.accel.display(),
-        args.gps.display()
+        args.accel.clone().unwrap_or_default().display(),
+        args.gps.clone().unwrap_or_default().display()
     );
     if let Some(c) = &args.config {
         s.push_str(&format!(" --config {}", c.display()));

@@ -4,6 +4,7 @@
 //! `logs` those of sensor logs (simulate, calibrate).
 
 mod allan;
+mod calibrate_imu;
 mod ins;
 mod logs;
 mod monte_carlo;
@@ -101,7 +102,10 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Simulate(args)) => logs::run_simulate(&args),
         Some(Command::Sensitivity(args)) => monte_carlo::run_sensitivity(&args),
         Some(Command::Merge(args)) => monte_carlo::run_merge(&args),
-        Some(Command::Calibrate(args)) => logs::run_calibrate(&args),
+        Some(Command::Calibrate(args)) => match (&args.imu, &args.gnss) {
+            (Some(imu), Some(gnss)) => calibrate_imu::run(&args, imu, gnss),
+            _ => logs::run_calibrate(&args),
+        },
         Some(Command::Allan(args)) => allan::run_allan(&args),
         Some(Command::Config(args)) => say(match args.model {
             ModelKind::Accelerometer => DEFAULT_TOML,

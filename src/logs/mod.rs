@@ -227,6 +227,29 @@ pub enum LogProblem {
         /// Line of the fix that took the sample.
         other_line: u64,
     },
+    /// The header names columns of two layouts that exclude each other.
+    #[error(
+        "the header names `{first}` and `{second}`, columns of two layouts that exclude each \
+         other: expected {expected}"
+    )]
+    ConflictingColumns {
+        /// A column of the first layout.
+        first: &'static str,
+        /// A column of the second.
+        second: &'static str,
+        /// What the header may hold.
+        expected: String,
+    },
+    /// A value outside the range its column accepts.
+    #[error("`{column}` = {value} is outside its accepted range: expected {range}")]
+    OutOfRange {
+        /// The column.
+        column: &'static str,
+        /// The value.
+        value: f64,
+        /// The accepted range in words.
+        range: String,
+    },
     /// A second reading of the file differs from the first.
     #[error("the file changed while it was being read: its second reading differs from the first")]
     Changed,

@@ -141,13 +141,29 @@ pub fn open_blocks<'a, const N: usize>(
     source: &'a dyn LogSource,
     columns: [&'static str; N],
 ) -> Result<(Layout<N>, Feed<'a>), LogError> {
+    open_blocks_choosing(source, &columns.join(","), |_, _| Ok(columns))
+}
+
+/// [`open_blocks`] with the columns chosen from the header: `choose` gets the header's names
+/// and its line and returns the columns to read (or the problem with the header), so that a
+/// log of one of several layouts is read in one opening (a pipe can be opened only once).
+/// `expected` describes the header in the message about an empty file.
+///
+/// # Errors
+/// As [`open_blocks`], and `choose`'s.
+pub fn open_blocks_choosing<'a, const N: usize>(
+    source: &'a dyn LogSource,
+    expected: &str,
+    choose: impl FnOnce(&[&str], u64) -> Result<[&'static str; N], LogError>,
+) -> Result<(Layout<N>, Feed<'a>), LogError> {
     let reader: Box<dyn Read + 'a> = source.open()?;
     let mut feed = Feed::new(source.name(), reader);
-    let expected = columns.join(",");
     let Some((text, line)) = feed.header()? else {
         return Err(LogError::of_file(
             source.name(),
-            LogProblem::Empty { header: expected },
+            LogProblem::Empty {
+                header: expected.to_string(),
+            },
         ));
     };
     let at = |problem| LogError::at(source.name(), line, problem);
@@ -162,6 +178,8 @@ pub fn open_blocks<'a, const N: usize>(
     if let Some(name) = found.iter().find(|name| !seen.insert(**name)) {
         return Err(at(LogProblem::DuplicateColumn { column: echo(name) }));
     }
+    let columns = choose(&found, line)?;
+    let expected = columns.join(",");
     let header = echo(&found.join(","));
     let mut positions = [0; N];
     for (k, column) in columns.iter().enumerate() {
@@ -204,7 +222,20 @@ impl<'a, const N: usize> CsvReader<'a, N> {
     /// # Errors
     /// [`LogError`] when the file cannot be read, is empty, or its header lacks a column.
     pub fn open(source: &'a dyn LogSource, columns: [&'static str; N]) -> Result<Self, LogError> {
-        let (layout, feed) = open_blocks(source, columns)?;
+        Self::open_choosing(source, &columns.join(","), |_, _| Ok(columns))
+    }
+
+    /// Opens `source` reading the columns `choose` picks from its header
+    /// ([`open_blocks_choosing`]).
+    ///
+    /// # Errors
+    /// As [`CsvReader::open`], and `choose`'s.
+    pub fn open_choosing(
+        source: &'a dyn LogSource,
+        expected: &str,
+        choose: impl FnOnce(&[&str], u64) -> Result<[&'static str; N], LogError>,
+    ) -> Result<Self, LogError> {
+        let (layout, feed) = open_blocks_choosing(source, expected, choose)?;
         Ok(Self {
             layout,
             line: 1,
@@ -218,6 +249,11 @@ impl<'a, const N: usize> CsvReader<'a, N> {
     /// The name of the file in messages.
     pub fn file(&self) -> &str {
         &self.layout.file
+    }
+
+    /// The columns read, in the order of each row's values.
+    pub fn columns(&self) -> [&'static str; N] {
+        self.layout.columns
     }
 
     /// An error at the current line.

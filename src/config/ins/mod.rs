@@ -20,6 +20,17 @@ pub const DEFAULT_INS_TOML: &str = include_str!("default.toml");
 /// The longest drive: the default drive's length, s.
 pub const LONGEST_DRIVE_S: f64 = 600.0;
 
+/// The body axes of an IMU log's columns.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axes {
+    /// Forward-right-down, the navigation convention.
+    #[default]
+    Frd,
+    /// Forward-left-up, common in ROS (REP 103): y and z of FRD reversed.
+    Flu,
+}
+
 /// Every parameter of the three-axis study.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]

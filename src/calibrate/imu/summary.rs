@@ -1,0 +1,363 @@
+//! What a three-axis calibration reports: `summary.json` (the six biases and the attitude at the
+//! end with σ's, 95 % intervals and whether the drive determined them; the NIS test; the
+//! innovations' whiteness per component; the alignment; every assumption) and `estimates.csv`
+//! (one row per fix).
+
+use std::io::{self, Write};
+
+use serde::Serialize;
+
+use super::Settings;
+use super::run::{Calibrated, FixRecord, bias_sigmas, euler_sigmas};
+use crate::calibrate::diagnose::whiteness::{Whiteness, whiteness};
+use crate::calibrate::{NisTest, nis_test_rows};
+use crate::ins::euler_of;
+
+/// The confidence of the intervals.
+pub const CONFIDENCE: f64 = 0.95;
+
+/// A quantity is determined by the drive when its σ at the end is at most this fraction of the
+/// σ it would have from its prior and its process noise alone: the data then carry at least
+/// three times the prior's information about it.
+pub const IDENTIFIABLE_SIGMA_RATIO: f64 = 0.5;
+
+/// Three estimates in body axes (x, y, z) with their σ's and intervals.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Triad {
+    /// The estimates.
+    pub value: [f64; 3],
+    /// Their σ's.
+    pub sigma: [f64; 3],
+    /// The intervals' lower ends (`CONFIDENCE`).
+    pub lower: [f64; 3],
+    /// Their upper ends.
+    pub upper: [f64; 3],
+    /// Whether the drive determined each ([`IDENTIFIABLE_SIGMA_RATIO`]).
+    pub identifiable: [bool; 3],
+}
+
+/// The attitude at the end, degrees.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Attitude {
+    /// Roll, °.
+    pub roll: f64,
+    /// Pitch, °.
+    pub pitch: f64,
+    /// Yaw, °.
+    pub yaw: f64,
+    /// σ of roll, °.
+    pub sigma_roll: f64,
+    /// σ of pitch, °.
+    pub sigma_pitch: f64,
+    /// σ of yaw, °.
+    pub sigma_yaw: f64,
+    /// Whether the drive determined the yaw beyond the alignment's course.
+    pub yaw_identifiable: bool,
+}
+
+/// The alignment as the summary tells it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AlignmentRecord {
+    /// The fix the filter starts at, s.
+    pub t_s: f64,
+    /// The window's first fix, s.
+    pub window_start_s: f64,
+    /// The horizontal speed there, m/s.
+    pub speed_m_s: f64,
+    /// Roll, pitch and yaw at the start, °.
+    pub roll_deg: f64,
+    /// Pitch at the start, °.
+    pub pitch_deg: f64,
+    /// Yaw at the start (the course), °.
+    pub yaw_deg: f64,
+    /// Their prior σ's, °.
+    pub sigma_roll_deg: f64,
+    /// σ of pitch, °.
+    pub sigma_pitch_deg: f64,
+    /// σ of yaw, °.
+    pub sigma_yaw_deg: f64,
+    /// IMU rows before the start, which the filter does not use.
+    pub rows_before: u64,
+}
+
+/// One innovation component's whiteness test.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ComponentWhiteness {
+    /// The component, e.g. `position_north`.
+    pub component: &'static str,
+    /// The fixes that measured it.
+    pub fixes: usize,
+    /// The test.
+    #[serde(flatten)]
+    pub test: Whiteness,
+}
+
+/// `summary.json` of a three-axis calibration.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// `"ins"`: the three-axis calibration.
+    pub model: &'static str,
+    /// The IMU log, as named.
+    pub imu_file: String,
+    /// The GNSS log, as named.
+    pub gnss_file: String,
+    /// What the IMU rows hold.
+    pub imu_layout: super::read::ImuLayout,
+    /// IMU rows.
+    pub imu_rows: u64,
+    /// The median IMU step's rate, Hz.
+    pub imu_rate_hz: f64,
+    /// Fixes in the GNSS log.
+    pub fixes: usize,
+    /// Fixes the filter used (after the alignment's).
+    pub fixes_used: usize,
+    /// The alignment.
+    pub alignment: AlignmentRecord,
+    /// The gyro biases at the end, rad/s.
+    pub gyro_bias_rad_s: Triad,
+    /// The accelerometer biases at the end, m/s².
+    pub accel_bias_m_s2: Triad,
+    /// The attitude at the end.
+    pub attitude_deg: Attitude,
+    /// The NIS test over the fixes.
+    pub nis: NisTest,
+    /// Whiteness of each innovation component's normalized sequence.
+    pub whiteness: Vec<ComponentWhiteness>,
+    /// Whether the intervals rest on a model a test rejects.
+    pub intervals_conditional: bool,
+    /// The tests that reject it.
+    pub rejected_by: Vec<String>,
+    /// What the reader should know.
+    pub warnings: Vec<String>,
+    /// Every assumption made.
+    pub assumptions: Settings,
+}
+
+/// The innovation components' names, in the record's order.
+pub const COMPONENTS: [&str; 6] = [
+    "position_north",
+    "position_east",
+    "position_down",
+    "velocity_north",
+    "velocity_east",
+    "velocity_down",
+];
+
+fn triad(value: [f64; 3], sigma: [f64; 3], prior: [f64; 3]) -> Triad {
+    let z = crate::stats::normal_bound(1.0 - CONFIDENCE);
+    Triad {
+        value,
+        sigma,
+        lower: [0, 1, 2].map(|i| value[i] - z * sigma[i]),
+        upper: [0, 1, 2].map(|i| value[i] + z * sigma[i]),
+        identifiable: [0, 1, 2].map(|i| sigma[i] <= IDENTIFIABLE_SIGMA_RATIO * prior[i]),
+    }
+}
+
+/// The σ a bias would have at `t` s after the start from its prior and its process alone.
+fn prior_sigma(sigma0: f64, k: f64, tau: Option<f64>, t: f64) -> f64 {
+    match tau {
+        Some(_) => sigma0,
+        None => (sigma0 * sigma0 + k * k * t).sqrt(),
+    }
+}
+
+/// The summary of `c` calibrated with `s`, the IMU log named `imu_file`.
+pub fn summary(c: &Calibrated, s: &Settings, imu_file: &str) -> Summary {
+    let last = c.records.last();
+    let elapsed = last.map_or(0.0, |r| r.t_s - c.start_s);
+    let (gyro, accel, attitude) = match last {
+        Some(r) => end_estimates(r, c, s, elapsed),
+        None => (
+            triad([f64::NAN; 3], [f64::NAN; 3], [1.0; 3]),
+            triad([f64::NAN; 3], [f64::NAN; 3], [1.0; 3]),
+            Attitude {
+                roll: f64::NAN,
+                pitch: f64::NAN,
+                yaw: f64::NAN,
+                sigma_roll: f64::NAN,
+                sigma_pitch: f64::NAN,
+                sigma_yaw: f64::NAN,
+                yaw_identifiable: false,
+            },
+        ),
+    };
+    let (nis, whiteness, rejected_by) = tests(c, s);
+    let alignment = alignment_record(c);
+    let mut warnings = Vec::new();
+    if !attitude.yaw_identifiable {
+        warnings.push(format!(
+            "the yaw is not determined beyond the alignment's course: its σ at the end, {:.2}°, \
+             is more than {IDENTIFIABLE_SIGMA_RATIO} of the alignment's (a drive without turns \
+             or speed changes cannot tell it)",
+            attitude.sigma_yaw
+        ));
+    }
+    if c.missing_velocity[2] > 0 {
+        warnings.push(format!(
+            "{} of {} fixes have no vertical velocity: only their position and horizontal \
+             velocity are used",
+            c.missing_velocity[2], c.fixes
+        ));
+    }
+    Summary {
+        model: "ins",
+        imu_file: imu_file.to_string(),
+        gnss_file: c.gnss_file.clone(),
+        imu_layout: c.layout,
+        imu_rows: c.span.rows,
+        imu_rate_hz: 1.0 / c.span.median_step_s,
+        fixes: c.fixes,
+        fixes_used: c.records.len(),
+        alignment,
+        gyro_bias_rad_s: gyro,
+        accel_bias_m_s2: accel,
+        attitude_deg: attitude,
+        intervals_conditional: !rejected_by.is_empty(),
+        nis,
+        whiteness,
+        rejected_by,
+        warnings,
+        assumptions: *s,
+    }
+}
+
+/// The NIS test, each component's whiteness, and the tests that reject the model.
+fn tests(c: &Calibrated, s: &Settings) -> (NisTest, Vec<ComponentWhiteness>, Vec<String>) {
+    let nis: Vec<f64> = c.records.iter().map(|r| r.nis).collect();
+    let rows: Vec<usize> = c.records.iter().map(|r| r.rows).collect();
+    let nis = nis_test_rows(&nis, &rows, s.false_alarm_rate);
+    let whiteness: Vec<ComponentWhiteness> = (0..6)
+        .filter_map(|i| {
+            let u: Vec<f64> = c
+                .records
+                .iter()
+                .filter(|r| r.innovation[i].is_finite())
+                .map(|r| r.innovation[i] / r.innovation_sigma[i])
+                .collect();
+            (!u.is_empty()).then(|| ComponentWhiteness {
+                component: COMPONENTS[i],
+                fixes: u.len(),
+                test: whiteness(&u, s.false_alarm_rate),
+            })
+        })
+        .collect();
+    let mut rejected_by = Vec::new();
+    if nis.verdict == "fail" {
+        rejected_by.push("nis".to_string());
+    }
+    for w in &whiteness {
+        if w.test.verdict == "fail" {
+            rejected_by.push(format!("whiteness_{}", w.component));
+        }
+    }
+    (nis, whiteness, rejected_by)
+}
+
+/// The alignment as the summary tells it.
+fn alignment_record(c: &Calibrated) -> AlignmentRecord {
+    let a = &c.alignment;
+    let deg = f64::to_degrees;
+    let p = &a.covariance;
+    let sig = |i: usize| deg(p[(6 + i, 6 + i)].sqrt());
+    AlignmentRecord {
+        t_s: c.start_s,
+        window_start_s: c.start_s - a.window_s,
+        speed_m_s: a.speed_m_s,
+        roll_deg: deg(a.euler_rad[0]),
+        pitch_deg: deg(a.euler_rad[1]),
+        yaw_deg: deg(a.euler_rad[2]),
+        sigma_roll_deg: sig(0),
+        sigma_pitch_deg: sig(1),
+        sigma_yaw_deg: sig(2),
+        rows_before: 0,
+    }
+}
+
+/// The biases and the attitude of the last record `r`.
+fn end_estimates(r: &FixRecord, c: &Calibrated, s: &Settings, t: f64) -> (Triad, Triad, Attitude) {
+    let (sg, sa) = bias_sigmas(&r.covariance);
+    let pg = prior_sigma(
+        s.gyro_bias_sigma_rad_s,
+        s.gyro_bias_random_walk_rad_s_per_sqrt_s,
+        s.gyro_bias_correlation_time_s,
+        t,
+    );
+    let pa = prior_sigma(
+        s.accel_bias_sigma_m_s2,
+        s.accel_bias_random_walk_m_s2_per_sqrt_s,
+        s.accel_bias_correlation_time_s,
+        t,
+    );
+    let (roll, pitch, yaw) = euler_of(&r.pva.attitude);
+    let [s_roll, s_pitch, s_yaw] = euler_sigmas(&r.pva, &r.covariance);
+    // The yaw's σ from the alignment and the gyro's noise alone over the drive.
+    let yaw0 = c.alignment.covariance[(8, 8)];
+    let arw = s.gyro_arw_rad_per_sqrt_s;
+    let yaw_prior = (yaw0 + arw * arw * t).sqrt();
+    let deg = f64::to_degrees;
+    (
+        triad(r.gyro_bias_rad_s.into(), sg, [pg; 3]),
+        triad(r.accel_bias_m_s2.into(), sa, [pa; 3]),
+        Attitude {
+            roll: deg(roll),
+            pitch: deg(pitch),
+            yaw: deg(yaw),
+            sigma_roll: deg(s_roll),
+            sigma_pitch: deg(s_pitch),
+            sigma_yaw: deg(s_yaw),
+            yaw_identifiable: s_yaw <= IDENTIFIABLE_SIGMA_RATIO * yaw_prior,
+        },
+    )
+}
+
+/// The header of `estimates.csv`.
+pub const ESTIMATES_HEADER: &str = "t_s,lat_deg,lon_deg,height_m,vn_m_s,ve_m_s,vd_m_s,roll_deg,\
+pitch_deg,yaw_deg,bgx_rad_s,bgy_rad_s,bgz_rad_s,bax_m_s2,bay_m_s2,baz_m_s2,sigma_n_m,sigma_e_m,\
+sigma_d_m,sigma_vn_m_s,sigma_ve_m_s,sigma_vd_m_s,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg,\
+sigma_bgx_rad_s,sigma_bgy_rad_s,sigma_bgz_rad_s,sigma_bax_m_s2,sigma_bay_m_s2,sigma_baz_m_s2,\
+nu_n_m,nu_e_m,nu_d_m,nu_vn_m_s,nu_ve_m_s,nu_vd_m_s,sqrt_s_n_m,sqrt_s_e_m,sqrt_s_d_m,\
+sqrt_s_vn_m_s,sqrt_s_ve_m_s,sqrt_s_vd_m_s,nis,nis_dof";
+
+/// `estimates.csv`: one row per fix (the filtered estimates after its update, their σ's, the
+/// innovation, √S and the NIS; `nan` where a component was not measured).
+///
+/// # Errors
+/// The writer's.
+pub fn write_estimates(c: &Calibrated, out: &mut impl Write) -> io::Result<()> {
+    writeln!(out, "{ESTIMATES_HEADER}")?;
+    for r in &c.records {
+        let p = &r.pva.position;
+        let v = r.pva.velocity_ned_m_s;
+        let (roll, pitch, yaw) = euler_of(&r.pva.attitude);
+        let [sr, sp, sy] = euler_sigmas(&r.pva, &r.covariance);
+        let (sg, sa) = bias_sigmas(&r.covariance);
+        let cov = &r.covariance;
+        let mut row = vec![
+            r.t_s,
+            p.lat_rad.to_degrees(),
+            p.lon_rad.to_degrees(),
+            p.height_m,
+            v.x,
+            v.y,
+            v.z,
+            roll.to_degrees(),
+            pitch.to_degrees(),
+            yaw.to_degrees(),
+        ];
+        row.extend(r.gyro_bias_rad_s.iter());
+        row.extend(r.accel_bias_m_s2.iter());
+        row.extend((0..6).map(|i| cov[(i, i)].max(0.0).sqrt()));
+        row.extend([sr, sp, sy].map(f64::to_degrees));
+        row.extend(sg);
+        row.extend(sa);
+        row.extend(r.innovation);
+        row.extend(r.innovation_sigma);
+        row.push(r.nis);
+        row.push(r.rows as f64);
+        let mut line = String::new();
+        crate::logs::write::push_row(&mut line, &row);
+        out.write_all(line.as_bytes())?;
+    }
+    Ok(())
+}

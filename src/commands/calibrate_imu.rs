@@ -1,0 +1,123 @@
+//! `calibrate --imu FILE --gnss FILE`: a whole IMU calibrated from a raw recording.
+
+use std::io::{IsTerminal, Write};
+use std::path::Path;
+
+use anyhow::{Context, Result};
+
+use crate::cli::CalibrateArgs;
+use accelcal::calibrate::imu::run::{ImuCalibrateError, calibrate};
+use accelcal::calibrate::imu::summary::{Summary, summary, write_estimates};
+use accelcal::calibrate::imu::{CONSUMER, Settings};
+use accelcal::error::ConfigError;
+use accelcal::logs::read::LogFile;
+use accelcal::output::{StagedFiles, check_directory};
+
+/// The files the three-axis calibration writes.
+const ESTIMATES_FILE: &str = "estimates.csv";
+const SUMMARY_FILE: &str = "summary.json";
+
+/// The options of the one-axis calibration that the three-axis one does not take yet.
+fn refuse_one_axis_options(args: &CalibrateArgs) -> Result<(), ConfigError> {
+    let given = [
+        ("--every-sample", args.every_sample),
+        ("--estimate-noise", args.estimate_noise),
+        ("--config", args.config.is_some()),
+    ];
+    match given.iter().find(|(_, g)| *g) {
+        Some((name, _)) => Err(ConfigError::invalid(
+            name,
+            "given with --imu",
+            "an option of the one-axis calibration (--accel/--gps); the three-axis calibration \
+             runs with the documented consumer-MEMS assumptions, which summary.json lists",
+        )),
+        None => Ok(()),
+    }
+}
+
+pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
+    refuse_one_axis_options(args)?;
+    let settings: Settings = CONSUMER;
+    check_directory(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE])?;
+    if !args.quiet && std::io::stderr().is_terminal() {
+        eprintln!("checking the logs, aligning and running the filter…");
+    }
+    let (imu_log, gnss_log) = (LogFile::new(imu), LogFile::new(gnss));
+    let c = calibrate(&imu_log, &gnss_log, &settings).map_err(anyhow_of)?;
+    let s = summary(&c, &settings, &imu.display().to_string());
+    let mut staged = StagedFiles::create(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE])?;
+    let into = |name: &str| format!("cannot write {}", args.out.join(name).display());
+    write_estimates(&c, staged.writer(ESTIMATES_FILE)).with_context(|| into(ESTIMATES_FILE))?;
+    let json = serde_json::to_string_pretty(&s).expect("the summary serializes") + "\n";
+    staged
+        .writer(SUMMARY_FILE)
+        .write_all(json.as_bytes())
+        .with_context(|| into(SUMMARY_FILE))?;
+    staged.commit()?;
+    print_result(&s)
+}
+
+/// The error as the exit code reads it: a bad log or a recording that cannot be aligned is
+/// the user's to fix.
+fn anyhow_of(e: ImuCalibrateError) -> anyhow::Error {
+    match e {
+        ImuCalibrateError::Log(l) => l.into(),
+        other => anyhow::Error::new(super::logs::UsageError(other.to_string())),
+    }
+}
+
+/// The result on standard output, the warnings on standard error.
+fn print_result(s: &Summary) -> Result<()> {
+    for w in &s.warnings {
+        eprintln!("warning: {w}");
+    }
+    let triad = |name: &str, t: &accelcal::calibrate::imu::summary::Triad, unit: &str| {
+        let parts: Vec<String> = (0..3)
+            .map(|i| {
+                let id = if t.identifiable[i] {
+                    ""
+                } else {
+                    " (not determined)"
+                };
+                format!(
+                    "{} {:+.5} ± {:.5}{id}",
+                    ["x", "y", "z"][i],
+                    t.value[i],
+                    t.sigma[i]
+                )
+            })
+            .collect();
+        format!("{name} ({unit}): {}\n", parts.join(", "))
+    };
+    let a = &s.attitude_deg;
+    let mut out = triad("gyro bias", &s.gyro_bias_rad_s, "rad/s");
+    out += &triad("accelerometer bias", &s.accel_bias_m_s2, "m/s²");
+    out += &format!(
+        "attitude at the end: roll {:.2}° ± {:.2}, pitch {:.2}° ± {:.2}, yaw {:.2}° ± {:.2}{}\n",
+        a.roll,
+        a.sigma_roll,
+        a.pitch,
+        a.sigma_pitch,
+        a.yaw,
+        a.sigma_yaw,
+        if a.yaw_identifiable {
+            ""
+        } else {
+            " (yaw not determined beyond the course)"
+        }
+    );
+    out += &format!(
+        "NIS: sum {:.1} over {} fixes, band [{:.1}, {:.1}] at α = {}: {}\n",
+        s.nis.sum, s.nis.fixes, s.nis.lower, s.nis.upper, s.nis.false_alarm_rate, s.nis.verdict
+    );
+    if s.intervals_conditional {
+        out += &format!(
+            "the σ's assume a model that {} reject(s)\n",
+            s.rejected_by.join(", ")
+        );
+    }
+    let mut stdout = std::io::stdout().lock();
+    stdout
+        .write_all(out.as_bytes())
+        .map_err(|e| anyhow::Error::new(super::StdoutError(e)))
+}
