@@ -6,9 +6,11 @@ use std::path::Path;
 use anyhow::{Context, Result};
 
 use crate::cli::CalibrateArgs;
+use accelcal::calibrate::imu::config::settings_of;
 use accelcal::calibrate::imu::run::{ImuCalibrateError, calibrate};
 use accelcal::calibrate::imu::summary::{Summary, summary, write_estimates};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
+use accelcal::config::ConfigText;
 use accelcal::error::ConfigError;
 use accelcal::logs::read::LogFile;
 use accelcal::output::{StagedFiles, check_directory};
@@ -22,14 +24,13 @@ fn refuse_one_axis_options(args: &CalibrateArgs) -> Result<(), ConfigError> {
     let given = [
         ("--every-sample", args.every_sample),
         ("--estimate-noise", args.estimate_noise),
-        ("--config", args.config.is_some()),
     ];
     match given.iter().find(|(_, g)| *g) {
         Some((name, _)) => Err(ConfigError::invalid(
             name,
             "given with --imu",
             "an option of the one-axis calibration (--accel/--gps); the three-axis calibration \
-             runs with the documented consumer-MEMS assumptions, which summary.json lists",
+             does not estimate noise statistics yet: set them with --config",
         )),
         None => Ok(()),
     }
@@ -37,7 +38,10 @@ fn refuse_one_axis_options(args: &CalibrateArgs) -> Result<(), ConfigError> {
 
 pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
     refuse_one_axis_options(args)?;
-    let settings: Settings = CONSUMER;
+    let settings: Settings = match &args.config {
+        Some(path) => settings_of(&ConfigText::read(path)?)?,
+        None => CONSUMER,
+    };
     check_directory(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE])?;
     if !args.quiet && std::io::stderr().is_terminal() {
         eprintln!("checking the logs, aligning and running the filter…");

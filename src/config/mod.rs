@@ -15,7 +15,7 @@ mod false_alarm;
 pub mod ins;
 mod keys;
 mod sensitivity;
-mod source;
+pub mod source;
 pub mod statistics;
 
 use std::f64::consts::PI;

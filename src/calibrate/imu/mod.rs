@@ -12,6 +12,7 @@
 //!    assumption made.
 
 pub mod align;
+pub mod config;
 pub mod gnss;
 pub mod read;
 pub mod run;
