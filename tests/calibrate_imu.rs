@@ -3,7 +3,8 @@
 //! control; the same numbers from the same recording in other forms (forward-left-up axes,
 //! increments, gzip, fixes missing); and bad recordings refused with file, line and field.
 
-use accelcal::calibrate::imu::run::calibrate;
+use accelcal::calibrate::imu::run::{Calibrated, calibrate};
+use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ins::{Axes, InsConfig};
@@ -25,6 +26,8 @@ struct Recording {
     imu: String,
     gnss: String,
     truth: [f64; 6],
+    /// The biases at the middle of the drive, with its time, s.
+    middle: (f64, [f64; 6]),
 }
 
 fn study() -> Study {
@@ -35,17 +38,16 @@ fn recording(study: &Study, index: u64) -> Recording {
     let (mut imu, mut gnss, mut truth) = (Vec::new(), Vec::new(), Vec::new());
     write_realization(study, index, &mut imu, &mut gnss, &mut truth).expect("in memory");
     let truth = String::from_utf8(truth).expect("text");
-    let last: Vec<f64> = truth
-        .lines()
-        .last()
-        .expect("rows")
-        .split(',')
-        .map(|f| f.parse().expect("a number"))
-        .collect();
+    let row =
+        |l: &str| -> Vec<f64> { l.split(',').map(|f| f.parse().expect("a number")).collect() };
+    let last = row(truth.lines().last().expect("rows"));
+    let rows = truth.lines().count() - 1;
+    let mid = row(truth.lines().nth(rows / 2).expect("rows"));
     Recording {
         imu: String::from_utf8(imu).expect("text"),
         gnss: String::from_utf8(gnss).expect("text"),
         truth: std::array::from_fn(|i| last[10 + i]),
+        middle: (mid[0], std::array::from_fn(|i| mid[10 + i])),
     }
 }
 
@@ -74,12 +76,40 @@ fn settings_of(study: &Study) -> Settings {
 }
 
 fn run(imu: &str, gnss: &str, s: &Settings) -> Summary {
+    summary(&calibrated(imu, gnss, s), s, "imu.csv")
+}
+
+fn calibrated(imu: &str, gnss: &str, s: &Settings) -> Calibrated {
     let (i, g) = (
         LogText::new("imu.csv", imu.as_bytes()),
         LogText::new("gnss.csv", gnss.as_bytes()),
     );
-    let c = calibrate(&i, &g, s).expect("a simulated recording calibrates");
-    summary(&c, s, "imu.csv")
+    calibrate(&i, &g, s).expect("a simulated recording calibrates")
+}
+
+/// |error| / σ of the six smoothed biases at the fix at `t_s` against `truth`; and whether
+/// every smoothed σ is at most the filtered one (to 10⁻⁹) with the last fix's equal.
+fn smoothed_z(c: &Calibrated, t_s: f64, truth: &[f64; 6]) -> ([f64; 6], bool) {
+    let s = smooth(&c.records);
+    let k = c
+        .records
+        .iter()
+        .position(|r| (r.t_s - t_s).abs() < 1e-6)
+        .expect("a fix at the middle");
+    let p = &s[k].covariance;
+    let z = std::array::from_fn(|i| {
+        let v = if i < 3 {
+            s[k].gyro_bias_rad_s[i]
+        } else {
+            s[k].accel_bias_m_s2[i - 3]
+        };
+        (v - truth[i]).abs() / p[(9 + i, 9 + i)].sqrt()
+    });
+    let tighter = c.records.iter().zip(&s).all(|(r, sm)| {
+        (0..15).all(|i| sm.covariance[(i, i)] <= r.covariance[(i, i)] * (1.0 + 1e-9))
+    });
+    let last = s.last().expect("fixes").covariance == c.records.last().expect("fixes").covariance;
+    (z, tighter && last)
 }
 
 /// |error| / σ of the six biases.
@@ -102,21 +132,41 @@ fn band(n: u64, alpha: f64) -> (u64, u64) {
 }
 
 /// The six biases recovered against the truth over 100 recordings of the default 10-minute
-/// drive, each axis inside the binomial band of a 95 % interval at α = 1 % split over the six;
-/// the same recordings with the σ's halved (the half-width control) fall below it.
+/// drive — filtered at the end, and smoothed at the middle — each axis inside the binomial band
+/// of a 95 % interval at α = 1 % split over the twelve; the same recordings with the σ's halved
+/// (the half-width control) fall below it; every smoothed σ at most the filtered one.
 #[test]
 fn biases_are_within_their_sigmas_over_many_recordings() {
     let study = study();
     let settings = settings_of(&study);
-    let z: Vec<[f64; 6]> = (0..RECORDINGS)
+    let runs: Vec<([f64; 6], [f64; 6], bool)> = (0..RECORDINGS)
         .into_par_iter()
         .map(|i| {
             let r = recording(&study, i);
-            z_scores(&run(&r.imu, &r.gnss, &settings), &r.truth)
+            let c = calibrated(&r.imu, &r.gnss, &settings);
+            let (zs, tighter) = smoothed_z(&c, r.middle.0, &r.middle.1);
+            (
+                z_scores(&summary(&c, &settings, "imu.csv"), &r.truth),
+                zs,
+                tighter,
+            )
         })
         .collect();
-    let (lo, hi) = band(RECORDINGS, FALSE_ALARM / 6.0);
+    assert!(
+        runs.iter().all(|r| r.2),
+        "a smoothed σ above the filtered one"
+    );
+    let (lo, hi) = band(RECORDINGS, FALSE_ALARM / 12.0);
     let names = ["bgx", "bgy", "bgz", "bax", "bay", "baz"];
+    for (k, name) in names.iter().enumerate() {
+        let smoothed = runs.iter().filter(|r| r.1[k] <= 1.959_964).count() as u64;
+        eprintln!("{name}: smoothed at the middle, {smoothed} within 1.96σ");
+        assert!(
+            (lo..=hi).contains(&smoothed),
+            "{name} smoothed: {smoothed} of {RECORDINGS} within 1.96σ, band [{lo}, {hi}]"
+        );
+    }
+    let z: Vec<[f64; 6]> = runs.iter().map(|r| r.0).collect();
     for (k, name) in names.iter().enumerate() {
         let inside = z.iter().filter(|z| z[k] <= 1.959_964).count() as u64;
         let halved = z.iter().filter(|z| z[k] <= 1.959_964 / 2.0).count() as u64;

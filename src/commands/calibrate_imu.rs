@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use crate::cli::CalibrateArgs;
 use accelcal::calibrate::imu::config::settings_of;
 use accelcal::calibrate::imu::run::{ImuCalibrateError, calibrate};
+use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary, write_estimates};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ConfigText;
@@ -51,7 +52,9 @@ pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
     let s = summary(&c, &settings, &imu.display().to_string());
     let mut staged = StagedFiles::create(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE])?;
     let into = |name: &str| format!("cannot write {}", args.out.join(name).display());
-    write_estimates(&c, staged.writer(ESTIMATES_FILE)).with_context(|| into(ESTIMATES_FILE))?;
+    let smoothed = smooth(&c.records);
+    write_estimates(&c, &smoothed, staged.writer(ESTIMATES_FILE))
+        .with_context(|| into(ESTIMATES_FILE))?;
     let json = serde_json::to_string_pretty(&s).expect("the summary serializes") + "\n";
     staged
         .writer(SUMMARY_FILE)

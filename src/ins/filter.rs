@@ -16,6 +16,8 @@ use super::error_state::{
 use super::gnss::{self, Fix};
 use super::mech::{self, Increment, Pva};
 
+mod measured;
+
 /// A filter step that cannot go on.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum FilterError {
@@ -42,6 +44,8 @@ pub struct Innovation {
     pub covariance: DMatrix<f64>,
     /// νᵀS⁻¹ν.
     pub nis: f64,
+    /// The estimated errors K·ν the update took out of the solution.
+    pub correction: SVector<f64, STATES>,
 }
 
 /// How the filter carries its covariance from one IMU step to the next.
@@ -121,6 +125,9 @@ pub struct Ekf {
     fix_period_steps: Option<usize>,
     /// The previous step's compensated increments (for sculling and coning).
     before: Option<Increment>,
+    /// Φ from the last update to the last covariance propagation, when tracked (a smoother
+    /// needs it; [`Ekf::with_transition`]).
+    transition: Option<Matrix15>,
 }
 
 impl Ekf {
@@ -149,7 +156,22 @@ impl Ekf {
             steps_since_update: 0,
             fix_period_steps: None,
             before: None,
+            transition: None,
         }
+    }
+
+    /// The same filter keeping Φ from each update to the next ([`Ekf::take_transition`]).
+    #[must_use]
+    pub fn with_transition(mut self) -> Self {
+        self.flush();
+        self.transition = Some(Matrix15::identity());
+        self
+    }
+
+    /// Φ from the last update (or the start) to the last covariance propagation, restarted at
+    /// the identity; `None` unless tracked.
+    pub fn take_transition(&mut self) -> Option<Matrix15> {
+        self.transition.replace(Matrix15::identity())
     }
 
     /// The same filter propagating its covariance as `propagation` says.
@@ -199,6 +221,9 @@ impl Ekf {
                 let phi = discrete::transition(&big_f, now.dt_s);
                 let q = discrete::process_noise(&phi, &self.noise, now.dt_s);
                 self.covariance = phi * self.covariance * phi.transpose() + q;
+                if let Some(t) = self.transition.as_mut() {
+                    *t = phi * *t;
+                }
             }
             Propagation::Interval { interval_s } => self.gather(&f_b, now.dt_s, interval_s),
         }
@@ -259,6 +284,9 @@ impl Ekf {
         let phi = discrete::transition_third_order(&big_f, p.t_s);
         let q = discrete::process_noise_series(&big_f, &self.noise, p.t_s);
         self.covariance = discrete::transition_congruence(&phi, &self.covariance) + q;
+        if let Some(t) = self.transition.as_mut() {
+            *t = phi * *t;
+        }
     }
 
     /// The update by `fix` (the pending steps first propagated): the innovation, the
@@ -296,69 +324,7 @@ impl Ekf {
             nis: nu.1,
             residual: nu.0,
             covariance: s,
-        })
-    }
-
-    /// The update by `fix` measuring only the velocity components `measured` says (north, east,
-    /// down; the position always): a receiver that reports no vertical velocity, or none.
-    ///
-    /// # Errors
-    /// [`FilterError::Innovation`] when S is not positive definite.
-    pub fn update_measured(
-        &mut self,
-        fix: &Fix,
-        measured: [bool; 3],
-    ) -> Result<Innovation, FilterError> {
-        if measured == [true; 3] || fix.velocity_ned_m_s.is_none() || measured == [false; 3] {
-            let mut f = *fix;
-            if measured == [false; 3] {
-                f.velocity_ned_m_s = None;
-            }
-            return self.update(&f);
-        }
-        self.flush();
-        self.fix_period_steps = Some(self.steps_since_update);
-        self.steps_since_update = 0;
-        let omega = self
-            .before
-            .map_or(Vector3::zeros(), |b| b.dtheta_rad / b.dt_s);
-        let (position, velocity) = gnss::antenna(&self.pva, &self.lever_arm_b_m, &omega);
-        let h6 = gnss::observation(&self.pva, &self.lever_arm_b_m, &omega);
-        let v = fix.velocity_ned_m_s.unwrap_or_else(Vector3::zeros);
-        let z6 = [
-            gnss::ned_difference_m(&position, &fix.position).as_slice(),
-            (velocity - v).as_slice(),
-        ]
-        .concat();
-        let sr = &fix.position_sigma_m;
-        let sv = &fix.velocity_sigma_m_s;
-        let r6 = [sr.x, sr.y, sr.z, sv.x, sv.y, sv.z].map(|s| s * s);
-        let rows: Vec<usize> = (0..6).filter(|&i| i < 3 || measured[i - 3]).collect();
-        let h = DMatrix::from_fn(rows.len(), STATES, |i, j| h6[(rows[i], j)]);
-        let z = DVector::from_fn(rows.len(), |i, _| z6[rows[i]]);
-        let r = DVector::from_fn(rows.len(), |i, _| r6[rows[i]]);
-        let p = DMatrix::from_column_slice(STATES, STATES, self.covariance.as_slice());
-        let hp = &h * &p;
-        let s = &hp * h.transpose() + DMatrix::from_diagonal(&r);
-        let t_s = fix.t_s;
-        let chol = s
-            .clone()
-            .cholesky()
-            .ok_or(FilterError::Innovation { t_s })?;
-        let k = chol.solve(&hp).transpose();
-        let nis = z.dot(&chol.solve(&z));
-        let dx = &k * &z;
-        let i_kh = DMatrix::identity(STATES, STATES) - &k * &h;
-        let kr = &k * DMatrix::from_diagonal(&r);
-        let p_new = &i_kh * &p * i_kh.transpose() + kr * k.transpose();
-        let p_new = (&p_new + p_new.transpose()) * 0.5;
-        self.covariance = Matrix15::from_column_slice(p_new.as_slice());
-        self.correct(&SVector::<f64, STATES>::from_column_slice(dx.as_slice()));
-        Ok(Innovation {
-            t_s,
-            residual: z,
-            covariance: s,
-            nis,
+            correction: dx,
         })
     }
 
@@ -389,20 +355,36 @@ impl Ekf {
         Ok((dx, (nu, nis), s))
     }
 
-    /// The closed-loop correction by the estimated errors `dx` (estimate minus truth): each part
-    /// of the solution has its error taken out, and the error state is zero again.
+    /// The closed-loop correction by the estimated errors `dx` ([`apply_correction`]).
     fn correct(&mut self, dx: &SMatrix<f64, STATES, 1>) {
-        let p = &mut self.pva.position;
-        let (rn, re) = super::earth::radii_m(p.lat_rad);
-        let dr = dx.fixed_rows::<3>(POSITION);
-        p.lat_rad -= dr[0] / (rn + p.height_m);
-        p.lon_rad -= dr[1] / ((re + p.height_m) * p.lat_rad.cos());
-        p.height_m += dr[2];
-        self.pva.velocity_ned_m_s -= dx.fixed_rows::<3>(VELOCITY);
-        // Ĉ = exp([δψ×])C, so C = exp(−[δψ×])Ĉ.
-        let psi = dx.fixed_rows::<3>(ATTITUDE).into_owned();
-        self.pva.attitude = UnitQuaternion::from_scaled_axis(-psi) * self.pva.attitude;
-        self.gyro_bias_rad_s -= dx.fixed_rows::<3>(GYRO_BIAS);
-        self.accel_bias_m_s2 -= dx.fixed_rows::<3>(ACCEL_BIAS);
+        apply_correction(
+            &mut self.pva,
+            &mut self.gyro_bias_rad_s,
+            &mut self.accel_bias_m_s2,
+            dx,
+        );
     }
+}
+
+/// The closed-loop correction by the estimated errors `dx` (estimate minus truth): each part of
+/// the solution and the biases has its error taken out (a smoother applies its own corrections
+/// to a filtered solution the same way).
+pub fn apply_correction(
+    pva: &mut Pva,
+    gyro_bias_rad_s: &mut Vector3<f64>,
+    accel_bias_m_s2: &mut Vector3<f64>,
+    dx: &SMatrix<f64, STATES, 1>,
+) {
+    let p = &mut pva.position;
+    let (rn, re) = super::earth::radii_m(p.lat_rad);
+    let dr = dx.fixed_rows::<3>(POSITION);
+    p.lat_rad -= dr[0] / (rn + p.height_m);
+    p.lon_rad -= dr[1] / ((re + p.height_m) * p.lat_rad.cos());
+    p.height_m += dr[2];
+    pva.velocity_ned_m_s -= dx.fixed_rows::<3>(VELOCITY);
+    // Ĉ = exp([δψ×])C, so C = exp(−[δψ×])Ĉ.
+    let psi = dx.fixed_rows::<3>(ATTITUDE).into_owned();
+    pva.attitude = UnitQuaternion::from_scaled_axis(-psi) * pva.attitude;
+    *gyro_bias_rad_s -= dx.fixed_rows::<3>(GYRO_BIAS);
+    *accel_bias_m_s2 -= dx.fixed_rows::<3>(ACCEL_BIAS);
 }

@@ -7,7 +7,8 @@
 //!    window before it, and the prior covariance carries the alignment's errors.
 //! 3. `run`: the filter from that fix on, each fix at its own time between IMU samples (the
 //!    step cut there), one record per fix.
-//! 4. `summary`: the six biases and the attitude at the end with σ's, intervals and whether the
+//! 4. `smoother`: the Rauch–Tung–Striebel pass backwards over the fixes.
+//! 5. `summary`: the six biases and the attitude at the end with σ's, intervals and whether the
 //!    drive determined them; the NIS test and the innovations' whiteness per component; every
 //!    assumption made.
 
@@ -16,6 +17,7 @@ pub mod config;
 pub mod gnss;
 pub mod read;
 pub mod run;
+pub mod smoother;
 pub mod summary;
 
 use nalgebra::Vector3;

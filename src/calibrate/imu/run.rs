@@ -2,7 +2,7 @@
 //! way, the filter started at the alignment's fix and updated at every later fix at its own
 //! time (the IMU step that holds it cut there, its increments shared in proportion).
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, SVector, Vector3};
 use thiserror::Error;
 
 use super::Settings;
@@ -10,7 +10,9 @@ use super::align::{self, AlignSettings, Alignment, Plan, Sources};
 use super::gnss::{GnssRow, read_gnss};
 use super::read::{ImuLayout, ImuReader, ImuSpan};
 use crate::ins::discrete::NoiseDensities;
-use crate::ins::error_state::{ACCEL_BIAS, ATTITUDE, BiasDecay, GYRO_BIAS, Matrix15, POSITION};
+use crate::ins::error_state::{
+    ACCEL_BIAS, ATTITUDE, BiasDecay, GYRO_BIAS, Matrix15, POSITION, STATES,
+};
 use crate::ins::filter::{Ekf, FilterError};
 use crate::ins::gnss::Fix;
 use crate::ins::mech::{Increment, Pva};
@@ -51,6 +53,12 @@ pub struct FixRecord {
     pub accel_bias_m_s2: Vector3<f64>,
     /// The covariance after the update.
     pub covariance: Matrix15,
+    /// The covariance before it.
+    pub prior_covariance: Matrix15,
+    /// Φ from the previous fix's update (or the start) to this fix.
+    pub transition: Matrix15,
+    /// The errors the update took out of the solution.
+    pub correction: SVector<f64, STATES>,
     /// The innovation: position NED (m), velocity NED (m/s); NaN where not measured.
     pub innovation: [f64; 6],
     /// √S of each component; NaN where not measured.
@@ -164,7 +172,7 @@ fn start(h: &GnssRow, a: &Alignment, s: &Settings) -> Ekf {
         p0[(GYRO_BIAS + i, GYRO_BIAS + i)] = s.gyro_bias_sigma_rad_s.powi(2);
     }
     let (noise, decay) = noise(s);
-    Ekf::new(pva, p0, noise, decay, s.lever_arm())
+    Ekf::new(pva, p0, noise, decay, s.lever_arm()).with_transition()
 }
 
 /// Calibrates the recording `imu` + `gnss` with the assumptions `s`.
@@ -352,6 +360,9 @@ fn update(
     for (m, &k) in missing.iter_mut().zip(&measured) {
         *m += usize::from(!k);
     }
+    f.flush();
+    let prior_covariance = f.covariance;
+    let transition = f.take_transition().unwrap_or_else(Matrix15::identity);
     let nu = f.update_measured(&fix, measured)?;
     let (mut innovation, mut innovation_sigma) = ([f64::NAN; 6], [f64::NAN; 6]);
     let components: Vec<usize> = (0..6).filter(|&i| i < 3 || measured[i - 3]).collect();
@@ -366,6 +377,9 @@ fn update(
         gyro_bias_rad_s: f.gyro_bias_rad_s,
         accel_bias_m_s2: f.accel_bias_m_s2,
         covariance: f.covariance,
+        prior_covariance,
+        transition,
+        correction: nu.correction,
         innovation,
         innovation_sigma,
         nis: nu.nis,

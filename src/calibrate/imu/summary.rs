@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use super::Settings;
 use super::run::{Calibrated, FixRecord, bias_sigmas, euler_sigmas};
+use super::smoother::Smoothed;
 use crate::calibrate::diagnose::whiteness::{Whiteness, whiteness};
 use crate::calibrate::{NisTest, nis_test_rows};
 use crate::ins::euler_of;
@@ -317,16 +318,25 @@ pitch_deg,yaw_deg,bgx_rad_s,bgy_rad_s,bgz_rad_s,bax_m_s2,bay_m_s2,baz_m_s2,sigma
 sigma_d_m,sigma_vn_m_s,sigma_ve_m_s,sigma_vd_m_s,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg,\
 sigma_bgx_rad_s,sigma_bgy_rad_s,sigma_bgz_rad_s,sigma_bax_m_s2,sigma_bay_m_s2,sigma_baz_m_s2,\
 nu_n_m,nu_e_m,nu_d_m,nu_vn_m_s,nu_ve_m_s,nu_vd_m_s,sqrt_s_n_m,sqrt_s_e_m,sqrt_s_d_m,\
-sqrt_s_vn_m_s,sqrt_s_ve_m_s,sqrt_s_vd_m_s,nis,nis_dof";
+sqrt_s_vn_m_s,sqrt_s_ve_m_s,sqrt_s_vd_m_s,nis,nis_dof,smoothed_roll_deg,smoothed_pitch_deg,\
+smoothed_yaw_deg,smoothed_bgx_rad_s,smoothed_bgy_rad_s,smoothed_bgz_rad_s,smoothed_bax_m_s2,\
+smoothed_bay_m_s2,smoothed_baz_m_s2,smoothed_sigma_roll_deg,smoothed_sigma_pitch_deg,\
+smoothed_sigma_yaw_deg,smoothed_sigma_bgx_rad_s,smoothed_sigma_bgy_rad_s,smoothed_sigma_bgz_rad_s,\
+smoothed_sigma_bax_m_s2,smoothed_sigma_bay_m_s2,smoothed_sigma_baz_m_s2";
 
 /// `estimates.csv`: one row per fix (the filtered estimates after its update, their σ's, the
-/// innovation, √S and the NIS; `nan` where a component was not measured).
+/// innovation, √S and the NIS, `nan` where a component was not measured; then the smoothed
+/// attitude and biases with their σ's).
 ///
 /// # Errors
 /// The writer's.
-pub fn write_estimates(c: &Calibrated, out: &mut impl Write) -> io::Result<()> {
+pub fn write_estimates(
+    c: &Calibrated,
+    smoothed: &[Smoothed],
+    out: &mut impl Write,
+) -> io::Result<()> {
     writeln!(out, "{ESTIMATES_HEADER}")?;
-    for r in &c.records {
+    for (r, sm) in c.records.iter().zip(smoothed) {
         let p = &r.pva.position;
         let v = r.pva.velocity_ned_m_s;
         let (roll, pitch, yaw) = euler_of(&r.pva.attitude);
@@ -355,6 +365,15 @@ pub fn write_estimates(c: &Calibrated, out: &mut impl Write) -> io::Result<()> {
         row.extend(r.innovation_sigma);
         row.push(r.nis);
         row.push(r.rows as f64);
+        let (roll, pitch, yaw) = euler_of(&sm.pva.attitude);
+        row.extend([roll, pitch, yaw].map(f64::to_degrees));
+        row.extend(sm.gyro_bias_rad_s.iter());
+        row.extend(sm.accel_bias_m_s2.iter());
+        let [sr, sp, sy] = euler_sigmas(&sm.pva, &sm.covariance);
+        row.extend([sr, sp, sy].map(f64::to_degrees));
+        let (sg, sa) = bias_sigmas(&sm.covariance);
+        row.extend(sg);
+        row.extend(sa);
         let mut line = String::new();
         crate::logs::write::push_row(&mut line, &row);
         out.write_all(line.as_bytes())?;
