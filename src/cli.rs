@@ -8,7 +8,7 @@ use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
 use accelcal::config::{AccelerometerOutput, TruthModel};
 use accelcal::ensemble::Engine;
 
-mod calibrate;
+pub mod calibrate;
 pub use calibrate::CalibrateArgs;
 
 /// Calibrates an accelerometer's bias with GPS through a Kalman filter, checks the filter with a

@@ -296,3 +296,41 @@ fn missing_fixes_leave_the_biases_within_their_sigmas() {
         }
     }
 }
+
+/// `--estimate-noise` on one simulated recording, started from a horizontal σ three times the
+/// truth's: the maximum-likelihood horizontal σ's interval holds the true 1 m and the time
+/// offset's holds 0 (one recording: a check of the machinery, not of the coverage).
+#[test]
+fn noise_estimate_finds_the_receivers_sigma_and_no_offset() {
+    use accelcal::calibrate::imu::gnss::read_gnss;
+    use accelcal::calibrate::imu::noise::{ImuKey, estimate};
+    use accelcal::calibrate::imu::read::read_steps;
+    // The drive's first 240 s (three turns, two climbs, four speed changes) keep it quick.
+    let mut config = InsConfig::default();
+    config.drive.duration_s = 240.0;
+    let study = Study::from_config(&config).expect("valid");
+    let truth = settings_of(&study);
+    let r = recording(&study, 11);
+    let start = Settings {
+        gnss_position_sigma_m: [3.0, 3.0, 2.0],
+        ..truth
+    };
+    let rows = read_gnss(&LogText::new("gnss.csv", r.gnss.as_bytes())).expect("reads");
+    let imu = LogText::new("imu.csv", r.imu.as_bytes());
+    let (steps, span, _) = read_steps(&imu, start.axes).expect("reads");
+    let keys = [ImuKey::GnssHorizontalSigma, ImuKey::GnssTimeOffset];
+    let e = estimate(&rows, &steps, &span, &start, &keys, 0.95).expect("finite");
+    let (sigma, offset) = (&e.keys[0], &e.keys[1]);
+    eprintln!("{sigma:?}\n{offset:?}\n{} evaluations", e.evaluations);
+    assert!(sigma.identifiable && offset.identifiable);
+    assert!(
+        sigma.lower.unwrap() < 1.0 && 1.0 < sigma.upper.unwrap(),
+        "{sigma:?}"
+    );
+    assert!(
+        offset.lower.unwrap() < 0.0 && 0.0 < offset.upper.unwrap(),
+        "{offset:?}"
+    );
+    // The negative control: the configured 3 m lies outside the interval.
+    assert!(sigma.upper.unwrap() < 3.0);
+}

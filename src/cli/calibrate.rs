@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 use clap::builder::TypedValueParser;
 
+use accelcal::calibrate::imu::noise::ImuKey;
 use accelcal::likelihood::Key;
 
 /// Options of `calibrate`.
@@ -44,7 +45,7 @@ pub struct CalibrateArgs {
     pub estimate_noise: bool,
     /// The statistics --estimate-noise searches [default: the two GPS σ's, and
     /// bias_random_walk_m_s2_per_sqrt_s when the filter's bias is a random walk; naming it makes
-    /// a constant bias a random walk].
+    /// a constant bias a random walk. With --imu: the GNSS σ's, the VRW and the time offset].
     #[arg(
         long,
         value_name = "KEY,…",
@@ -52,7 +53,7 @@ pub struct CalibrateArgs {
         requires = "estimate_noise",
         value_parser = estimate_keys()
     )]
-    pub estimate: Vec<Key>,
+    pub estimate: Vec<EstimateKey>,
     /// The confidence of --estimate-noise's intervals, in (0, 1).
     #[arg(long, value_name = "P", default_value_t = 0.95, value_parser = confidence,
           requires = "estimate_noise")]
@@ -62,10 +63,30 @@ pub struct CalibrateArgs {
     pub quiet: bool,
 }
 
+/// A statistic `--estimate` names: of the one-axis calibration or of the three-axis one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EstimateKey {
+    /// A one-axis statistic (`--accel`/`--gps`).
+    OneAxis(Key),
+    /// A three-axis key (`--imu`/`--gnss`).
+    ThreeAxis(ImuKey),
+}
+
+impl EstimateKey {
+    /// Its name.
+    pub fn name(self) -> &'static str {
+        match self {
+            EstimateKey::OneAxis(k) => k.name(),
+            EstimateKey::ThreeAxis(k) => k.name(),
+        }
+    }
+}
+
 /// The statistics `--estimate` accepts, each named by its `[filter]` key: every searchable row of
-/// the statistics' table ([`Key::ALL`]), with its words and unit as help.
-fn estimate_keys() -> impl TypedValueParser<Value = Key> {
-    let values = Key::ALL.map(|k| {
+/// the statistics' table ([`Key::ALL`]) and the three-axis keys ([`ImuKey::ALL`]), with their
+/// words and unit as help.
+fn estimate_keys() -> impl TypedValueParser<Value = EstimateKey> {
+    let one = Key::ALL.map(|k| {
         let words = k.0.words;
         let mut help = words[..1].to_uppercase();
         help.push_str(&words[1..]);
@@ -73,8 +94,16 @@ fn estimate_keys() -> impl TypedValueParser<Value = Key> {
         help.push_str(k.unit());
         clap::builder::PossibleValue::new(k.name()).help(help)
     });
-    clap::builder::PossibleValuesParser::new(values)
-        .map(|name| Key::parse(&name).expect("a possible value is a key's name"))
+    let three = ImuKey::ALL.map(|k| {
+        let help = format!("With --imu: {}", k.words());
+        clap::builder::PossibleValue::new(k.name()).help(help)
+    });
+    clap::builder::PossibleValuesParser::new(one.into_iter().chain(three)).map(|name| {
+        Key::parse(&name).map_or_else(
+            || EstimateKey::ThreeAxis(ImuKey::parse(&name).expect("a possible value is a key")),
+            EstimateKey::OneAxis,
+        )
+    })
 }
 
 /// A confidence strictly between 0 and 1.

@@ -6,14 +6,18 @@ use std::path::Path;
 use anyhow::{Context, Result};
 
 use crate::cli::CalibrateArgs;
+use crate::cli::calibrate::EstimateKey;
 use accelcal::calibrate::imu::config::settings_of;
-use accelcal::calibrate::imu::run::{ImuCalibrateError, calibrate};
+use accelcal::calibrate::imu::gnss::read_gnss;
+use accelcal::calibrate::imu::noise::{self, ImuKey};
+use accelcal::calibrate::imu::read::read_steps;
+use accelcal::calibrate::imu::run::{Calibrated, ImuCalibrateError, calibrate, calibrate_held};
 use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary, write_estimates};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ConfigText;
 use accelcal::error::ConfigError;
-use accelcal::logs::read::LogFile;
+use accelcal::logs::read::{LogFile, LogSource};
 use accelcal::output::{StagedFiles, check_directory};
 
 /// The files the three-axis calibration writes.
@@ -22,16 +26,13 @@ const SUMMARY_FILE: &str = "summary.json";
 
 /// The options of the one-axis calibration that the three-axis one does not take yet.
 fn refuse_one_axis_options(args: &CalibrateArgs) -> Result<(), ConfigError> {
-    let given = [
-        ("--every-sample", args.every_sample),
-        ("--estimate-noise", args.estimate_noise),
-    ];
+    let given = [("--every-sample", args.every_sample)];
     match given.iter().find(|(_, g)| *g) {
         Some((name, _)) => Err(ConfigError::invalid(
             name,
             "given with --imu",
             "an option of the one-axis calibration (--accel/--gps); the three-axis calibration \
-             does not estimate noise statistics yet: set them with --config",
+             writes one row per fix",
         )),
         None => Ok(()),
     }
@@ -48,8 +49,13 @@ pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
         eprintln!("checking the logs, aligning and running the filter…");
     }
     let (imu_log, gnss_log) = (LogFile::new(imu), LogFile::new(gnss));
-    let c = calibrate(&imu_log, &gnss_log, &settings).map_err(anyhow_of)?;
-    let s = summary(&c, &settings, &imu.display().to_string());
+    let (c, s) = if args.estimate_noise {
+        with_noise(args, &imu_log, &gnss_log, &settings)?
+    } else {
+        let c = calibrate(&imu_log, &gnss_log, &settings).map_err(anyhow_of)?;
+        let s = summary(&c, &settings, &imu.display().to_string());
+        (c, s)
+    };
     let mut staged = StagedFiles::create(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE])?;
     let into = |name: &str| format!("cannot write {}", args.out.join(name).display());
     let smoothed = smooth(&c.records);
@@ -62,6 +68,61 @@ pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
         .with_context(|| into(SUMMARY_FILE))?;
     staged.commit()?;
     print_result(&s)
+}
+
+/// The keys `--estimate` names for the three-axis path, or its default ones.
+fn imu_keys(args: &CalibrateArgs) -> Result<Vec<ImuKey>> {
+    if args.estimate.is_empty() {
+        return Ok(ImuKey::DEFAULT.to_vec());
+    }
+    args.estimate
+        .iter()
+        .map(|k| match k {
+            EstimateKey::ThreeAxis(k) => Ok(*k),
+            EstimateKey::OneAxis(k) => Err(anyhow::Error::new(super::logs::UsageError(format!(
+                "--estimate {}: a statistic of the one-axis calibration (--accel/--gps); with \
+                 --imu the keys are {}",
+                k.name(),
+                ImuKey::ALL.map(ImuKey::name).join(", ")
+            )))),
+        })
+        .collect()
+}
+
+/// `--estimate-noise`: the logs held, the keys estimated, the recording calibrated with them.
+fn with_noise(
+    args: &CalibrateArgs,
+    imu: &LogFile,
+    gnss: &LogFile,
+    settings: &Settings,
+) -> Result<(Calibrated, Summary)> {
+    let keys = imu_keys(args)?;
+    let rows = read_gnss(gnss)?;
+    let (steps, span, layout) = read_steps(imu, settings.axes)?;
+    if !args.quiet && std::io::stderr().is_terminal() {
+        eprintln!(
+            "estimating {} by maximum likelihood…",
+            keys.iter().map(|k| k.name()).collect::<Vec<_>>().join(", ")
+        );
+    }
+    let estimate = noise::estimate(&rows, &steps, &span, settings, &keys, args.confidence)
+        .ok_or_else(|| {
+            anyhow::Error::new(super::logs::UsageError(
+                "the likelihood of the drive is not finite at the configured statistics: the \
+                 filter cannot start from them"
+                    .to_string(),
+            ))
+        })?;
+    let c = calibrate_held(
+        &rows,
+        (&steps, span, layout),
+        &estimate.settings,
+        gnss.name(),
+    )
+    .map_err(anyhow_of)?;
+    let mut s = summary(&c, &estimate.settings, imu.name());
+    s.noise_estimate = Some(estimate);
+    Ok((c, s))
 }
 
 /// The error as the exit code reads it: a bad log or a recording that cannot be aligned is

@@ -7,6 +7,7 @@ use std::path::Path;
 use std::io::Write as _;
 
 use super::{load_model, write};
+use crate::cli::calibrate::EstimateKey;
 use crate::cli::{CalibrateArgs, SimulateArgs};
 use accelcal::calibrate::CalibrateError;
 use accelcal::calibrate::{self, Settings};
@@ -236,7 +237,20 @@ fn noise_request(args: &CalibrateArgs, settings: &Settings) -> Result<Option<Req
     if !args.estimate_noise {
         return Ok(None);
     }
-    Request::new(&args.estimate, args.confidence, &settings.filter_stats)
+    let mut keys = Vec::new();
+    for k in &args.estimate {
+        match k {
+            EstimateKey::OneAxis(k) => keys.push(*k),
+            EstimateKey::ThreeAxis(k) => {
+                return Err(UsageError(format!(
+                    "--estimate {}: a key of the three-axis calibration (--imu/--gnss)",
+                    k.name()
+                ))
+                .into());
+            }
+        }
+    }
+    Request::new(&keys, args.confidence, &settings.filter_stats)
         .map(Some)
         .map_err(|e| UsageError(e.to_string()).into())
 }
@@ -312,7 +326,7 @@ fn calibrate_command(args: &CalibrateArgs) -> String {
     if args.estimate_noise {
         s.push_str(" --estimate-noise");
         if !args.estimate.is_empty() {
-            let keys: Vec<&str> = args.estimate.iter().map(|&k| k.name()).collect();
+            let keys: Vec<&str> = args.estimate.iter().map(|k| k.name()).collect();
             s.push_str(&format!(" --estimate {}", keys.join(",")));
         }
         if args.confidence != 0.95 {

@@ -241,13 +241,23 @@ impl Ekf {
     fn gather(&mut self, f_b: &Vector3<f64>, dt: f64, interval_s: f64) {
         let c = *self.pva.attitude.to_rotation_matrix().matrix();
         let period = self.fix_period_steps;
-        // Intervals that tile the time between fixes, so that a fix ends one and P is current
-        // when it is read before the update: the largest divisor of the fix period up to the
-        // nominal interval; one step until the first fix has shown the period.
+        // Intervals of the nominal length, or of the fix period when that is shorter; one step
+        // until the first fix has shown the period. A period the nominal interval divides is
+        // tiled by whole intervals, so that P is current at each evenly spaced fix; otherwise
+        // the update flushes the interval it cuts (a fix between two IMU samples makes the
+        // period a count of steps with no useful divisor: 1 201 parts of steps between fixes
+        // at 1 200 Hz, a prime, which the largest divisor turned into a propagation per step).
         let target = || {
             let nominal = ((interval_s / dt).round() as usize).max(1);
             period.map_or(1, |m| {
-                (1..=nominal.min(m)).rev().find(|d| m % d == 0).unwrap_or(1)
+                if m % nominal == 0 || m < nominal {
+                    nominal.min(m)
+                } else {
+                    (1..=nominal)
+                        .rev()
+                        .find(|d| m % d == 0 && 2 * d >= nominal)
+                        .unwrap_or(nominal)
+                }
             })
         };
         let pending = self.pending.get_or_insert_with(|| Pending {

@@ -12,7 +12,7 @@
 //! reported as not identifiable.
 
 pub mod evaluate;
-mod profile;
+pub mod profile;
 mod search;
 
 use rayon::prelude::*;
@@ -281,33 +281,68 @@ pub fn estimate(
             _ => (b.0 * b.1).sqrt().ln(),
         })
         .collect();
-    let objective = Objective::new(&f, lo.clone(), hi.clone());
-    if !objective.value(&u0).is_finite() {
-        return None;
-    }
-    let free: Vec<usize> = (0..keys.len()).collect();
-    let best = objective.maximize(&u0, &free);
-    let q = chi_squared_quantile(1.0, request.confidence, Tail::Lower);
-    let ends: Vec<profile::End> = (0..2 * keys.len())
-        .into_par_iter()
-        .map(|e| {
-            let side = if e % 2 == 0 { -1.0 } else { 1.0 };
-            profile::interval_end(&f, (&lo, &hi), &best, &free, (e / 2, side, q))
-        })
-        .collect();
-    let evaluations = objective.evaluations() + ends.iter().map(|e| e.evaluations).sum::<u64>();
+    let fit = maximize(&f, (&lo, &hi), &u0, request.confidence)?;
     let estimates = keys
         .iter()
         .enumerate()
-        .map(|(j, &key)| key_estimate(key, (best.u[j], lo[j], hi[j]), &ends[2 * j..2 * j + 2]))
+        .map(|(j, &key)| key_estimate(key, (fit.u[j], lo[j], hi[j]), &fit.ends[2 * j..2 * j + 2]))
         .collect();
     Some(NoiseEstimate {
-        log_likelihood: best.value,
-        evaluations,
+        log_likelihood: fit.value,
+        evaluations: fit.evaluations,
         confidence: request.confidence,
-        deviance_threshold: q,
+        deviance_threshold: fit.deviance_threshold,
         keys: estimates,
-        stats: stats_at(&best.u),
+        stats: stats_at(&fit.u),
+    })
+}
+
+/// The maximum of a log-likelihood and its variables' profile-likelihood intervals.
+#[derive(Clone, Debug)]
+pub struct Fit {
+    /// Where ℓ is largest.
+    pub u: Vec<f64>,
+    /// ℓ there.
+    pub value: f64,
+    /// Each variable's interval ends, lower then upper (`End::at` is `None` where the
+    /// deviance stays below the quantile up to the box).
+    pub ends: Vec<profile::End>,
+    /// −2·Δℓ at the ends: the χ²₁ quantile at the confidence.
+    pub deviance_threshold: f64,
+    /// Evaluations of ℓ in all.
+    pub evaluations: u64,
+}
+
+/// The maximum of `f` over the box [lo, hi] from `u0` (Newton with finite differences, an
+/// active set at the bounds), and each variable's profile-likelihood interval at `confidence`
+/// (the interval ends computed in parallel). `None` when `f` is not finite at `u0`.
+pub fn maximize(
+    f: &(dyn Fn(&[f64]) -> f64 + Sync),
+    (lo, hi): (&[f64], &[f64]),
+    u0: &[f64],
+    confidence: f64,
+) -> Option<Fit> {
+    let objective = Objective::new(f, lo.to_vec(), hi.to_vec());
+    if !objective.value(u0).is_finite() {
+        return None;
+    }
+    let free: Vec<usize> = (0..u0.len()).collect();
+    let best = objective.maximize(u0, &free);
+    let q = chi_squared_quantile(1.0, confidence, Tail::Lower);
+    let ends: Vec<profile::End> = (0..2 * u0.len())
+        .into_par_iter()
+        .map(|e| {
+            let side = if e % 2 == 0 { -1.0 } else { 1.0 };
+            profile::interval_end(f, (lo, hi), &best, &free, (e / 2, side, q))
+        })
+        .collect();
+    let evaluations = objective.evaluations() + ends.iter().map(|e| e.evaluations).sum::<u64>();
+    Some(Fit {
+        u: best.u,
+        value: best.value,
+        ends,
+        deviance_threshold: q,
+        evaluations,
     })
 }
 

@@ -33,6 +33,7 @@ struct Statistics {
     gnss_lever_arm_m: Option<[f64; 3]>,
     gnss_position_sigma_m: Option<[f64; 3]>,
     gnss_velocity_sigma_m_s: Option<f64>,
+    gnss_time_offset_s: Option<f64>,
 }
 
 #[derive(Clone, Debug, Default, Deserialize)]
@@ -65,6 +66,9 @@ struct File {
     #[serde(default)]
     alignment: Alignment,
 }
+
+/// The largest GNSS time offset accepted, s.
+pub const MAX_TIME_OFFSET_S: f64 = 0.5;
 
 /// The keys' accepted ranges: (field, value, lowest, highest, words).
 type Check = (&'static str, f64, f64, f64, &'static str);
@@ -158,6 +162,11 @@ pub fn settings_of(text: &ConfigText) -> Result<Settings, ConfigError> {
             .or(file.gnss.gnss_velocity_sigma_m_s)
             .unwrap_or(c.gnss_velocity_sigma_m_s),
         gnss_lever_arm_m: gnss(|s| s.gnss_lever_arm_m).unwrap_or(c.gnss_lever_arm_m),
+        gnss_time_offset_s: file
+            .filter
+            .gnss_time_offset_s
+            .or(file.gnss.gnss_time_offset_s)
+            .unwrap_or(c.gnss_time_offset_s),
         vertical_velocity_sigma_m_s: al
             .vertical_velocity_sigma_m_s
             .unwrap_or(c.vertical_velocity_sigma_m_s),
@@ -225,6 +234,7 @@ pub fn validate(s: &Settings) -> Result<(), ConfigError> {
         ("window_s", s.alignment_window_s, 0.05, 60.0, "in [0.05, 60] s"),
         ("heading_offset_sigma_deg", s.heading_offset_sigma_deg, 0.01, 30.0, "in [0.01, 30]° (a larger offset breaks the filter's linearization)"),
         ("false_alarm_rate", s.false_alarm_rate, 1e-6, 0.5, "in [1e-6, 0.5]"),
+        ("gnss_time_offset_s", s.gnss_time_offset_s, -MAX_TIME_OFFSET_S, MAX_TIME_OFFSET_S, "in [−0.5, 0.5] s"),
     ];
     for (field, tau) in [
         (

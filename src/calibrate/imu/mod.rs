@@ -15,9 +15,11 @@
 pub mod align;
 pub mod config;
 pub mod gnss;
+pub mod noise;
 pub mod read;
 pub mod run;
 pub mod smoother;
+mod step;
 pub mod summary;
 
 use nalgebra::Vector3;
@@ -51,6 +53,7 @@ pub const CONSUMER: Settings = Settings {
     gnss_position_sigma_m: [2.0, 2.0, 4.0],
     gnss_velocity_sigma_m_s: 0.1,
     gnss_lever_arm_m: [0.0; 3],
+    gnss_time_offset_s: 0.0,
     vertical_velocity_sigma_m_s: 0.5,
     heading_speed_m_s: 5.0,
     alignment_window_s: 2.0,
@@ -86,6 +89,9 @@ pub struct Settings {
     pub gnss_velocity_sigma_m_s: f64,
     /// The antenna from the IMU in body axes, m.
     pub gnss_lever_arm_m: [f64; 3],
+    /// The receiver's time offset, s: a fix stamped t describes the antenna at t + offset
+    /// (positive: the fixes are stamped early).
+    pub gnss_time_offset_s: f64,
     /// The σ of the vertical velocity 0 assumed at the start when the log has none, m/s.
     pub vertical_velocity_sigma_m_s: f64,
     /// The lowest horizontal speed whose course gives the heading, m/s.

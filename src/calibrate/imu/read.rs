@@ -250,3 +250,67 @@ impl<'a> ImuReader<'a> {
 fn csv_columns_are_rates(csv: &CsvReader<'_, 7>) -> bool {
     csv.columns()[1] == RATE_COLUMNS[1]
 }
+
+/// A source of IMU steps: the log's reader, or steps held in memory.
+pub trait StepSource {
+    /// The next step; `None` at the end.
+    ///
+    /// # Errors
+    /// The log's problem at that row.
+    fn next_step(&mut self) -> Result<Option<ImuStep>, LogError>;
+    /// The first row's time, once a step is read.
+    fn first_s(&self) -> Option<f64>;
+}
+
+impl StepSource for ImuReader<'_> {
+    fn next_step(&mut self) -> Result<Option<ImuStep>, LogError> {
+        ImuReader::next_step(self)
+    }
+
+    fn first_s(&self) -> Option<f64> {
+        ImuReader::first_s(self)
+    }
+}
+
+/// Steps held in memory, read from their start.
+pub struct HeldSteps<'a> {
+    steps: &'a [ImuStep],
+    next: usize,
+}
+
+impl<'a> HeldSteps<'a> {
+    /// The steps `steps`.
+    pub fn new(steps: &'a [ImuStep]) -> Self {
+        Self { steps, next: 0 }
+    }
+}
+
+impl StepSource for HeldSteps<'_> {
+    fn next_step(&mut self) -> Result<Option<ImuStep>, LogError> {
+        let step = self.steps.get(self.next).copied();
+        self.next += 1;
+        Ok(step)
+    }
+
+    fn first_s(&self) -> Option<f64> {
+        self.steps.first().map(|s| s.t_s - s.increment.dt_s)
+    }
+}
+
+/// The IMU log `imu` read whole: its steps, span and layout (`--estimate-noise` runs the
+/// filter over them many times).
+///
+/// # Errors
+/// The log's first problem, with its line.
+pub fn read_steps(
+    imu: &dyn LogSource,
+    axes: crate::config::ins::Axes,
+) -> Result<(Vec<ImuStep>, ImuSpan, ImuLayout), LogError> {
+    let mut reader = ImuReader::open(imu, axes)?;
+    let layout = reader.layout();
+    let mut steps = Vec::new();
+    while let Some(step) = reader.next_step()? {
+        steps.push(step);
+    }
+    Ok((steps, reader.finish()?, layout))
+}

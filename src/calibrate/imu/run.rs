@@ -2,20 +2,16 @@
 //! way, the filter started at the alignment's fix and updated at every later fix at its own
 //! time (the IMU step that holds it cut there, its increments shared in proportion).
 
-use nalgebra::{Matrix3, SVector, Vector3};
+use nalgebra::Vector3;
 use thiserror::Error;
 
 use super::Settings;
 use super::align::{self, AlignSettings, Alignment, Plan, Sources};
 use super::gnss::{GnssRow, read_gnss};
-use super::read::{ImuLayout, ImuReader, ImuSpan};
-use crate::ins::discrete::NoiseDensities;
-use crate::ins::error_state::{
-    ACCEL_BIAS, ATTITUDE, BiasDecay, GYRO_BIAS, Matrix15, POSITION, STATES,
-};
+use super::read::{HeldSteps, ImuLayout, ImuReader, ImuSpan, ImuStep, StepSource};
+pub use super::step::{FixRecord, bias_sigmas, euler_sigmas};
+use super::step::{Running, part, start, update, velocity_sigmas};
 use crate::ins::filter::{Ekf, FilterError};
-use crate::ins::gnss::Fix;
-use crate::ins::mech::{Increment, Pva};
 use crate::logs::read::LogSource;
 use crate::logs::{LogError, LogProblem};
 
@@ -36,37 +32,6 @@ pub enum ImuCalibrateError {
     /// The filter's covariance stopped being positive definite.
     #[error(transparent)]
     Filter(#[from] FilterError),
-}
-
-/// One fix's filtered estimates.
-#[derive(Clone, Debug, PartialEq)]
-pub struct FixRecord {
-    /// The fix's line in the GNSS log.
-    pub line: u64,
-    /// Its time, s.
-    pub t_s: f64,
-    /// The navigation solution after the update.
-    pub pva: Pva,
-    /// The gyro bias estimate, rad/s.
-    pub gyro_bias_rad_s: Vector3<f64>,
-    /// The accelerometer bias estimate, m/s².
-    pub accel_bias_m_s2: Vector3<f64>,
-    /// The covariance after the update.
-    pub covariance: Matrix15,
-    /// The covariance before it.
-    pub prior_covariance: Matrix15,
-    /// Φ from the previous fix's update (or the start) to this fix.
-    pub transition: Matrix15,
-    /// The errors the update took out of the solution.
-    pub correction: SVector<f64, STATES>,
-    /// The innovation: position NED (m), velocity NED (m/s); NaN where not measured.
-    pub innovation: [f64; 6],
-    /// √S of each component; NaN where not measured.
-    pub innovation_sigma: [f64; 6],
-    /// νᵀS⁻¹ν.
-    pub nis: f64,
-    /// The components measured.
-    pub rows: usize,
 }
 
 /// A calibrated recording.
@@ -92,126 +57,66 @@ pub struct Calibrated {
     pub missing_velocity: [usize; 3],
 }
 
-/// The increments of `inc` over the part of its step from `lo` to `hi` (its end `end`).
-fn part(inc: &Increment, end: f64, lo: f64, hi: f64) -> Increment {
-    let frac = (hi - lo) / inc.dt_s;
-    debug_assert!(hi <= end + 1e-9);
-    Increment {
-        dtheta_rad: inc.dtheta_rad * frac,
-        dvel_m_s: inc.dvel_m_s * frac,
-        dt_s: hi - lo,
-    }
+/// The filter run over the steps: its records and where it ended.
+pub struct Filtered {
+    /// The alignment's fixes.
+    pub plan: Plan,
+    /// The alignment.
+    pub alignment: Alignment,
+    /// One record per fix updated.
+    pub records: Vec<FixRecord>,
+    /// Fixes without each velocity component.
+    pub missing: [usize; 3],
+    /// The filter after the last step.
+    pub ekf: Ekf,
+    /// The first fix not yet updated.
+    pub next: usize,
 }
 
-/// The filter's noise densities and decays from `s`.
-fn noise(s: &Settings) -> (NoiseDensities, BiasDecay) {
-    let density = |sigma: f64, k: f64, tau: Option<f64>| match tau {
-        Some(t) => 2.0 * sigma * sigma / t,
-        None => k * k,
-    };
-    let decay = |tau: Option<f64>| tau.map_or(0.0, |t| 1.0 / t);
-    (
-        NoiseDensities {
-            accel_vrw_m_s_per_sqrt_s: s.accel_vrw_m_s_per_sqrt_s,
-            gyro_arw_rad_per_sqrt_s: s.gyro_arw_rad_per_sqrt_s,
-            gyro_bias_density: density(
-                s.gyro_bias_sigma_rad_s,
-                s.gyro_bias_random_walk_rad_s_per_sqrt_s,
-                s.gyro_bias_correlation_time_s,
-            ),
-            accel_bias_density: density(
-                s.accel_bias_sigma_m_s2,
-                s.accel_bias_random_walk_m_s2_per_sqrt_s,
-                s.accel_bias_correlation_time_s,
-            ),
-        },
-        BiasDecay {
-            gyro_per_s: decay(s.gyro_bias_correlation_time_s),
-            accel_per_s: decay(s.accel_bias_correlation_time_s),
-        },
-    )
+/// The GNSS rows with each fix's time moved by the receiver's offset `offset_s` (a fix stamped
+/// t describes the antenna at t + offset).
+pub fn shifted(rows: &[GnssRow], offset_s: f64) -> Vec<GnssRow> {
+    rows.iter()
+        .map(|r| GnssRow {
+            t_s: r.t_s + offset_s,
+            ..*r
+        })
+        .collect()
 }
 
-/// The fix of `row` with the σ's of the log or of `s`, and which velocity components it
-/// measures.
-fn fix_of(row: &GnssRow, s: &Settings) -> (Fix, [bool; 3]) {
-    let measured = row.velocity_ned_m_s.map(|v| v.is_some());
-    let v = row.velocity_ned_m_s.map(|v| v.unwrap_or(0.0));
-    let ps = row.position_sigma_m;
-    let vs = row.velocity_sigma_m_s;
-    let fix = Fix {
-        t_s: row.t_s,
-        position: row.position,
-        velocity_ned_m_s: measured.contains(&true).then(|| Vector3::from(v)),
-        position_sigma_m: Vector3::from(
-            [0, 1, 2].map(|i| ps[i].unwrap_or(s.gnss_position_sigma_m[i])),
-        ),
-        velocity_sigma_m_s: Vector3::from(
-            [0, 1, 2].map(|i| vs[i].unwrap_or(s.gnss_velocity_sigma_m_s)),
-        ),
-    };
-    (fix, measured)
-}
-
-/// The filter at fix `h` from the alignment `a`: the IMU carried from the antenna's fix, the
-/// prior covariance of position, alignment and gyro biases.
-fn start(h: &GnssRow, a: &Alignment, s: &Settings) -> Ekf {
-    let (fix, _) = fix_of(h, s);
-    let [roll, pitch, yaw] = a.euler_rad;
-    let attitude = crate::ins::attitude_from_euler(roll, pitch, yaw);
-    let c: Matrix3<f64> = *attitude.to_rotation_matrix().matrix();
-    let v = h.velocity_ned_m_s.map(|v| v.unwrap_or(0.0));
-    let pva = Pva {
-        position: align::imu_position(&h.position, &c, &s.lever_arm()),
-        velocity_ned_m_s: Vector3::from(v),
-        attitude,
-    };
-    let mut p0 = a.covariance;
-    for i in 0..3 {
-        p0[(POSITION + i, POSITION + i)] = fix.position_sigma_m[i].powi(2);
-        p0[(GYRO_BIAS + i, GYRO_BIAS + i)] = s.gyro_bias_sigma_rad_s.powi(2);
-    }
-    let (noise, decay) = noise(s);
-    Ekf::new(pva, p0, noise, decay, s.lever_arm()).with_transition()
-}
-
-/// Calibrates the recording `imu` + `gnss` with the assumptions `s`.
+/// The filter over the fixes `rows` and the steps of `source`, started by the alignment.
 ///
 /// # Errors
-/// [`ImuCalibrateError::Log`] naming the file and line of the first problem of either log (a
-/// fix outside the IMU log's span included); [`ImuCalibrateError::Alignment`] when no fix is
-/// fast enough for the heading; [`ImuCalibrateError::Filter`] when the filter breaks down.
-pub fn calibrate(
-    imu: &dyn LogSource,
-    gnss: &dyn LogSource,
+/// A log's problem; [`ImuCalibrateError::Alignment`] when no fix is fast enough for the
+/// heading or the log ends before it; [`ImuCalibrateError::Filter`].
+pub fn filter(
+    rows: &[GnssRow],
+    source: &mut dyn StepSource,
     s: &Settings,
-) -> Result<Calibrated, ImuCalibrateError> {
-    let rows = read_gnss(gnss)?;
-    let mut reader = ImuReader::open(imu, s.axes)?;
-    let layout = reader.layout();
-    let mut first = reader.next_step()?;
-    let imu_first_s = reader.first_s().unwrap_or(f64::INFINITY);
+    gnss_name: &str,
+) -> Result<Filtered, ImuCalibrateError> {
+    let mut first = source.next_step()?;
+    let imu_first_s = source.first_s().unwrap_or(f64::INFINITY);
     let settings = AlignSettings {
         speed_m_s: s.heading_speed_m_s,
         window_s: s.alignment_window_s,
         heading_offset_sigma_rad: s.heading_offset_sigma_deg.to_radians(),
     };
-    let plan = align::plan(&rows, imu_first_s, &settings).ok_or_else(|| no_heading(gnss, s))?;
+    let plan = align::plan(rows, imu_first_s, &settings).ok_or_else(|| no_heading(gnss_name, s))?;
     let (ra, rh) = (&rows[plan.first], &rows[plan.start]);
     let mut sum_dv = Vector3::zeros();
-    let mut ekf: Option<Ekf> = None;
-    let mut alignment = None;
+    let mut started: Option<(Ekf, Alignment)> = None;
     let mut next = plan.start + 1;
     let mut records = Vec::with_capacity(rows.len() - next);
     let mut missing = [0; 3];
     while let Some(step) = first
         .take()
-        .map_or_else(|| reader.next_step(), |f| Ok(Some(f)))?
+        .map_or_else(|| source.next_step(), |f| Ok(Some(f)))?
     {
         let (t1, inc) = (step.t_s, step.increment);
         let t0 = t1 - inc.dt_s;
         let mut from = t0;
-        if ekf.is_none() {
+        if started.is_none() {
             let (lo, hi) = (t0.max(ra.t_s), t1.min(rh.t_s));
             if hi > lo {
                 sum_dv += part(&inc, t1, lo, hi).dvel_m_s;
@@ -226,88 +131,113 @@ pub fn calibrate(
                 heading_offset_sigma_rad: settings.heading_offset_sigma_rad,
             };
             let a = align::align(ra, rh, &(sum_dv / (rh.t_s - ra.t_s)), &sources);
-            ekf = Some(start(rh, &a, s));
-            alignment = Some(a);
+            started = Some((start(rh, &a, s), a));
             from = rh.t_s;
         }
         let mut run = Running {
-            ekf: ekf.as_mut().expect("started"),
-            rows: &rows,
+            ekf: &mut started.as_mut().expect("started").0,
+            rows,
             next: &mut next,
             records: &mut records,
             missing: &mut missing,
         };
         run.step(&inc, from, t1, s)?;
     }
-    let span = reader.finish()?;
-    check_span(&rows, &span, gnss.name())?;
-    // Fixes within half a step after the last sample: updated where the log ends.
-    if let Some(f) = ekf.as_mut() {
-        while next < rows.len() {
-            records.push(update(f, &rows[next], s, &mut missing)?);
-            next += 1;
-        }
-    }
-    let alignment = alignment.ok_or_else(|| ImuCalibrateError::Alignment {
-        file: gnss.name().to_string(),
+    let (ekf, alignment) = started.ok_or_else(|| ImuCalibrateError::Alignment {
+        file: gnss_name.to_string(),
         reason: format!(
             "the IMU log ends before the alignment's fix at {} s",
             rh.t_s
         ),
     })?;
-    Ok(Calibrated {
-        gnss_file: gnss.name().to_string(),
-        span,
-        layout,
-        fixes: rows.len(),
+    Ok(Filtered {
         plan,
         alignment,
-        start_s: rh.t_s,
         records,
-        missing_velocity: missing,
+        missing,
+        ekf,
+        next,
     })
 }
 
-/// The running filter and where it is among the fixes.
-struct Running<'a> {
-    ekf: &'a mut Ekf,
-    rows: &'a [GnssRow],
-    next: &'a mut usize,
-    records: &'a mut Vec<FixRecord>,
-    missing: &'a mut [usize; 3],
+/// Calibrates the recording `imu` + `gnss` with the assumptions `s`.
+///
+/// # Errors
+/// [`ImuCalibrateError::Log`] naming the file and line of the first problem of either log (a
+/// fix outside the IMU log's span included); [`ImuCalibrateError::Alignment`] when no fix is
+/// fast enough for the heading; [`ImuCalibrateError::Filter`] when the filter breaks down.
+pub fn calibrate(
+    imu: &dyn LogSource,
+    gnss: &dyn LogSource,
+    s: &Settings,
+) -> Result<Calibrated, ImuCalibrateError> {
+    let rows = shifted(&read_gnss(gnss)?, s.gnss_time_offset_s);
+    let mut reader = ImuReader::open(imu, s.axes)?;
+    let layout = reader.layout();
+    let run = filter(&rows, &mut reader, s, gnss.name());
+    let span = reader.finish()?;
+    assemble(&rows, run?, (span, layout), s, gnss.name())
 }
 
-impl Running<'_> {
-    /// The IMU step `inc` ending at `t1` from `from` on: propagated up to each fix it holds,
-    /// updated there, then to its end.
-    fn step(
-        &mut self,
-        inc: &Increment,
-        mut from: f64,
-        t1: f64,
-        s: &Settings,
-    ) -> Result<(), FilterError> {
-        while *self.next < self.rows.len() && self.rows[*self.next].t_s <= t1 {
-            let tf = self.rows[*self.next].t_s;
-            if tf > from {
-                self.ekf.propagate(&part(inc, t1, from, tf));
-                from = tf;
-            }
-            let record = update(self.ekf, &self.rows[*self.next], s, self.missing)?;
-            self.records.push(record);
-            *self.next += 1;
-        }
-        if t1 > from {
-            self.ekf.propagate(&part(inc, t1, from, t1));
-        }
-        Ok(())
+/// [`calibrate`] from the GNSS log's `rows` (as read) and the IMU log's `steps`, `span` and
+/// `layout` held in memory.
+///
+/// # Errors
+/// As [`calibrate`].
+pub fn calibrate_held(
+    rows: &[GnssRow],
+    (steps, span, layout): (&[ImuStep], ImuSpan, ImuLayout),
+    s: &Settings,
+    gnss: &str,
+) -> Result<Calibrated, ImuCalibrateError> {
+    let rows = shifted(rows, s.gnss_time_offset_s);
+    let run = filter(&rows, &mut HeldSteps::new(steps), s, gnss);
+    assemble(&rows, run?, (span, layout), s, gnss)
+}
+
+/// The calibration from a filter's run over the whole log: every fix checked against the
+/// log's span, the last fixes updated.
+fn assemble(
+    rows: &[GnssRow],
+    mut run: Filtered,
+    (span, layout): (ImuSpan, ImuLayout),
+    s: &Settings,
+    gnss: &str,
+) -> Result<Calibrated, ImuCalibrateError> {
+    check_span(rows, &span, gnss)?;
+    finish(rows.len(), &mut run, s, rows)?;
+    Ok(Calibrated {
+        gnss_file: gnss.to_string(),
+        span,
+        layout,
+        fixes: rows.len(),
+        plan: run.plan,
+        alignment: run.alignment,
+        start_s: rows[run.plan.start].t_s,
+        records: run.records,
+        missing_velocity: run.missing,
+    })
+}
+
+/// The fixes within half a step after the last sample, updated where the log ends.
+fn finish(
+    fixes: usize,
+    run: &mut Filtered,
+    s: &Settings,
+    rows: &[GnssRow],
+) -> Result<(), FilterError> {
+    while run.next < fixes {
+        let record = update(&mut run.ekf, &rows[run.next], s, &mut run.missing)?;
+        run.records.push(record);
+        run.next += 1;
     }
+    Ok(())
 }
 
 /// The error of a recording whose course never gives the heading.
-fn no_heading(gnss: &dyn LogSource, s: &Settings) -> ImuCalibrateError {
+fn no_heading(gnss: &str, s: &Settings) -> ImuCalibrateError {
     ImuCalibrateError::Alignment {
-        file: gnss.name().to_string(),
+        file: gnss.to_string(),
         reason: format!(
             "no fix with a horizontal speed of at least {} m/s and a fix with a horizontal \
              velocity {} s or more before it (within the IMU log): the course cannot give the \
@@ -338,83 +268,4 @@ fn check_span(rows: &[GnssRow], span: &ImuSpan, gnss: &str) -> Result<(), LogErr
         }
         None => Ok(()),
     }
-}
-
-/// The σ's of the velocity at fix `r`: the log's or the default, and for a missing vertical
-/// velocity the σ of the assumption 0.
-fn velocity_sigmas(r: &GnssRow, s: &Settings) -> Vector3<f64> {
-    Vector3::from([0, 1, 2].map(|i| match r.velocity_ned_m_s[i] {
-        Some(_) => r.velocity_sigma_m_s[i].unwrap_or(s.gnss_velocity_sigma_m_s),
-        None => s.vertical_velocity_sigma_m_s,
-    }))
-}
-
-/// The update by the fix of `row`, recorded.
-fn update(
-    f: &mut Ekf,
-    row: &GnssRow,
-    s: &Settings,
-    missing: &mut [usize; 3],
-) -> Result<FixRecord, FilterError> {
-    let (fix, measured) = fix_of(row, s);
-    for (m, &k) in missing.iter_mut().zip(&measured) {
-        *m += usize::from(!k);
-    }
-    f.flush();
-    let prior_covariance = f.covariance;
-    let transition = f.take_transition().unwrap_or_else(Matrix15::identity);
-    let nu = f.update_measured(&fix, measured)?;
-    let (mut innovation, mut innovation_sigma) = ([f64::NAN; 6], [f64::NAN; 6]);
-    let components: Vec<usize> = (0..6).filter(|&i| i < 3 || measured[i - 3]).collect();
-    for (k, &i) in components.iter().enumerate() {
-        innovation[i] = nu.residual[k];
-        innovation_sigma[i] = nu.covariance[(k, k)].sqrt();
-    }
-    Ok(FixRecord {
-        line: row.line,
-        t_s: row.t_s,
-        pva: f.pva,
-        gyro_bias_rad_s: f.gyro_bias_rad_s,
-        accel_bias_m_s2: f.accel_bias_m_s2,
-        covariance: f.covariance,
-        prior_covariance,
-        transition,
-        correction: nu.correction,
-        innovation,
-        innovation_sigma,
-        nis: nu.nis,
-        rows: components.len(),
-    })
-}
-
-/// The σ's of roll, pitch and yaw (rad) from the attitude error's covariance at `pva`: the
-/// Euler angles' first-order response to a small rotation about north, east and down, found
-/// by central differences.
-pub fn euler_sigmas(pva: &Pva, p: &Matrix15) -> [f64; 3] {
-    let h = 1e-7;
-    let mut j = Matrix3::zeros();
-    for axis in 0..3 {
-        let mut d = Vector3::zeros();
-        d[axis] = h;
-        let plus =
-            crate::ins::euler_of(&(nalgebra::UnitQuaternion::from_scaled_axis(d) * pva.attitude));
-        let minus =
-            crate::ins::euler_of(&(nalgebra::UnitQuaternion::from_scaled_axis(-d) * pva.attitude));
-        let diff = [plus.0 - minus.0, plus.1 - minus.1, plus.2 - minus.2];
-        for (k, x) in diff.iter().enumerate() {
-            let wrapped =
-                (x + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-            j[(k, axis)] = wrapped / (2.0 * h);
-        }
-    }
-    let cov = j * p.fixed_view::<3, 3>(ATTITUDE, ATTITUDE) * j.transpose();
-    [0, 1, 2].map(|i| cov[(i, i)].max(0.0).sqrt())
-}
-
-/// The σ of each accelerometer and gyro bias in `p`.
-pub fn bias_sigmas(p: &Matrix15) -> ([f64; 3], [f64; 3]) {
-    (
-        [0, 1, 2].map(|i| p[(GYRO_BIAS + i, GYRO_BIAS + i)].max(0.0).sqrt()),
-        [0, 1, 2].map(|i| p[(ACCEL_BIAS + i, ACCEL_BIAS + i)].max(0.0).sqrt()),
-    )
 }

@@ -8,6 +8,7 @@ use std::io::{self, Write};
 use serde::Serialize;
 
 use super::Settings;
+use super::noise::NoiseEstimate;
 use super::run::{Calibrated, FixRecord, bias_sigmas, euler_sigmas};
 use super::smoother::Smoothed;
 use crate::calibrate::diagnose::whiteness::{Whiteness, whiteness};
@@ -130,8 +131,10 @@ pub struct Summary {
     pub rejected_by: Vec<String>,
     /// What the reader should know.
     pub warnings: Vec<String>,
-    /// Every assumption made.
+    /// Every assumption made (with `--estimate-noise`, the estimates in place).
     pub assumptions: Settings,
+    /// The statistics estimated from the drive (`--estimate-noise`), or `null`.
+    pub noise_estimate: Option<NoiseEstimate>,
 }
 
 /// The innovation components' names, in the record's order.
@@ -220,6 +223,7 @@ pub fn summary(c: &Calibrated, s: &Settings, imu_file: &str) -> Summary {
         rejected_by,
         warnings,
         assumptions: *s,
+        noise_estimate: None,
     }
 }
 

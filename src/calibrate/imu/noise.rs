@@ -1,0 +1,286 @@
+//! `calibrate --imu --estimate-noise`: the noise statistics and the receiver's time offset by
+//! maximum likelihood of the GNSS innovations, with profile-likelihood intervals.
+//!
+//! A filter whose statistics are right has white innovations with covariance S, so the
+//! statistics that maximise ℓ(θ) = −½ Σ_k (m_k ln 2π + ln det S_k + ν_kᵀS_k⁻¹ν_k) are those the
+//! drive supports (Mehra, IEEE Trans. Automatic Control 15(2), 1970; the same likelihood as the
+//! one-axis `--estimate-noise`, `crate::likelihood`). Each evaluation runs the three-axis filter
+//! over the IMU steps held in memory. The σ's and random walks are searched in their
+//! logarithms within ×10^±2 of their starting values; the time offset linearly within
+//! ±[`MAX_TIME_OFFSET_S`]. An interval end that reaches the box is open, and the key is then
+//! reported as not identifiable.
+
+use serde::Serialize;
+
+use super::Settings;
+use super::config::MAX_TIME_OFFSET_S;
+use super::gnss::GnssRow;
+use super::read::{HeldSteps, ImuSpan, ImuStep};
+use super::run::{filter, shifted};
+use crate::likelihood::{Fit, maximize};
+
+/// A quantity `--estimate-noise` can estimate on the three-axis path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ImuKey {
+    /// The fixes' horizontal position σ (north and east), m.
+    GnssHorizontalSigma,
+    /// Their vertical position σ, m.
+    GnssVerticalSigma,
+    /// Their velocity σ per component, m/s.
+    GnssVelocitySigma,
+    /// The accelerometers' velocity random walk, m/s/√s.
+    AccelVrw,
+    /// The gyros' angle random walk, rad/√s.
+    GyroArw,
+    /// The accelerometer biases' random walk, m/s²/√s.
+    AccelBiasRandomWalk,
+    /// The gyro biases' random walk, rad/s/√s.
+    GyroBiasRandomWalk,
+    /// The receiver's time offset, s.
+    GnssTimeOffset,
+}
+
+impl ImuKey {
+    /// Every key, in `summary.json`'s order.
+    pub const ALL: [ImuKey; 8] = [
+        ImuKey::GnssHorizontalSigma,
+        ImuKey::GnssVerticalSigma,
+        ImuKey::GnssVelocitySigma,
+        ImuKey::AccelVrw,
+        ImuKey::GyroArw,
+        ImuKey::AccelBiasRandomWalk,
+        ImuKey::GyroBiasRandomWalk,
+        ImuKey::GnssTimeOffset,
+    ];
+
+    /// The keys searched when none is named: the receiver's three σ's, the velocity random walk
+    /// and the time offset.
+    pub const DEFAULT: [ImuKey; 5] = [
+        ImuKey::GnssHorizontalSigma,
+        ImuKey::GnssVerticalSigma,
+        ImuKey::GnssVelocitySigma,
+        ImuKey::AccelVrw,
+        ImuKey::GnssTimeOffset,
+    ];
+
+    /// Its name on the command line and in `summary.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ImuKey::GnssHorizontalSigma => "gnss_horizontal_sigma_m",
+            ImuKey::GnssVerticalSigma => "gnss_vertical_sigma_m",
+            ImuKey::GnssVelocitySigma => "gnss_velocity_sigma_m_s",
+            ImuKey::AccelVrw => "accel_vrw_m_s_per_sqrt_s",
+            ImuKey::GyroArw => "gyro_arw_rad_per_sqrt_s",
+            ImuKey::AccelBiasRandomWalk => "accel_bias_random_walk_m_s2_per_sqrt_s",
+            ImuKey::GyroBiasRandomWalk => "gyro_bias_random_walk_rad_s_per_sqrt_s",
+            ImuKey::GnssTimeOffset => "gnss_time_offset_s",
+        }
+    }
+
+    /// What it is, in words with its unit.
+    pub fn words(self) -> &'static str {
+        match self {
+            ImuKey::GnssHorizontalSigma => "the fixes' horizontal position σ, m",
+            ImuKey::GnssVerticalSigma => "the fixes' vertical position σ, m",
+            ImuKey::GnssVelocitySigma => "the fixes' velocity σ per component, m/s",
+            ImuKey::AccelVrw => "the accelerometers' velocity random walk, m/s/√s",
+            ImuKey::GyroArw => "the gyros' angle random walk, rad/√s",
+            ImuKey::AccelBiasRandomWalk => "the accelerometer biases' random walk, m/s²/√s",
+            ImuKey::GyroBiasRandomWalk => "the gyro biases' random walk, rad/s/√s",
+            ImuKey::GnssTimeOffset => {
+                "the receiver's time offset (a fix stamped t is at t + offset), s"
+            }
+        }
+    }
+
+    /// The key named `name`.
+    pub fn parse(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// Whether it is searched linearly (it can be negative), not in its logarithm.
+    fn linear(self) -> bool {
+        self == ImuKey::GnssTimeOffset
+    }
+
+    /// Its value in `s`.
+    pub fn get(self, s: &Settings) -> f64 {
+        match self {
+            ImuKey::GnssHorizontalSigma => s.gnss_position_sigma_m[0],
+            ImuKey::GnssVerticalSigma => s.gnss_position_sigma_m[2],
+            ImuKey::GnssVelocitySigma => s.gnss_velocity_sigma_m_s,
+            ImuKey::AccelVrw => s.accel_vrw_m_s_per_sqrt_s,
+            ImuKey::GyroArw => s.gyro_arw_rad_per_sqrt_s,
+            ImuKey::AccelBiasRandomWalk => s.accel_bias_random_walk_m_s2_per_sqrt_s,
+            ImuKey::GyroBiasRandomWalk => s.gyro_bias_random_walk_rad_s_per_sqrt_s,
+            ImuKey::GnssTimeOffset => s.gnss_time_offset_s,
+        }
+    }
+
+    /// `s` with this key set to `v`.
+    pub fn set(self, s: &mut Settings, v: f64) {
+        match self {
+            ImuKey::GnssHorizontalSigma => {
+                s.gnss_position_sigma_m[0] = v;
+                s.gnss_position_sigma_m[1] = v;
+            }
+            ImuKey::GnssVerticalSigma => s.gnss_position_sigma_m[2] = v,
+            ImuKey::GnssVelocitySigma => s.gnss_velocity_sigma_m_s = v,
+            ImuKey::AccelVrw => s.accel_vrw_m_s_per_sqrt_s = v,
+            ImuKey::GyroArw => s.gyro_arw_rad_per_sqrt_s = v,
+            ImuKey::AccelBiasRandomWalk => s.accel_bias_random_walk_m_s2_per_sqrt_s = v,
+            ImuKey::GyroBiasRandomWalk => s.gyro_bias_random_walk_rad_s_per_sqrt_s = v,
+            ImuKey::GnssTimeOffset => s.gnss_time_offset_s = v,
+        }
+    }
+
+    /// The search's box around the value `v`, in the search's variable.
+    fn bounds(self, v: f64) -> (f64, f64) {
+        if self.linear() {
+            (-MAX_TIME_OFFSET_S, MAX_TIME_OFFSET_S)
+        } else {
+            let c = v.max(1e-12).ln();
+            (
+                c - BOX_DECADES * std::f64::consts::LN_10,
+                c + BOX_DECADES * std::f64::consts::LN_10,
+            )
+        }
+    }
+
+    /// The key's value of the search's variable `u`.
+    fn value(self, u: f64) -> f64 {
+        if self.linear() { u } else { u.exp() }
+    }
+}
+
+/// The search's box for a σ or random walk: its starting value ×10^±2.
+const BOX_DECADES: f64 = 2.0;
+
+/// One key's estimate.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct KeyEstimate {
+    /// The key.
+    pub key: &'static str,
+    /// The maximum-likelihood value, which the calibration uses.
+    pub value: f64,
+    /// The interval's lower end; `null` when it reached the search's bound.
+    pub lower: Option<f64>,
+    /// The upper end; `null` when it reached the search's bound.
+    pub upper: Option<f64>,
+    /// Whether both ends lie inside the search's bounds: only then does the drive determine it.
+    pub identifiable: bool,
+    /// The search's bounds.
+    pub search_bounds: [f64; 2],
+}
+
+/// The estimate of the requested keys.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NoiseEstimate {
+    /// ℓ at the maximum.
+    pub log_likelihood: f64,
+    /// Evaluations of ℓ (each a run of the filter).
+    pub evaluations: u64,
+    /// The intervals' confidence.
+    pub confidence: f64,
+    /// The fixes ℓ sums over.
+    pub fixes: usize,
+    /// Each key, in the request's order.
+    pub keys: Vec<KeyEstimate>,
+    /// The assumptions with the estimates in place.
+    #[serde(skip)]
+    pub settings: Settings,
+}
+
+/// The log-likelihood of the GNSS innovations of the filter with assumptions `s` over the
+/// first `fixes` fixes after the alignment's; −∞ when the filter cannot run or updates fewer.
+pub fn log_likelihood(rows: &[GnssRow], steps: &[ImuStep], s: &Settings, fixes: usize) -> f64 {
+    let rows = shifted(rows, s.gnss_time_offset_s);
+    let Ok(run) = filter(&rows, &mut HeldSteps::new(steps), s, "") else {
+        return f64::NEG_INFINITY;
+    };
+    if run.records.len() < fixes {
+        return f64::NEG_INFINITY;
+    }
+    let ln_2pi = (2.0 * std::f64::consts::PI).ln();
+    -0.5 * run.records[..fixes]
+        .iter()
+        .map(|r| r.rows as f64 * ln_2pi + r.log_det_s + r.nis)
+        .sum::<f64>()
+}
+
+/// The fixes every offset in the box leaves inside the IMU log: those after the alignment's
+/// fix stamped at least [`MAX_TIME_OFFSET_S`] before its end.
+fn fixes_in_reach(rows: &[GnssRow], span: &ImuSpan, start: usize) -> usize {
+    rows[start + 1..]
+        .iter()
+        .filter(|r| r.t_s + MAX_TIME_OFFSET_S <= span.last_s)
+        .count()
+}
+
+/// Maximises ℓ over `keys` from `s` (the others held), with each key's profile-likelihood
+/// interval at `confidence`. `None` when ℓ is not finite at `s`.
+pub fn estimate(
+    rows: &[GnssRow],
+    steps: &[ImuStep],
+    span: &ImuSpan,
+    s: &Settings,
+    keys: &[ImuKey],
+    confidence: f64,
+) -> Option<NoiseEstimate> {
+    let start = filter(
+        &shifted(rows, s.gnss_time_offset_s),
+        &mut HeldSteps::new(steps),
+        s,
+        "",
+    )
+    .ok()?
+    .plan
+    .start;
+    let fixes = fixes_in_reach(rows, span, start);
+    let settings_at = |u: &[f64]| {
+        let mut t = *s;
+        for (k, x) in keys.iter().zip(u) {
+            k.set(&mut t, k.value(*x));
+        }
+        t
+    };
+    let f = |u: &[f64]| log_likelihood(rows, steps, &settings_at(u), fixes);
+    let bounds: Vec<(f64, f64)> = keys.iter().map(|k| k.bounds(k.get(s))).collect();
+    let lo: Vec<f64> = bounds.iter().map(|b| b.0).collect();
+    let hi: Vec<f64> = bounds.iter().map(|b| b.1).collect();
+    let u0: Vec<f64> = keys
+        .iter()
+        .map(|k| {
+            if k.linear() {
+                k.get(s)
+            } else {
+                k.get(s).max(1e-12).ln()
+            }
+        })
+        .collect();
+    let fit: Fit = maximize(&f, (&lo, &hi), &u0, confidence)?;
+    let estimates = keys
+        .iter()
+        .enumerate()
+        .map(|(j, &k)| {
+            let (l, h) = (fit.ends[2 * j].at, fit.ends[2 * j + 1].at);
+            let inside = |x: Option<f64>| x.is_some_and(|x| x > lo[j] && x < hi[j]);
+            KeyEstimate {
+                key: k.name(),
+                value: k.value(fit.u[j]),
+                lower: l.filter(|&x| x > lo[j]).map(|x| k.value(x)),
+                upper: h.filter(|&x| x < hi[j]).map(|x| k.value(x)),
+                identifiable: inside(l) && inside(h),
+                search_bounds: [k.value(lo[j]), k.value(hi[j])],
+            }
+        })
+        .collect();
+    Some(NoiseEstimate {
+        log_likelihood: fit.value,
+        evaluations: fit.evaluations,
+        confidence,
+        fixes,
+        keys: estimates,
+        settings: settings_at(&fit.u),
+    })
+}

@@ -1,0 +1,251 @@
+//! One step of the calibration's filter: the increments of a part of an IMU step, the filter's
+//! start from the alignment, an update by one fix and its record, and the σ's a record gives.
+
+use nalgebra::{Matrix3, SVector, Vector3};
+
+use super::Settings;
+use super::align::{self, Alignment};
+use super::gnss::GnssRow;
+use crate::ins::discrete::NoiseDensities;
+use crate::ins::error_state::{
+    ACCEL_BIAS, ATTITUDE, BiasDecay, GYRO_BIAS, Matrix15, POSITION, STATES,
+};
+use crate::ins::filter::{Ekf, FilterError};
+use crate::ins::gnss::Fix;
+use crate::ins::mech::{Increment, Pva};
+
+/// One fix's filtered estimates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FixRecord {
+    /// The fix's line in the GNSS log.
+    pub line: u64,
+    /// Its time, s.
+    pub t_s: f64,
+    /// The navigation solution after the update.
+    pub pva: Pva,
+    /// The gyro bias estimate, rad/s.
+    pub gyro_bias_rad_s: Vector3<f64>,
+    /// The accelerometer bias estimate, m/s².
+    pub accel_bias_m_s2: Vector3<f64>,
+    /// The covariance after the update.
+    pub covariance: Matrix15,
+    /// The covariance before it.
+    pub prior_covariance: Matrix15,
+    /// Φ from the previous fix's update (or the start) to this fix.
+    pub transition: Matrix15,
+    /// The errors the update took out of the solution.
+    pub correction: SVector<f64, STATES>,
+    /// The innovation: position NED (m), velocity NED (m/s); NaN where not measured.
+    pub innovation: [f64; 6],
+    /// √S of each component; NaN where not measured.
+    pub innovation_sigma: [f64; 6],
+    /// νᵀS⁻¹ν.
+    pub nis: f64,
+    /// ln det S.
+    pub log_det_s: f64,
+    /// The components measured.
+    pub rows: usize,
+}
+
+/// The increments of `inc` over the part of its step from `lo` to `hi` (its end `end`).
+pub(super) fn part(inc: &Increment, end: f64, lo: f64, hi: f64) -> Increment {
+    let frac = (hi - lo) / inc.dt_s;
+    debug_assert!(hi <= end + 1e-9);
+    Increment {
+        dtheta_rad: inc.dtheta_rad * frac,
+        dvel_m_s: inc.dvel_m_s * frac,
+        dt_s: hi - lo,
+    }
+}
+
+/// The filter's noise densities and decays from `s`.
+fn noise(s: &Settings) -> (NoiseDensities, BiasDecay) {
+    let density = |sigma: f64, k: f64, tau: Option<f64>| match tau {
+        Some(t) => 2.0 * sigma * sigma / t,
+        None => k * k,
+    };
+    let decay = |tau: Option<f64>| tau.map_or(0.0, |t| 1.0 / t);
+    (
+        NoiseDensities {
+            accel_vrw_m_s_per_sqrt_s: s.accel_vrw_m_s_per_sqrt_s,
+            gyro_arw_rad_per_sqrt_s: s.gyro_arw_rad_per_sqrt_s,
+            gyro_bias_density: density(
+                s.gyro_bias_sigma_rad_s,
+                s.gyro_bias_random_walk_rad_s_per_sqrt_s,
+                s.gyro_bias_correlation_time_s,
+            ),
+            accel_bias_density: density(
+                s.accel_bias_sigma_m_s2,
+                s.accel_bias_random_walk_m_s2_per_sqrt_s,
+                s.accel_bias_correlation_time_s,
+            ),
+        },
+        BiasDecay {
+            gyro_per_s: decay(s.gyro_bias_correlation_time_s),
+            accel_per_s: decay(s.accel_bias_correlation_time_s),
+        },
+    )
+}
+
+/// The fix of `row` with the σ's of the log or of `s`, and which velocity components it
+/// measures.
+fn fix_of(row: &GnssRow, s: &Settings) -> (Fix, [bool; 3]) {
+    let measured = row.velocity_ned_m_s.map(|v| v.is_some());
+    let v = row.velocity_ned_m_s.map(|v| v.unwrap_or(0.0));
+    let ps = row.position_sigma_m;
+    let vs = row.velocity_sigma_m_s;
+    let fix = Fix {
+        t_s: row.t_s,
+        position: row.position,
+        velocity_ned_m_s: measured.contains(&true).then(|| Vector3::from(v)),
+        position_sigma_m: Vector3::from(
+            [0, 1, 2].map(|i| ps[i].unwrap_or(s.gnss_position_sigma_m[i])),
+        ),
+        velocity_sigma_m_s: Vector3::from(
+            [0, 1, 2].map(|i| vs[i].unwrap_or(s.gnss_velocity_sigma_m_s)),
+        ),
+    };
+    (fix, measured)
+}
+
+/// The filter at fix `h` from the alignment `a`: the IMU carried from the antenna's fix, the
+/// prior covariance of position, alignment and gyro biases.
+pub(super) fn start(h: &GnssRow, a: &Alignment, s: &Settings) -> Ekf {
+    let (fix, _) = fix_of(h, s);
+    let [roll, pitch, yaw] = a.euler_rad;
+    let attitude = crate::ins::attitude_from_euler(roll, pitch, yaw);
+    let c: Matrix3<f64> = *attitude.to_rotation_matrix().matrix();
+    let v = h.velocity_ned_m_s.map(|v| v.unwrap_or(0.0));
+    let pva = Pva {
+        position: align::imu_position(&h.position, &c, &s.lever_arm()),
+        velocity_ned_m_s: Vector3::from(v),
+        attitude,
+    };
+    let mut p0 = a.covariance;
+    for i in 0..3 {
+        p0[(POSITION + i, POSITION + i)] = fix.position_sigma_m[i].powi(2);
+        p0[(GYRO_BIAS + i, GYRO_BIAS + i)] = s.gyro_bias_sigma_rad_s.powi(2);
+    }
+    let (noise, decay) = noise(s);
+    Ekf::new(pva, p0, noise, decay, s.lever_arm()).with_transition()
+}
+
+/// The running filter and where it is among the fixes.
+pub(super) struct Running<'a> {
+    pub(super) ekf: &'a mut Ekf,
+    pub(super) rows: &'a [GnssRow],
+    pub(super) next: &'a mut usize,
+    pub(super) records: &'a mut Vec<FixRecord>,
+    pub(super) missing: &'a mut [usize; 3],
+}
+
+impl Running<'_> {
+    /// The IMU step `inc` ending at `t1` from `from` on: propagated up to each fix it holds,
+    /// updated there, then to its end.
+    pub(super) fn step(
+        &mut self,
+        inc: &Increment,
+        mut from: f64,
+        t1: f64,
+        s: &Settings,
+    ) -> Result<(), FilterError> {
+        while *self.next < self.rows.len() && self.rows[*self.next].t_s <= t1 {
+            let tf = self.rows[*self.next].t_s;
+            if tf > from {
+                self.ekf.propagate(&part(inc, t1, from, tf));
+                from = tf;
+            }
+            let record = update(self.ekf, &self.rows[*self.next], s, self.missing)?;
+            self.records.push(record);
+            *self.next += 1;
+        }
+        if t1 > from {
+            self.ekf.propagate(&part(inc, t1, from, t1));
+        }
+        Ok(())
+    }
+}
+
+/// The σ's of the velocity at fix `r`: the log's or the default, and for a missing vertical
+/// velocity the σ of the assumption 0.
+pub(super) fn velocity_sigmas(r: &GnssRow, s: &Settings) -> Vector3<f64> {
+    Vector3::from([0, 1, 2].map(|i| match r.velocity_ned_m_s[i] {
+        Some(_) => r.velocity_sigma_m_s[i].unwrap_or(s.gnss_velocity_sigma_m_s),
+        None => s.vertical_velocity_sigma_m_s,
+    }))
+}
+
+/// The update by the fix of `row`, recorded.
+pub(super) fn update(
+    f: &mut Ekf,
+    row: &GnssRow,
+    s: &Settings,
+    missing: &mut [usize; 3],
+) -> Result<FixRecord, FilterError> {
+    let (fix, measured) = fix_of(row, s);
+    for (m, &k) in missing.iter_mut().zip(&measured) {
+        *m += usize::from(!k);
+    }
+    f.flush();
+    let prior_covariance = f.covariance;
+    let transition = f.take_transition().unwrap_or_else(Matrix15::identity);
+    let nu = f.update_measured(&fix, measured)?;
+    let (mut innovation, mut innovation_sigma) = ([f64::NAN; 6], [f64::NAN; 6]);
+    let components: Vec<usize> = (0..6).filter(|&i| i < 3 || measured[i - 3]).collect();
+    for (k, &i) in components.iter().enumerate() {
+        innovation[i] = nu.residual[k];
+        innovation_sigma[i] = nu.covariance[(k, k)].sqrt();
+    }
+    Ok(FixRecord {
+        line: row.line,
+        t_s: row.t_s,
+        pva: f.pva,
+        gyro_bias_rad_s: f.gyro_bias_rad_s,
+        accel_bias_m_s2: f.accel_bias_m_s2,
+        covariance: f.covariance,
+        prior_covariance,
+        transition,
+        correction: nu.correction,
+        innovation,
+        innovation_sigma,
+        nis: nu.nis,
+        log_det_s: nu
+            .covariance
+            .clone()
+            .cholesky()
+            .map_or(f64::NAN, |c| 2.0 * c.l().diagonal().map(f64::ln).sum()),
+        rows: components.len(),
+    })
+}
+
+/// The σ's of roll, pitch and yaw (rad) from the attitude error's covariance at `pva`: the
+/// Euler angles' first-order response to a small rotation about north, east and down, found
+/// by central differences.
+pub fn euler_sigmas(pva: &Pva, p: &Matrix15) -> [f64; 3] {
+    let h = 1e-7;
+    let mut j = Matrix3::zeros();
+    for axis in 0..3 {
+        let mut d = Vector3::zeros();
+        d[axis] = h;
+        let plus =
+            crate::ins::euler_of(&(nalgebra::UnitQuaternion::from_scaled_axis(d) * pva.attitude));
+        let minus =
+            crate::ins::euler_of(&(nalgebra::UnitQuaternion::from_scaled_axis(-d) * pva.attitude));
+        let diff = [plus.0 - minus.0, plus.1 - minus.1, plus.2 - minus.2];
+        for (k, x) in diff.iter().enumerate() {
+            let wrapped =
+                (x + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+            j[(k, axis)] = wrapped / (2.0 * h);
+        }
+    }
+    let cov = j * p.fixed_view::<3, 3>(ATTITUDE, ATTITUDE) * j.transpose();
+    [0, 1, 2].map(|i| cov[(i, i)].max(0.0).sqrt())
+}
+
+/// The σ of each accelerometer and gyro bias in `p`.
+pub fn bias_sigmas(p: &Matrix15) -> ([f64; 3], [f64; 3]) {
+    (
+        [0, 1, 2].map(|i| p[(GYRO_BIAS + i, GYRO_BIAS + i)].max(0.0).sqrt()),
+        [0, 1, 2].map(|i| p[(ACCEL_BIAS + i, ACCEL_BIAS + i)].max(0.0).sqrt()),
+    )
+}
