@@ -1,5 +1,6 @@
-//! Seeded fuzzing of the four surfaces a user can hand the tool: the sensor logs (through
-//! `calibrate`), the configuration (through `ensemble`, `simulate`, `sensitivity` and `report`,
+//! Seeded fuzzing of the five surfaces a user can hand the tool: the one-axis sensor logs
+//! (through `calibrate --accel --gps`), the three-axis recordings (through `calibrate --imu
+//! --gnss`: the shipped comma2k19 minute's first 4 s), the configuration (through `ensemble`, `simulate`, `sensitivity` and `report`,
 //! at tiny sizes), the shard partials (through `merge`) and the command line.
 //!
 //! Every input is a mutation of a valid one by a generator seeded per case, so a finding is
@@ -373,15 +374,17 @@ fn fault(ended: &Ended) -> Option<String> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Surface {
     Logs,
+    Imu,
     Config,
     Partials,
     CommandLine,
 }
 
-const SURFACES: [(Surface, usize); 4] = [
-    (Surface::Logs, 280),
-    (Surface::Config, 280),
-    (Surface::Partials, 200),
+const SURFACES: [(Surface, usize); 5] = [
+    (Surface::Logs, 220),
+    (Surface::Imu, 100),
+    (Surface::Config, 260),
+    (Surface::Partials, 180),
     (Surface::CommandLine, 240),
 ];
 
@@ -406,6 +409,9 @@ struct Base {
     dir: PathBuf,
     accel: Vec<u8>,
     gps: Vec<u8>,
+    /// The shipped three-axis recording cut to its first [`IMU_SECONDS`]: IMU and GNSS logs.
+    imu: Vec<u8>,
+    gnss: Vec<u8>,
     partials: [Vec<u8>; 2],
     one: serde_json::Value,
 }
@@ -448,9 +454,33 @@ fn base(dir: &Path) -> Base {
         dir: dir.to_path_buf(),
         accel: read("logs/accelerometer.csv"),
         gps: read("logs/gps.csv"),
+        imu: first_seconds("imu.csv"),
+        gnss: first_seconds("gnss.csv"),
         partials: [read("p1.bin"), read("p2.bin")],
         one: common::summary_without_timing(&dir.join("one.json")),
     }
+}
+
+/// The length of the three-axis recording the IMU surface mutates, s: 400 IMU rows and 40
+/// fixes, the vehicle already above the heading's speed, so that the unmutated run calibrates
+/// (exit 0) in a few hundredths of a second.
+const IMU_SECONDS: f64 = 4.0;
+
+/// The shipped comma2k19 three-axis log `name` with its rows up to [`IMU_SECONDS`].
+fn first_seconds(name: &str) -> Vec<u8> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/comma2k19_3d")
+        .join(name);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut out = String::new();
+    for (k, line) in text.lines().enumerate() {
+        let t: f64 = line.split(',').next().unwrap().parse().unwrap_or(0.0);
+        if k == 0 || t <= IMU_SECONDS {
+            out += line;
+            out.push('\n');
+        }
+    }
+    out.into_bytes()
 }
 
 /// A sentinel in each output a failing run must not touch.
@@ -501,6 +531,109 @@ fn case_logs(rng: &mut Rng, base: &Base, dir: &Path) -> (Vec<String>, Vec<&'stat
     let mut args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
     args.extend(["--gps", "g.csv", "--out", "cal"].map(String::from));
     (args, vec!["cal/summary.json"])
+}
+
+/// One three-axis case: the 4 s recording with one or both logs mutated (the generic mutations,
+/// a hostile field, or a change of layout: the rates' header renamed to increments, one column
+/// renamed, dropped or added, rows swapped), the IMU log sometimes gzipped, sometimes with a
+/// small configuration naming the axes, through `calibrate --imu --gnss`.
+fn case_imu(rng: &mut Rng, base: &Base, dir: &Path) -> (Vec<String>, Vec<&'static str>) {
+    let mut imu = base.imu.clone();
+    let mut gnss = base.gnss.clone();
+    let mutations = if rng.chance(60) { 1 } else { 2 + rng.below(2) };
+    for _ in 0..mutations {
+        let target = if rng.chance(55) { &mut imu } else { &mut gnss };
+        match rng.below(5) {
+            0 | 1 => mutate_bytes(rng, target),
+            2 | 3 => mutate_field(rng, target),
+            _ => mutate_layout(rng, target),
+        }
+    }
+    let gzipped = rng.chance(10);
+    if gzipped {
+        use std::io::Write as _;
+        let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+        gz.write_all(&imu).unwrap();
+        imu = gz.finish().unwrap();
+    }
+    std::fs::write(dir.join("imu.csv"), imu).unwrap();
+    std::fs::write(dir.join("gnss.csv"), gnss).unwrap();
+    let mut args: Vec<String> = ["calibrate", "-q", "--imu", "imu.csv", "--gnss", "gnss.csv"]
+        .map(String::from)
+        .to_vec();
+    if rng.chance(15) {
+        let axes = rng.pick(&["\"frd\"", "\"flu\"", "\"xyz\"", "1"]);
+        let config = format!("model = \"ins\"\n[imu]\naxes = {axes}\n");
+        std::fs::write(dir.join("imu.toml"), config).unwrap();
+        args.extend(["--config", "imu.toml"].map(String::from));
+    }
+    args.extend(["--out", "cal3"].map(String::from));
+    (args, vec!["cal3/summary.json", "cal3/estimates.csv"])
+}
+
+/// A change of a log's layout: its header's rate columns renamed to increments (a valid
+/// layout whose numbers are now wrong by the step), one column renamed to another of either
+/// layout, a column dropped or added on every line, or two rows swapped.
+fn mutate_layout(rng: &mut Rng, text: &mut Vec<u8>) {
+    let s = String::from_utf8_lossy(text).into_owned();
+    let mut lines: Vec<String> = s.lines().map(String::from).collect();
+    if lines.len() < 3 {
+        return;
+    }
+    const NAMES: &[&str] = &[
+        "t_s",
+        "ax_m_s2",
+        "gz_rad_s",
+        "dvx_m_s",
+        "dthz_rad",
+        "lat_deg",
+        "vd_m_s",
+        "sigma_n_m",
+        "sigma_vn_m_s",
+        "",
+    ];
+    match rng.below(5) {
+        0 => {
+            lines[0] = lines[0]
+                .replace("ax_m_s2", "dvx_m_s")
+                .replace("ay_m_s2", "dvy_m_s")
+                .replace("az_m_s2", "dvz_m_s")
+                .replace("gx_rad_s", "dthx_rad")
+                .replace("gy_rad_s", "dthy_rad")
+                .replace("gz_rad_s", "dthz_rad");
+        }
+        1 => {
+            let mut cols: Vec<&str> = lines[0].split(',').collect();
+            let c = rng.below(cols.len());
+            cols[c] = *rng.pick(NAMES);
+            lines[0] = cols.join(",");
+        }
+        2 => {
+            let c = rng.below(lines[0].split(',').count());
+            for l in &mut lines {
+                let mut f: Vec<&str> = l.split(',').collect();
+                if c < f.len() {
+                    f.remove(c);
+                }
+                *l = f.join(",");
+            }
+        }
+        3 => {
+            let name = rng.pick(NAMES).to_string();
+            lines[0] += &format!(",{name}");
+            for l in lines.iter_mut().skip(1) {
+                *l += ",1.0";
+            }
+        }
+        _ => {
+            let (i, j) = (
+                1 + rng.below(lines.len() - 1),
+                1 + rng.below(lines.len() - 1),
+            );
+            lines.swap(i, j);
+        }
+    }
+    *text = (lines.join("\n") + "\n").into_bytes();
 }
 
 /// One comma-separated field of a log replaced by a hostile value.
@@ -635,6 +768,8 @@ const FLAGS: &[&str] = &[
     "--draws",
     "--accel",
     "--gps",
+    "--imu",
+    "--gnss",
     "--out",
     "--column",
     "--confidence",
@@ -672,6 +807,13 @@ const VALUES: &[&str] = &[
     "1.5",
     "../logs/accelerometer.csv",
     "../logs/gps.csv",
+    "imu.csv",
+    "gnss.csv",
+    concat!(env!("CARGO_MANIFEST_DIR"), "/examples/comma2k19_3d/imu.csv"),
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/comma2k19_3d/gnss.csv"
+    ),
     "../p1.bin",
     "out.json",
     "out/dir",
@@ -748,6 +890,7 @@ fn run_case(
     let rng = &mut Rng::new(seed);
     let (args, outputs) = match surface {
         Surface::Logs => case_logs(rng, base, dir),
+        Surface::Imu => case_imu(rng, base, dir),
         Surface::Config => case_config(rng, dir, &tally.reports),
         Surface::Partials => case_partials(rng, base, dir),
         Surface::CommandLine => case_command_line(rng),
@@ -788,7 +931,9 @@ fn run_case(
 fn keep(surface: Surface, case: usize, dir: &Path) {
     let to = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("fuzz/{surface:?}-{case}"));
     let _ = std::fs::create_dir_all(&to);
-    for f in ["a.csv", "g.csv", "c.toml", "q1.bin", "q2.bin"] {
+    for f in [
+        "a.csv", "g.csv", "imu.csv", "gnss.csv", "imu.toml", "c.toml", "q1.bin", "q2.bin",
+    ] {
         let _ = std::fs::copy(dir.join(f), to.join(f));
     }
 }
@@ -869,6 +1014,15 @@ fn thousands_of_hostile_inputs_end_in_0_or_2_and_clobber_nothing() {
         .filter(|f| strict || f.known.is_none())
         .count();
     assert_eq!(failing, 0, "{text}");
+    // The three-axis surface reaches both ends: some mutated recordings still calibrate, most
+    // are refused (a surface whose every input is refused at the header tests one line).
+    let ends = tally.ends.lock().unwrap();
+    let [ok, refused, _] = ends.get("Imu calibrate").copied().unwrap_or_default();
+    assert!(
+        ok > 0 && refused > 0,
+        "the IMU surface: {ok} exit 0, {refused} exit 2"
+    );
+    drop(ends);
     assert!(
         jobs.len() >= total * 99 / 100,
         "every share of the inputs ran"
