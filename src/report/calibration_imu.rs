@@ -270,7 +270,8 @@ pub fn view(
             short(c.start_s),
             percent(CONFIDENCE)
         ),
-        conditional: conditional_page_words(&s.rejected_by),
+        // The components as words: "the position north innovations' whiteness".
+        conditional: conditional_page_words(&s.rejected_by).replace('_', " "),
         findings: super::calibration_imu_words::findings(s, elapsed),
         biases,
         attitude: attitude_rows(s),
