@@ -106,3 +106,33 @@ fn value(x: f64) -> String {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{rows, value};
+    use crate::calibrate::imu::CONSUMER;
+
+    #[test]
+    fn values_drop_trailing_zeros_also_in_powers_of_ten() {
+        assert_eq!(value(5e-5), "5 × 10⁻⁵");
+        assert_eq!(value(1.25e-7), "1.25 × 10⁻⁷");
+        assert_eq!(value(0.05), "0.05");
+        assert_eq!(value(2.0), "2");
+    }
+
+    #[test]
+    fn a_changed_assumption_is_marked_as_the_configuration_s() {
+        assert!(rows(&CONSUMER).iter().all(|r| r.source == "default"));
+        let mut s = CONSUMER;
+        s.gnss_position_sigma_m = [1.0, 1.0, 2.0];
+        let changed: Vec<_> = rows(&s)
+            .into_iter()
+            .filter(|r| r.source == "--config")
+            .map(|r| (r.key, r.value))
+            .collect();
+        assert_eq!(
+            changed,
+            vec![("gnss_position_sigma_m", "[1, 1, 2] m".to_string())]
+        );
+    }
+}

@@ -264,3 +264,18 @@ fn nis(c: &Calibrated, s: &Summary, t: &[f64]) -> Result<FigureView, RenderError
         imu_nis(t, &values, [&lower, &upper], &title),
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::unwrapped_deg;
+
+    #[test]
+    fn a_turn_through_south_is_drawn_without_its_jump() {
+        // 170° → −170° is a turn of +20°, not of −340°; back again, and a second lap.
+        let y = unwrapped_deg(&[170.0, -170.0, -150.0, 170.0, -10.0, 170.0, -170.0]);
+        assert_eq!(y, vec![170.0, 190.0, 210.0, 170.0, 350.0, 530.0, 550.0]);
+        // Negative control: values within 180° of each other are left alone.
+        let z = [10.0, 100.0, -60.0, 30.0];
+        assert_eq!(unwrapped_deg(&z), z.to_vec());
+    }
+}
