@@ -23,6 +23,9 @@ use accelcal::output::{StagedFiles, check_directory};
 /// The files the three-axis calibration writes.
 const ESTIMATES_FILE: &str = "estimates.csv";
 const SUMMARY_FILE: &str = "summary.json";
+const PAGE_FILE: &str = "index.html";
+/// Every file the calibration writes.
+const FILES: [&str; 3] = [ESTIMATES_FILE, SUMMARY_FILE, PAGE_FILE];
 
 /// The options of the one-axis calibration that the three-axis one does not take yet.
 fn refuse_one_axis_options(args: &CalibrateArgs) -> Result<(), ConfigError> {
@@ -44,7 +47,7 @@ pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
         Some(path) => settings_of(&ConfigText::read(path)?)?,
         None => CONSUMER,
     };
-    check_directory(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE])?;
+    check_directory(&args.out, &FILES)?;
     if !args.quiet && std::io::stderr().is_terminal() {
         eprintln!("checking the logs, aligning and running the filter…");
     }
@@ -56,7 +59,7 @@ pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
         let s = summary(&c, &settings, &imu.display().to_string());
         (c, s)
     };
-    let mut staged = StagedFiles::create(&args.out, &[ESTIMATES_FILE, SUMMARY_FILE])?;
+    let mut staged = StagedFiles::create(&args.out, &FILES)?;
     let into = |name: &str| format!("cannot write {}", args.out.join(name).display());
     let smoothed = smooth(&c.records);
     write_estimates(&c, &smoothed, staged.writer(ESTIMATES_FILE))
@@ -66,6 +69,12 @@ pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
         .writer(SUMMARY_FILE)
         .write_all(json.as_bytes())
         .with_context(|| into(SUMMARY_FILE))?;
+    let page =
+        accelcal::report::calibration_imu::render(&c, &s, &smoothed, &command(args, imu, gnss))?;
+    staged
+        .writer(PAGE_FILE)
+        .write_all(page.as_bytes())
+        .with_context(|| into(PAGE_FILE))?;
     staged.commit()?;
     print_result(&s)
 }
@@ -123,6 +132,28 @@ fn with_noise(
     let mut s = summary(&c, &estimate.settings, imu.name());
     s.noise_estimate = Some(estimate);
     Ok((c, s))
+}
+
+/// The command line that reproduces the calibration.
+fn command(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> String {
+    let config = args
+        .config
+        .as_ref()
+        .map_or(String::new(), |c| format!(" --config {}", c.display()));
+    let mut noise = String::new();
+    if args.estimate_noise {
+        noise.push_str(" --estimate-noise");
+        if !args.estimate.is_empty() {
+            let keys: Vec<&str> = args.estimate.iter().map(|k| k.name()).collect();
+            noise.push_str(&format!(" --estimate {}", keys.join(",")));
+        }
+    }
+    format!(
+        "accelcal calibrate --imu {} --gnss {}{config}{noise} --out {}",
+        imu.display(),
+        gnss.display(),
+        args.out.display()
+    )
 }
 
 /// The error as the exit code reads it: a bad log or a recording that cannot be aligned is

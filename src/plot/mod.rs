@@ -26,6 +26,7 @@ use crate::state::ErrorState;
 mod allan;
 mod axis;
 mod calibration;
+pub mod calibration_imu;
 mod cases;
 mod consistency;
 mod covariance;

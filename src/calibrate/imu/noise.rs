@@ -93,6 +93,19 @@ impl ImuKey {
         }
     }
 
+    /// The field of the assumptions ([`Settings`]) it sets.
+    pub fn field(self) -> &'static str {
+        match self {
+            ImuKey::GnssHorizontalSigma | ImuKey::GnssVerticalSigma => "gnss_position_sigma_m",
+            ImuKey::GnssVelocitySigma => "gnss_velocity_sigma_m_s",
+            ImuKey::AccelVrw => "accel_vrw_m_s_per_sqrt_s",
+            ImuKey::GyroArw => "gyro_arw_rad_per_sqrt_s",
+            ImuKey::AccelBiasRandomWalk => "accel_bias_random_walk_m_s2_per_sqrt_s",
+            ImuKey::GyroBiasRandomWalk => "gyro_bias_random_walk_rad_s_per_sqrt_s",
+            ImuKey::GnssTimeOffset => "gnss_time_offset_s",
+        }
+    }
+
     /// The key named `name`.
     pub fn parse(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|k| k.name() == name)
