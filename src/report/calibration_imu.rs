@@ -273,7 +273,7 @@ pub fn view(
         ),
         // The components as words: "the position north innovations' whiteness".
         conditional: conditional_page_words(&s.rejected_by).replace('_', " "),
-        findings: super::calibration_imu_words::findings(s, elapsed),
+        findings: super::calibration_imu_words::findings(s),
         biases,
         attitude: attitude_rows(s),
         alignment: alignment_rows(s),

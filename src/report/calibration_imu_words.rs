@@ -55,25 +55,24 @@ fn listed(items: &[String]) -> String {
 
 /// The sentences the numbers choose: the yaw, the undetermined biases, the innovations'
 /// whiteness.
-pub fn findings(s: &Summary, elapsed: f64) -> Vec<String> {
+pub fn findings(s: &Summary) -> Vec<String> {
     let a = &s.attitude_deg;
-    let arw_deg = s.assumptions.gyro_arw_rad_per_sqrt_s.to_degrees();
-    let yaw_prior = (s.alignment.sigma_yaw_deg.powi(2) + arw_deg * arw_deg * elapsed).sqrt();
+    let yaw_prior = s.alignment.sigma_yaw_deg;
     let mut out = vec![if a.yaw_identifiable {
         format!(
             "The yaw is determined by the drive: its σ at the end, {}°, is less than half of \
-             the {}° the alignment's course and the gyros' noise alone would leave; the \
-             drive's turns and speed changes tell it.",
+             the alignment's {}°; the drive's turns and speed changes tell the heading better \
+             than the course it started from.",
             sig(a.sigma_yaw, 2),
             sig(yaw_prior, 2)
         )
     } else {
         format!(
-            "The yaw is not determined: its σ at the end, {}°, is more than half of the {}° \
-             the alignment's course and the gyros' noise alone would leave. The drive has no \
-             turns or speed changes to tell it, so the yaw is the course at the alignment \
-             carried by the gyros, and the heading offset assumed (heading_offset_sigma_deg) \
-             stays in its σ.",
+            "The yaw is not determined: its σ at the end, {}°, is more than half of the \
+             alignment's {}°. The drive's turns and speed changes, if it has any, did not tell \
+             the heading better than the gyros' noise lets it drift, so the yaw is about the \
+             course at the alignment carried by the gyros, and the heading offset assumed \
+             (heading_offset_sigma_deg) stays in its σ.",
             sig(a.sigma_yaw, 2),
             sig(yaw_prior, 2)
         )

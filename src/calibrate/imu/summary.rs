@@ -192,9 +192,11 @@ pub fn summary(c: &Calibrated, s: &Settings, imu_file: &str) -> Summary {
     if !attitude.yaw_identifiable {
         warnings.push(format!(
             "the yaw is not determined beyond the alignment's course: its σ at the end, {:.2}°, \
-             is more than {IDENTIFIABLE_SIGMA_RATIO} of the alignment's (a drive without turns \
-             or speed changes cannot tell it)",
-            attitude.sigma_yaw
+             is more than {IDENTIFIABLE_SIGMA_RATIO} of the alignment's {:.2}° (the drive's turns \
+             and speed changes, if any, did not tell the heading better than the gyros' noise \
+             lets it drift)",
+            attitude.sigma_yaw,
+            c.alignment.covariance[(8, 8)].sqrt().to_degrees()
         ));
     }
     if c.missing_velocity[2] > 0 {
@@ -296,10 +298,9 @@ fn end_estimates(r: &FixRecord, c: &Calibrated, s: &Settings, t: f64) -> (Triad,
     );
     let (roll, pitch, yaw) = euler_of(&r.pva.attitude);
     let [s_roll, s_pitch, s_yaw] = euler_sigmas(&r.pva, &r.covariance);
-    // The yaw's σ from the alignment and the gyro's noise alone over the drive.
-    let yaw0 = c.alignment.covariance[(8, 8)];
-    let arw = s.gyro_arw_rad_per_sqrt_s;
-    let yaw_prior = (yaw0 + arw * arw * t).sqrt();
+    // The yaw is determined beyond the course the alignment took it from when its σ at the end
+    // is at most half the alignment's.
+    let yaw_prior = c.alignment.covariance[(8, 8)].sqrt();
     let deg = f64::to_degrees;
     (
         triad(r.gyro_bias_rad_s.into(), sg, [pg; 3]),
