@@ -14,7 +14,7 @@ use accelcal::ensemble::Engine;
 use accelcal::ensemble::partial::PartialError;
 use accelcal::error::ConfigError;
 use accelcal::export;
-use accelcal::ins::blocks::{Blocks, run_blocks};
+use accelcal::ins::blocks::Blocks;
 use accelcal::ins::ensemble::{self as ins_ensemble, InsSums, Track};
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::partial::{self, InsPartialHeader};
@@ -165,7 +165,7 @@ fn run_shard(
     quiet: bool,
 ) -> Result<()> {
     let blocks = Blocks::new(study.realizations);
-    let shard = super::monte_carlo::parse_shard(shard, blocks.blocks, blocks.realizations)?;
+    let shard = super::shards::parse_shard(shard, blocks.blocks, blocks.realizations)?;
     let range = blocks.of_shard(shard);
     let realizations = range
         .clone()
@@ -183,7 +183,7 @@ fn run_shard(
     let mut bar = super::Bar::new(quiet);
     bar.start(&format!("ins shard {k}/{m}"), realizations);
     let mut written = Ok(());
-    run_blocks(
+    ins_ensemble::run_blocks(
         study,
         &track,
         &blocks,
@@ -226,7 +226,7 @@ fn run_shard(
 /// file of another model than the first file's.
 pub(super) fn is_ins_merge(paths: &[PathBuf]) -> Result<bool, PartialError> {
     let mut first: Option<(String, String)> = None;
-    for (name, mut r) in super::monte_carlo::open_partials(paths)? {
+    for (name, mut r) in super::shards::open_partials(paths)? {
         let (json, _) = accelcal::ensemble::partial::read_header_line(&mut r, &name)?;
         let model = accelcal::ensemble::partial::header_model(&json);
         match &first {
@@ -251,7 +251,7 @@ pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
     if let Some(path) = &args.json {
         accelcal::output::check_file(path)?;
     }
-    let merged = partial::merge(super::monte_carlo::open_partials(&args.files)?)?;
+    let merged = partial::merge(super::shards::open_partials(&args.files)?)?;
     let label = format!("three axes (merged from {} shards)", args.files.len());
     write_document(
         &merged.config,

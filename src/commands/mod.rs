@@ -7,6 +7,7 @@ mod allan;
 mod ins;
 mod logs;
 mod monte_carlo;
+mod shards;
 
 use std::io::IsTerminal;
 use std::path::Path;

@@ -7,7 +7,7 @@ use std::path::Path;
 use super::{Bar, check_memory, load_model, say, verdict_lines, write_json};
 use crate::cli::{CaseArgs, EnsembleArgs, MergeArgs, ReportArgs, SensitivityArgs};
 use accelcal::config::{Config, SensitivityConfig};
-use accelcal::ensemble::{Engine, Ensemble, EnsembleRun, EnsembleStats, Shard, partial};
+use accelcal::ensemble::{Engine, Ensemble, EnsembleRun, EnsembleStats, partial};
 use accelcal::error::ConfigError;
 use accelcal::filter::FilterSchedule;
 use accelcal::model::{Model, Work};
@@ -169,24 +169,6 @@ pub(super) fn run_sensitivity(args: &SensitivityArgs) -> Result<()> {
     Ok(())
 }
 
-/// "K/M" as shard K of M, with 1 ≤ K ≤ M ≤ `blocks`, the blocks of `realizations`.
-pub(super) fn parse_shard(
-    text: &str,
-    blocks: u64,
-    realizations: u64,
-) -> Result<Shard, ConfigError> {
-    let expected = format!(
-        "must be K/M with whole numbers 1 ≤ K ≤ M ≤ {blocks} (the blocks of N = {realizations})"
-    );
-    let parsed = text
-        .split_once('/')
-        .and_then(|(k, m)| Some((k.trim().parse::<u64>().ok()?, m.trim().parse::<u64>().ok()?)));
-    match parsed {
-        Some((k, m)) if 1 <= k && k <= m && m <= blocks => Ok(Shard { index: k, of: m }),
-        _ => Err(ConfigError::invalid("--shard", text, expected)),
-    }
-}
-
 fn run_shard(
     model: &Model,
     schedule: &FilterSchedule,
@@ -197,7 +179,7 @@ fn run_shard(
 ) -> Result<()> {
     let ensemble = Ensemble::new(model, schedule).with_engine(engine);
     let partition = ensemble.partition();
-    let shard = parse_shard(shard, partition.blocks, partition.realizations)?;
+    let shard = super::shards::parse_shard(shard, partition.blocks, partition.realizations)?;
     let ensemble = ensemble.with_shard(shard);
     let blocks = ensemble.block_range();
     let realizations = partition.realizations_in(&blocks);
@@ -252,22 +234,6 @@ fn run_shard(
     Ok(())
 }
 
-/// The partial files `paths`, opened, each with its name.
-pub(super) fn open_partials(
-    paths: &[std::path::PathBuf],
-) -> Result<Vec<(String, std::io::BufReader<std::fs::File>)>, partial::PartialError> {
-    let mut files = Vec::with_capacity(paths.len());
-    for path in paths {
-        let name = path.display().to_string();
-        let file = std::fs::File::open(path).map_err(|e| partial::PartialError::Unreadable {
-            file: name.clone(),
-            why: e.to_string(),
-        })?;
-        files.push((name, std::io::BufReader::new(file)));
-    }
-    Ok(files)
-}
-
 pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
     if let Some(path) = &args.json {
         check_file(path)?;
@@ -275,7 +241,7 @@ pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
     if super::ins::is_ins_merge(&args.files)? {
         return super::ins::run_merge(args);
     }
-    let merged = partial::merge(open_partials(&args.files)?)?;
+    let merged = partial::merge(super::shards::open_partials(&args.files)?)?;
     let model = Model::new(&merged.config)?;
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
     let run = EnsembleRun {

@@ -9,12 +9,15 @@
 //! folded in index order within blocks folded in order ([`super::blocks`]): the same numbers on
 //! any thread count and from any split into shards, memory flat in N.
 
+use std::ops::Range;
+
+use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
+use rayon::prelude::*;
+
 use crate::ensemble::normalized::{FixInput, NormalizedFix, NormalizedSums, StageInput};
 use crate::ensemble::{EnsembleStats, ResidualLayout};
-use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 
-use super::blocks::CHUNK;
-pub use super::blocks::sums;
+use super::blocks::{Blocks, CHUNK};
 use super::earth::offset;
 use super::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, POSITION, STATES, VELOCITY};
 use super::filter::{Ekf, FilterError};
@@ -348,6 +351,62 @@ pub fn empty_sums(study: &Study, track: &Track) -> InsSums {
         variance: SVector::zeros(),
         within_95: [0; STATES],
     }
+}
+
+/// The sums of each block of `range` of an ensemble of `study` cut as `blocks`, handed to
+/// `on_block` in block order; `progress` is told how many realizations are done after every
+/// chunk.
+///
+/// # Errors
+/// The first realization's [`RealizationError`], in index order.
+pub fn run_blocks(
+    study: &Study,
+    track: &Track,
+    blocks: &Blocks,
+    range: Range<u64>,
+    mut progress: impl FnMut(u64),
+    mut on_block: impl FnMut(u64, &InsSums),
+) -> Result<(), RealizationError> {
+    let mut done = 0;
+    for b in range {
+        let mut sums = empty_sums(study, track);
+        let indices = blocks.realizations_of(b);
+        let mut first = indices.start;
+        while first < indices.end {
+            let last = (first + CHUNK).min(indices.end);
+            let chunk: Vec<Result<Normalized, RealizationError>> = (first..last)
+                .into_par_iter()
+                .map(|l| realization(study, track, l))
+                .collect();
+            for r in chunk {
+                sums.add(&r?);
+            }
+            done += last - first;
+            first = last;
+            progress(done);
+        }
+        on_block(b, &sums);
+    }
+    Ok(())
+}
+
+/// The sums of the whole ensemble of `realizations` realizations of `study`: its blocks folded
+/// in block order; `progress` is told how many are done after every chunk.
+///
+/// # Errors
+/// The first realization's [`RealizationError`], in index order.
+pub fn sums(
+    study: &Study,
+    track: &Track,
+    realizations: u64,
+    progress: impl FnMut(u64),
+) -> Result<InsSums, RealizationError> {
+    let blocks = Blocks::new(realizations);
+    let mut total = empty_sums(study, track);
+    run_blocks(study, track, &blocks, 0..blocks.blocks, progress, |_, s| {
+        total.merge(s);
+    })?;
+    Ok(total)
 }
 
 /// Which error states do not move between fixes: a bias whose truth and filter both hold it
