@@ -56,8 +56,8 @@ pub struct InsPartialHeader {
 const FIX_LEN: usize = FixSums::<STATES>::FLOATS + 2 * STATES * STATES;
 
 impl InsPartialHeader {
-    /// The header of shard `shard` (its `blocks`) of `study`'s ensemble, configured by
-    /// `config`, whose realizations took `elapsed_s`.
+    /// The header of shard `shard` (its `blocks`) of the ensemble configured by `config`,
+    /// whose sums have the fixes and residual lag of `sums`, its realizations run in `elapsed_s`.
     pub fn new(
         config: &InsConfig,
         sums: &InsSums,
