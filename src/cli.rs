@@ -140,9 +140,9 @@ pub struct EnsembleArgs {
     pub partial: Option<PathBuf>,
     /// How realizations are simulated: `sample` draws and integrates every accelerometer
     /// sample; `epoch` draws the noise's exact effect once per GPS interval (same distribution
-    /// at the fixes, several times faster).
-    #[arg(long, value_parser = engine_parser(), default_value_t = Engine::Sample)]
-    pub engine: Engine,
+    /// at the fixes, several times faster). Default: sample; the one-axis model's option only.
+    #[arg(long, value_parser = engine_parser())]
+    pub engine: Option<Engine>,
 }
 
 #[derive(Debug, Args)]

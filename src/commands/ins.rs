@@ -1,17 +1,25 @@
-//! The three-axis study's commands: `simulate --model ins --logs DIR` and `ensemble --model ins`.
+//! The three-axis study's commands: `simulate --model ins --logs DIR`, `ensemble --model ins`
+//! (whole, or one shard of it), and the merge of its shards.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use crate::cli::{EnsembleArgs, ModelArgs, SimulateArgs};
+use crate::cli::{EnsembleArgs, MergeArgs, ModelArgs, SimulateArgs};
 use accelcal::checks::{Budget, evaluate};
 use accelcal::config::ConfigText;
 use accelcal::config::ins::InsConfig;
+use accelcal::ensemble::Engine;
+use accelcal::ensemble::partial::PartialError;
 use accelcal::error::ConfigError;
 use accelcal::export;
-use accelcal::ins::ensemble::{self as ins_ensemble, Track};
+use accelcal::ins::blocks::Blocks;
+use accelcal::ins::ensemble::{self as ins_ensemble, InsSums, Track};
 use accelcal::ins::logs::write_realization;
+use accelcal::ins::partial::{self, InsPartialHeader};
 use accelcal::ins::setup::Study;
-use accelcal::output::{StagedFiles, check_directory};
+use accelcal::output::{AtomicFile, ScratchFile, StagedFiles, check_directory};
 use accelcal::study::Progress;
 
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
@@ -69,11 +77,12 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         )
         .into());
     }
-    if args.shard.is_some() {
+    // Given explicitly as its default, it changes nothing; any other engine would be ignored.
+    if let Some(engine) = args.engine.filter(|e| *e != Engine::default()) {
         return Err(ConfigError::invalid(
-            "--shard",
-            args.shard.as_deref().unwrap_or_default(),
-            "an option of the one-axis model only (the three-axis ensemble runs whole)",
+            "--engine",
+            engine,
+            "an option of the one-axis model only (the three-axis ensemble runs its own filter)",
         )
         .into());
     }
@@ -93,6 +102,9 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         )
         .into());
     }
+    if let (Some(shard), Some(path)) = (&args.shard, &args.partial) {
+        return run_shard(&config, &study, shard, path, args.model.quiet);
+    }
     if let Some(path) = &args.json {
         accelcal::output::check_file(path)?;
     }
@@ -101,17 +113,38 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
     let n = study.realizations;
     let mut bar = super::Bar::new(args.model.quiet);
     bar.start("ins", n);
-    let sums = ins_ensemble::sums(&study, &track, 0..n, |done| bar.advance(done))?;
+    let sums = ins_ensemble::sums(&study, &track, n, |done| bar.advance(done))?;
     bar.finish();
-    let outcome = sums.outcome(&study);
-    let verdicts = evaluate(&outcome.stats, &Budget::study(study.false_alarm_rate));
     let elapsed_s = start.elapsed().as_secs_f64();
-    let doc = export::ins::document(&config, &outcome, &verdicts, elapsed_s);
-    super::write_json(args.json.as_deref(), |w| {
+    write_document(
+        &config,
+        &study,
+        &sums,
+        elapsed_s,
+        args.json.as_deref(),
+        Some("three axes"),
+    )
+}
+
+/// The JSON of the ensemble whose sums are `sums` to `json` (standard output when `None`), and
+/// its checks' lines, labelled `label` (none when `None`), when it goes to a file.
+fn write_document(
+    config: &InsConfig,
+    study: &Study,
+    sums: &InsSums,
+    elapsed_s: f64,
+    json: Option<&Path>,
+    label: Option<&str>,
+) -> Result<()> {
+    let outcome = sums.outcome(study);
+    let verdicts = evaluate(&outcome.stats, &Budget::study(study.false_alarm_rate));
+    let doc = export::ins::document(config, &outcome, &verdicts, elapsed_s);
+    super::write_json(json, |w| {
         serde_json::to_writer_pretty(w, &doc).map_err(std::io::Error::from)
     })?;
-    if args.json.is_some() {
-        let mut lines = super::check_lines("three axes", n, n as f64 / elapsed_s, &verdicts);
+    if let (Some(_), Some(label)) = (json, label) {
+        let n = study.realizations;
+        let mut lines = super::check_lines(label, n, n as f64 / elapsed_s, &verdicts);
         for c in &doc.summary.checks {
             if let Some(first) = &c.first_failure_member {
                 lines.push_str(&format!("  {} fails from {first}\n", c.id.name()));
@@ -120,6 +153,114 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         super::say(&lines)?;
     }
     Ok(())
+}
+
+/// `ensemble --model ins --shard K/M --partial FILE`: the blocks of shard K of M, their sums
+/// written to `path` (see docs/CLUSTER.md).
+fn run_shard(
+    config: &InsConfig,
+    study: &Study,
+    shard: &str,
+    path: &Path,
+    quiet: bool,
+) -> Result<()> {
+    let blocks = Blocks::new(study.realizations);
+    let shard = super::shards::parse_shard(shard, blocks.blocks, blocks.realizations)?;
+    let range = blocks.of_shard(shard);
+    let realizations = range
+        .clone()
+        .map(|b| blocks.realizations_of(b).count() as u64)
+        .sum();
+    let (k, m) = (shard.index, shard.of);
+    // Both files are made before the run: a destination that cannot be written is refused at
+    // once, and neither is left behind by a failure (or by SIGINT or SIGTERM).
+    let mut file = AtomicFile::create(path)?;
+    // The header carries the run time, so blocks wait in a scratch file until the run ends.
+    let (spool, spool_file) = ScratchFile::beside(path, "blocks")?;
+    let mut spool_w = std::io::BufWriter::new(spool_file);
+    let start = std::time::Instant::now();
+    let track = Track::of(study);
+    let mut bar = super::Bar::new(quiet);
+    bar.start(&format!("ins shard {k}/{m}"), realizations);
+    let mut written = Ok(());
+    ins_ensemble::run_blocks(
+        study,
+        &track,
+        &blocks,
+        range.clone(),
+        |done| bar.advance(done),
+        |b, sums| {
+            if written.is_ok() {
+                written = spool_w.write_all(&partial::encode_block(b, sums));
+            }
+        },
+    )?;
+    bar.finish();
+    let empty = ins_ensemble::empty_sums(study, &track);
+    let elapsed_s = start.elapsed().as_secs_f64();
+    let header = InsPartialHeader::new(config, &empty, shard, range.clone(), elapsed_s);
+    written
+        .and_then(|()| spool_w.flush())
+        .map_err(|e| spool.error(e))?;
+    drop(spool_w);
+    let mut blocks_read = std::io::BufReader::new(spool.open()?);
+    partial::write_partial(file.writer(), &header, &mut blocks_read).map_err(|e| file.error(e))?;
+    file.commit()?;
+    if !quiet {
+        super::say(&format!(
+            "three axes, shard {k}/{m}: blocks {}..{} ({realizations} realizations) written to \
+             {}\n",
+            range.start,
+            range.end,
+            path.display()
+        ))?;
+    }
+    Ok(())
+}
+
+/// Whether the partial files `paths` are of the three-axis ensemble (all of them) or of the
+/// one-axis one (all of them).
+///
+/// # Errors
+/// [`PartialError`] naming a file that cannot be read or whose header is damaged, or the first
+/// file of another model than the first file's.
+pub(super) fn is_ins_merge(paths: &[PathBuf]) -> Result<bool, PartialError> {
+    let mut first: Option<(String, String)> = None;
+    for (name, mut r) in super::shards::open_partials(paths)? {
+        let (json, _) = accelcal::ensemble::partial::read_header_line(&mut r, &name)?;
+        let model = accelcal::ensemble::partial::header_model(&json);
+        match &first {
+            None => first = Some((name, model)),
+            Some((first_name, first_model)) if *first_model != model => {
+                return Err(PartialError::Mismatch {
+                    file: name,
+                    why: format!(
+                        "a partial of the {model} model, {first_name} of the {first_model} \
+                         model: the files of one ensemble only"
+                    ),
+                });
+            }
+            Some(_) => {}
+        }
+    }
+    Ok(first.is_some_and(|(_, model)| model == partial::MODEL))
+}
+
+/// `merge` of three-axis partial files: the JSON one `ensemble --model ins` run writes.
+pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
+    if let Some(path) = &args.json {
+        accelcal::output::check_file(path)?;
+    }
+    let merged = partial::merge(super::shards::open_partials(&args.files)?)?;
+    let label = format!("three axes (merged from {} shards)", args.files.len());
+    write_document(
+        &merged.config,
+        &merged.study,
+        &merged.sums,
+        merged.elapsed_s,
+        args.json.as_deref(),
+        (!args.quiet).then_some(label.as_str()),
+    )
 }
 
 /// `simulate --model ins`: one realization's IMU and GNSS logs and its truth.

@@ -8,6 +8,7 @@ mod calibrate_imu;
 mod ins;
 mod logs;
 mod monte_carlo;
+mod shards;
 
 use std::io::IsTerminal;
 use std::path::Path;

@@ -7,7 +7,7 @@ use std::path::Path;
 use super::{Bar, check_memory, load_model, say, verdict_lines, write_json};
 use crate::cli::{CaseArgs, EnsembleArgs, MergeArgs, ReportArgs, SensitivityArgs};
 use accelcal::config::{Config, SensitivityConfig};
-use accelcal::ensemble::{Engine, Ensemble, EnsembleRun, EnsembleStats, Partition, Shard, partial};
+use accelcal::ensemble::{Engine, Ensemble, EnsembleRun, EnsembleStats, partial};
 use accelcal::error::ConfigError;
 use accelcal::filter::FilterSchedule;
 use accelcal::model::{Model, Work};
@@ -87,14 +87,14 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         return run_shard(
             &model,
             &schedule,
-            args.engine,
+            args.engine.unwrap_or_default(),
             shard,
             path,
             args.model.quiet,
         );
     }
     let outcome = study::run_case(
-        &Ensemble::new(&model, &schedule).with_engine(args.engine),
+        &Ensemble::new(&model, &schedule).with_engine(args.engine.unwrap_or_default()),
         &mut Bar::new(args.model.quiet),
     );
     let doc = export::ensemble_doc(&model.config, &schedule, &outcome);
@@ -169,21 +169,6 @@ pub(super) fn run_sensitivity(args: &SensitivityArgs) -> Result<()> {
     Ok(())
 }
 
-/// "K/M" as shard K of M, with 1 ≤ K ≤ M ≤ the blocks of `partition`.
-fn parse_shard(text: &str, partition: &Partition) -> Result<Shard, ConfigError> {
-    let expected = format!(
-        "must be K/M with whole numbers 1 ≤ K ≤ M ≤ {} (the blocks of N = {})",
-        partition.blocks, partition.realizations
-    );
-    let parsed = text
-        .split_once('/')
-        .and_then(|(k, m)| Some((k.trim().parse::<u64>().ok()?, m.trim().parse::<u64>().ok()?)));
-    match parsed {
-        Some((k, m)) if 1 <= k && k <= m && m <= partition.blocks => Ok(Shard { index: k, of: m }),
-        _ => Err(ConfigError::invalid("--shard", text, expected)),
-    }
-}
-
 fn run_shard(
     model: &Model,
     schedule: &FilterSchedule,
@@ -194,7 +179,7 @@ fn run_shard(
 ) -> Result<()> {
     let ensemble = Ensemble::new(model, schedule).with_engine(engine);
     let partition = ensemble.partition();
-    let shard = parse_shard(shard, &partition)?;
+    let shard = super::shards::parse_shard(shard, partition.blocks, partition.realizations)?;
     let ensemble = ensemble.with_shard(shard);
     let blocks = ensemble.block_range();
     let realizations = partition.realizations_in(&blocks);
@@ -253,16 +238,10 @@ pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
     if let Some(path) = &args.json {
         check_file(path)?;
     }
-    let mut files = Vec::with_capacity(args.files.len());
-    for path in &args.files {
-        let name = path.display().to_string();
-        let file = std::fs::File::open(path).map_err(|e| partial::PartialError::Unreadable {
-            file: name.clone(),
-            why: e.to_string(),
-        })?;
-        files.push((name, std::io::BufReader::new(file)));
+    if super::ins::is_ins_merge(&args.files)? {
+        return super::ins::run_merge(args);
     }
-    let merged = partial::merge(files)?;
+    let merged = partial::merge(super::shards::open_partials(&args.files)?)?;
     let model = Model::new(&merged.config)?;
     let schedule = FilterSchedule::new(&model.timeline, &model.filter_stats)?;
     let run = EnsembleRun {

@@ -6,7 +6,10 @@
 //!
 //! The truth is computed once and shared (every realization drives the same road); each
 //! realization's random stream depends only on the seed and its index, and the realizations are
-//! folded in index order, chunk by chunk: the same numbers on any thread count, memory flat in N.
+//! folded in index order within blocks folded in order ([`super::blocks`]): the same numbers on
+//! any thread count and from any split into shards, memory flat in N.
+
+use std::ops::Range;
 
 use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 use rayon::prelude::*;
@@ -14,6 +17,7 @@ use rayon::prelude::*;
 use crate::ensemble::normalized::{FixInput, NormalizedFix, NormalizedSums, StageInput};
 use crate::ensemble::{EnsembleStats, ResidualLayout};
 
+use super::blocks::{Blocks, CHUNK};
 use super::earth::offset;
 use super::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, POSITION, STATES, VELOCITY};
 use super::filter::{Ekf, FilterError};
@@ -23,10 +27,6 @@ use super::mech::{Increment, Pva};
 use super::sensors::Imu;
 use super::setup::Study;
 use super::truth::Truth;
-
-/// Realizations run side by side before they are folded into the sums, in index order (each
-/// holds its normalized fixes until then: 2.5 MB for the default drive).
-const CHUNK: u64 = 16;
 
 /// The GNSS measurement's rows: position and velocity, NED.
 pub const MEASURED: usize = 6;
@@ -79,6 +79,16 @@ impl InsSums {
         self.variance += r.final_sigma.component_mul(&r.final_sigma);
         for (k, w) in self.within_95.iter_mut().enumerate() {
             *w += u64::from((r.final_error[k] / r.final_sigma[k]).abs() <= Z95);
+        }
+    }
+
+    /// Adds `other`, the sums of other realizations of the same ensemble.
+    pub fn merge(&mut self, other: &InsSums) {
+        self.normalized.merge(&other.normalized);
+        self.sq_error += other.sq_error;
+        self.variance += other.variance;
+        for (w, o) in self.within_95.iter_mut().zip(other.within_95) {
+            *w += o;
         }
     }
 
@@ -320,14 +330,14 @@ pub fn layout(fixes: usize, max_lag: Option<usize>) -> ResidualLayout {
 }
 
 /// The memory an ensemble of `study` holds, bytes: a chunk of realizations' normalized fixes,
-/// the sums per fix and the residual products.
+/// and twice the sums per fix and the residual products (a block's and the total).
 pub fn memory_bytes(study: &Study) -> f64 {
     let fixes = (study.duration_s * study.imu_rate_hz / study.imu_steps_per_fix as f64).floor();
     let record = std::mem::size_of::<NormalizedFix<STATES, MEASURED>>() as f64;
     let per_fix = std::mem::size_of::<crate::ensemble::FixSums<STATES>>() as f64
         + 2.0 * (STATES * STATES * 8) as f64;
     let products = layout(fixes as usize, study.residual_max_lag).len() as f64 * 8.0;
-    CHUNK as f64 * fixes * record + fixes * per_fix + products
+    CHUNK as f64 * fixes * record + 2.0 * (fixes * per_fix + products)
 }
 
 /// Empty sums for `study`'s ensemble.
@@ -343,32 +353,60 @@ pub fn empty_sums(study: &Study, track: &Track) -> InsSums {
     }
 }
 
-/// The sums over realizations `range` of `study`, folded in index order; `progress` is told how
-/// many are done after every chunk.
+/// The sums of each block of `range` of an ensemble of `study` cut as `blocks`, handed to
+/// `on_block` in block order; `progress` is told how many realizations are done after every
+/// chunk.
+///
+/// # Errors
+/// The first realization's [`RealizationError`], in index order.
+pub fn run_blocks(
+    study: &Study,
+    track: &Track,
+    blocks: &Blocks,
+    range: Range<u64>,
+    mut progress: impl FnMut(u64),
+    mut on_block: impl FnMut(u64, &InsSums),
+) -> Result<(), RealizationError> {
+    let mut done = 0;
+    for b in range {
+        let mut sums = empty_sums(study, track);
+        let indices = blocks.realizations_of(b);
+        let mut first = indices.start;
+        while first < indices.end {
+            let last = (first + CHUNK).min(indices.end);
+            let chunk: Vec<Result<Normalized, RealizationError>> = (first..last)
+                .into_par_iter()
+                .map(|l| realization(study, track, l))
+                .collect();
+            for r in chunk {
+                sums.add(&r?);
+            }
+            done += last - first;
+            first = last;
+            progress(done);
+        }
+        on_block(b, &sums);
+    }
+    Ok(())
+}
+
+/// The sums of the whole ensemble of `realizations` realizations of `study`: its blocks folded
+/// in block order; `progress` is told how many are done after every chunk.
 ///
 /// # Errors
 /// The first realization's [`RealizationError`], in index order.
 pub fn sums(
     study: &Study,
     track: &Track,
-    range: std::ops::Range<u64>,
-    mut progress: impl FnMut(u64),
+    realizations: u64,
+    progress: impl FnMut(u64),
 ) -> Result<InsSums, RealizationError> {
-    let mut sums = empty_sums(study, track);
-    let mut first = range.start;
-    while first < range.end {
-        let last = (first + CHUNK).min(range.end);
-        let chunk: Vec<Result<Normalized, RealizationError>> = (first..last)
-            .into_par_iter()
-            .map(|l| realization(study, track, l))
-            .collect();
-        for r in chunk {
-            sums.add(&r?);
-        }
-        first = last;
-        progress(first - range.start);
-    }
-    Ok(sums)
+    let blocks = Blocks::new(realizations);
+    let mut total = empty_sums(study, track);
+    run_blocks(study, track, &blocks, 0..blocks.blocks, progress, |_, s| {
+        total.merge(s);
+    })?;
+    Ok(total)
 }
 
 /// Which error states do not move between fixes: a bias whose truth and filter both hold it
@@ -389,5 +427,5 @@ pub fn constant_states(study: &Study) -> [bool; STATES] {
 /// # Errors
 /// The first realization's [`RealizationError`], in index order.
 pub fn run(study: &Study, track: &Track, realizations: u64) -> Result<Outcome, RealizationError> {
-    Ok(sums(study, track, 0..realizations, |_| {})?.outcome(study))
+    Ok(sums(study, track, realizations, |_| {})?.outcome(study))
 }

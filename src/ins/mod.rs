@@ -7,6 +7,7 @@
 //! WGS-84; attitude as the Hamilton quaternion q_b^n (scalar first), read as Euler angles ZYX
 //! (yaw ψ, then pitch θ, then roll φ).
 
+pub mod blocks;
 pub mod discrete;
 pub mod drive;
 pub mod earth;
@@ -17,6 +18,7 @@ pub mod gnss;
 pub mod logs;
 pub mod mech;
 pub mod names;
+pub mod partial;
 pub mod sensors;
 pub mod setup;
 pub mod truth;

@@ -72,7 +72,7 @@ fn judged(
     label: &str,
 ) -> Result<(Verdicts, Calibration, Vec<f64>), RealizationError> {
     progress.start(label, realizations);
-    let sums = ensemble::sums(study, track, 0..realizations, |done| progress.advance(done))?;
+    let sums = ensemble::sums(study, track, realizations, |done| progress.advance(done))?;
     progress.finish();
     let outcome = sums.outcome(study);
     let verdicts = evaluate(&outcome.stats, &Budget::study(study.false_alarm_rate));

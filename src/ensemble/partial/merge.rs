@@ -8,8 +8,8 @@ use crate::ensemble::sums::Accumulator;
 use crate::ensemble::{Engine, Partition, Shard};
 use crate::model::Model;
 
-/// The dotted path of the first field where `a` and `b` differ.
-fn first_difference(a: &Config, b: &Config) -> String {
+/// The dotted path of the first field where the configurations `a` and `b` differ.
+pub fn first_difference<C: serde::Serialize>(a: &C, b: &C) -> String {
     fn walk(a: &serde_json::Value, b: &serde_json::Value, path: &str) -> Option<String> {
         match (a, b) {
             (serde_json::Value::Object(x), serde_json::Value::Object(y)) => {
@@ -29,7 +29,7 @@ fn first_difference(a: &Config, b: &Config) -> String {
             _ => (a != b).then(|| path.to_string()),
         }
     }
-    let value = |c: &Config| serde_json::to_value(c).expect("a configuration serializes");
+    let value = |c: &C| serde_json::to_value(c).expect("a configuration serializes");
     walk(&value(a), &value(b), "").unwrap_or_default()
 }
 
@@ -106,7 +106,7 @@ struct Opened<R> {
     r: R,
 }
 
-fn mismatch(file: &str, why: String) -> PartialError {
+pub(super) fn mismatch(file: &str, why: String) -> PartialError {
     PartialError::Mismatch {
         file: file.to_string(),
         why,
@@ -195,25 +195,38 @@ fn shard_of_partition(h: &PartialHeader, partition: &Partition) -> Option<String
 
 /// Checks that the files `opened`, sorted by shard, hold each of the `shards` shards once.
 fn every_shard_once<R>(opened: &[Opened<R>], shards: u64) -> Result<(), PartialError> {
-    for pair in opened.windows(2) {
-        if pair[0].header.shard == pair[1].header.shard {
+    let given: Vec<(&str, u64)> = opened
+        .iter()
+        .map(|o| (o.name.as_str(), o.header.shard))
+        .collect();
+    each_shard_once(&given, shards)
+}
+
+/// Checks that the files `given` (name, shard k), sorted by shard, hold each of the `shards`
+/// shards once.
+///
+/// # Errors
+/// [`PartialError::Mismatch`] naming a shard given twice; [`PartialError::Missing`] naming the
+/// first shard missing and listing which file holds which shard.
+pub fn each_shard_once(given: &[(&str, u64)], shards: u64) -> Result<(), PartialError> {
+    for pair in given.windows(2) {
+        if pair[0].1 == pair[1].1 {
             return Err(mismatch(
-                &pair[1].name,
+                pair[1].0,
                 format!(
                     "shard {}/{shards} is given twice (also {})",
-                    pair[1].header.shard, pair[0].name
+                    pair[1].1, pair[0].0
                 ),
             ));
         }
     }
-    let present: Vec<u64> = opened.iter().map(|o| o.header.shard).collect();
-    match (1..=shards).find(|k| !present.contains(k)) {
+    match (1..=shards).find(|k| !given.iter().any(|g| g.1 == *k)) {
         Some(missing) => Err(PartialError::Missing {
             shard: missing,
             shards,
-            given: opened
+            given: given
                 .iter()
-                .map(|o| format!("{} (shard {}/{shards})", o.name, o.header.shard))
+                .map(|(name, k)| format!("{name} (shard {k}/{shards})"))
                 .collect::<Vec<_>>()
                 .join(", "),
         }),
