@@ -14,6 +14,10 @@
 //!    trend), and the IEEE 952 reading off the curve that replaces the fit when the test rejects
 //!    it.
 //!
+//! [`stream`] computes step 1 on a log read piece by piece, in memory independent of its length
+//! (with [`noise_stream`] for step 2), for `allan --imu` on long recordings; [`analyse_grid`]
+//! runs steps 3–5 on its result.
+//!
 //! [`simulate`] draws synthetic static logs with known terms (for the tests, the report and the
 //! benchmarks); [`export`] writes `allan.json`, `noise.toml` and `imu.yaml`; [`section`] measures
 //! the coverage of the intervals the report shows. The page and its figure are drawn above this

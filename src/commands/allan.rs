@@ -129,7 +129,7 @@ fn run_imu(args: &AllanArgs, path: &std::path::Path) -> Result<()> {
     let mut all: Vec<&str> = vec![JSON_FILE, TOML_FILE, YAML_FILE, PAGE_FILE];
     all.extend(axis_files.iter().map(String::as_str));
     accelcal::output::check_directory(&args.out, &all)?;
-    note("reading the log twice: the means and steps, then every channel's Allan deviation…");
+    note("reading the log and computing every channel's Allan deviation…");
     let a = analyse_imu_log(args, path)?;
     let name = path.display().to_string();
     let command = format!(
