@@ -115,7 +115,7 @@ pub(super) fn unreadable(file: &str, message: String) -> LogError {
 /// Reads the messages of one MCAP file into `topics` (every `Imu` topic's decoded).
 fn read_mcap(path: &Path, topics: &mut Topics) -> Result<(), LogError> {
     let file = path.display().to_string();
-    visit_mcap(path, &mut |event| match event {
+    visit_mcap(path, true, &mut |event| match event {
         McapEvent::Channel(topic, kind) => {
             topics
                 .types

@@ -122,19 +122,22 @@ pub fn analyse_records(
         ACCEPTED_STEP_RATIO.1 * median_s,
     );
     let mut streams: Vec<AllanStream> = means.into_iter().map(AllanStream::new).collect();
-    let mut batch: Vec<Vec<f64>> = vec![Vec::with_capacity(BATCH); channels.len()];
-    let feed = |streams: &mut Vec<AllanStream>, batch: &mut Vec<Vec<f64>>| {
-        streams
-            .par_iter_mut()
-            .zip(batch.par_iter_mut())
-            .for_each(|(s, b)| {
-                s.extend(b);
-                b.clear();
-            });
-    };
-    let mut previous_s: Option<f64> = None;
-    records
-        .read(&mut |r| {
+    // The second read on this thread, the streams on the others: batches handed over a queue
+    // of two, so that reading and summing overlap.
+    let (send, receive) = std::sync::mpsc::sync_channel::<Vec<Vec<f64>>>(2);
+    let read = std::thread::scope(|scope| {
+        let summing = scope.spawn(|| {
+            for batch in receive {
+                streams
+                    .par_iter_mut()
+                    .zip(batch.par_iter())
+                    .for_each(|(s, b)| s.extend(b));
+            }
+        });
+        let empty = || vec![Vec::with_capacity(BATCH); channels.len()];
+        let mut batch = empty();
+        let mut previous_s: Option<f64> = None;
+        let read = records.read(&mut |r| {
             if let Some(p) = previous_s.replace(r.t_s) {
                 let step_s = r.t_s - p;
                 if !(lo..=hi).contains(&step_s) {
@@ -152,12 +155,20 @@ pub fn analyse_records(
                 b.push(*v);
             }
             if batch[0].len() == BATCH {
-                feed(&mut streams, &mut batch);
+                // The receiver lives until every batch is sent.
+                send.send(std::mem::replace(&mut batch, empty()))
+                    .expect("the summing thread receives");
             }
             Ok(())
-        })
-        .map_err(StreamError::Log)?;
-    feed(&mut streams, &mut batch);
+        });
+        if read.is_ok() {
+            send.send(batch).expect("the summing thread receives");
+        }
+        drop(send);
+        summing.join().expect("the summing thread does not panic");
+        read
+    });
+    read.map_err(StreamError::Log)?;
     let samples = streams.first().map_or(0, AllanStream::samples);
     let analyses: Vec<ChannelAnalysis> = streams
         .into_par_iter()
