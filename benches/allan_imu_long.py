@@ -17,6 +17,7 @@ allantools' at the tau computed exactly (m <= 2^18) and at the strided ones.
 
 import argparse
 import json
+import os
 import re
 import statistics
 import subprocess
@@ -113,6 +114,7 @@ def main():
     print(f"{path}: {n} messages, {6 * n:.3g} values, {path.stat().st_size / 1e9:.2f} GB; "
           f"allantools {allantools.__version__}, numpy {np.__version__}")
 
+    print("load average before: %.1f %.1f %.1f" % os.getloadavg())
     runs = [run_binary(a.bin, path) for _ in range(a.repeats)]
     walls, rss, cpus = ([r[i] for r in runs] for i in range(3))
     print(f"accelcal allan --imu: wall median {statistics.median(walls):.2f} s "
@@ -121,15 +123,16 @@ def main():
           f"(max {max(rss):.0f})")
 
     y = np.concatenate([c for _, c in channels(n, a.rate, PIECE)])
-    times, worst_exact, worst_strided = [], 0.0, 0.0
+    times, cpu, worst_exact, worst_strided = [], [], 0.0, 0.0
     for rep in range(a.repeats):
-        start = time.perf_counter()
+        start, c0 = time.perf_counter(), time.process_time()
         devs = []
         for k in range(6):
             taus, dev, _, _ = allantools.oadev(np.ascontiguousarray(y[:, k]), rate=a.rate,
                                                data_type="freq", taus="octave")
             devs.append(dev)
         times.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - c0)
     columns = ["ax_m_s2", "ay_m_s2", "az_m_s2", "gx_rad_s", "gy_rad_s", "gz_rad_s"]
     for k, column in enumerate(columns):
         ch = runs[0][3]["channels"][column]
@@ -140,7 +143,8 @@ def main():
         if (m > EXACT_MAX_M).any():
             worst_strided = max(worst_strided, rel[m > EXACT_MAX_M].max())
     print(f"allantools.oadev, six channels in memory: wall median {statistics.median(times):.2f} s "
-          f"(min {min(times):.2f}, max {max(times):.2f})")
+          f"(min {min(times):.2f}, max {max(times):.2f}), CPU median {statistics.median(cpu):.2f} s")
+    print("load average after: %.1f %.1f %.1f" % os.getloadavg())
     print(f"largest |accelcal/allantools - 1|: {worst_exact:.1e} at m <= 2^18 (exact), "
           f"{worst_strided:.1e} beyond (strided)")
 

@@ -210,15 +210,16 @@ impl AllanStream {
             *last = x;
             j += 1;
         }
+        // Strides are powers of two: a mask, not a division, per sample.
         for t in &mut self.strided {
-            if i.is_multiple_of(t.stride) {
+            if i & (t.stride - 1) == 0 {
                 let q = i / t.stride;
                 t.ring[q % RING] = x;
                 t.term(q);
             }
         }
         let (next_m, next_stride) = self.next_strided();
-        if i.is_multiple_of(next_stride) {
+        if i & (next_stride - 1) == 0 {
             self.history.push(x);
             if i == 2 * next_m {
                 self.strided.push(StridedTau::start(next_m, &self.history));
