@@ -145,7 +145,11 @@ impl ImuRecords for McapRecords {
                 if kind != IMU_TYPE {
                     return Ok(());
                 }
-                let k = counts.entry(topic.to_string()).or_default();
+                // A lookup by the borrowed name: no allocation per message.
+                if !counts.contains_key(topic) {
+                    counts.insert(topic.to_string(), 0);
+                }
+                let k = counts.get_mut(topic).expect("inserted");
                 let m = decode_imu(data).map_err(|e| {
                     let at = format!("{}, topic {topic}, message {k}", f.display());
                     unreadable(&at, e)
