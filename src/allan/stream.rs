@@ -7,9 +7,9 @@
 //! same stretches and blocks over a window of the phase 2·[`EXACT_MAX_M`] + [`STRETCH`] long: the
 //! same bits as [`deviation::overlapping_avars`] on the whole phase. Beyond, at τ = mτ₀ with
 //! m > [`EXACT_MAX_M`], the second differences are taken at the offsets k that are multiples of
-//! the stride s = m / [`OFFSETS_PER_TAU`] only (Howe, Allan & Barnes 1981, § 5: the overlapping
-//! estimator with a step of s between its terms; stride m is the non-overlapping one, stride 1
-//! the fully overlapping one):
+//! the stride s = m / [`OFFSETS_PER_TAU`] only: NIST SP 1065's eq. (11) with a step of s between
+//! its terms (s = 1 is eq. (11) itself, s = m the non-overlapping Allan variance of the same
+//! handbook):
 //!
 //! σ̂²(mτ₀) = Σ_{k ∈ sℤ, 0 ≤ k ≤ n − 2m} (x_{k+2m} − 2x_{k+m} + x_k)² / (2 T m²),  T the terms.
 //!
