@@ -170,7 +170,7 @@ fn stretch_sums_plain(
 crate::lanes::vectorized! {
     /// [`stretch_sums_plain`], compiled for AVX2 when the processor has it (the same bits:
     /// Rust contracts no product and sum into an FMA).
-    fn stretch_sums(x: &[f64], factors: &[usize], terms: &[usize], from: usize, to: usize) -> Vec<f64> => stretch_sums_plain
+    pub(crate) fn stretch_sums(x: &[f64], factors: &[usize], terms: &[usize], from: usize, to: usize) -> Vec<f64> => stretch_sums_plain
 }
 
 /// The overlapping Allan variance at every factor of `factors` from the phase `x` (in

@@ -14,6 +14,10 @@
 //!    trend), and the IEEE 952 reading off the curve that replaces the fit when the test rejects
 //!    it.
 //!
+//! [`stream`] computes step 1 on a log read piece by piece, in memory independent of its length
+//! (with [`noise_stream`] for step 2), for `allan --imu` on long recordings; [`analyse_grid`]
+//! runs steps 3–5 on its result.
+//!
 //! [`simulate`] draws synthetic static logs with known terms (for the tests, the report and the
 //! benchmarks); [`export`] writes `allan.json`, `noise.toml` and `imu.yaml`; [`section`] measures
 //! the coverage of the intervals the report shows. The page and its figure are drawn above this
@@ -29,9 +33,11 @@ pub mod imu;
 pub mod log;
 pub mod nnls;
 pub mod noise_id;
+pub mod noise_stream;
 pub mod reading;
 pub mod section;
 pub mod simulate;
+pub mod stream;
 
 use rayon::prelude::*;
 use thiserror::Error;
@@ -160,20 +166,33 @@ fn points(x: &[f64], tau0_s: f64, confidence: f64) -> Vec<AllanPoint> {
     let n = x.len() - 1;
     let factors = deviation::octave_factors(n);
     let avars = deviation::overlapping_avars(x, &factors);
-    let mut out: Vec<AllanPoint> = factors
+    let raw: Vec<(usize, f64, Option<NoiseId>)> = factors
         .par_iter()
         .zip(avars)
-        .map(|(&m, avar)| {
-            let noise = noise_id::identify(&noise_id::block_means(x, m));
-            AllanPoint {
-                m,
-                tau_s: m as f64 * tau0_s,
-                adev: avar.sqrt(),
-                noise,
-                identified_here: noise.is_some(),
-                edf: None,
-                interval: None,
-            }
+        .map(|(&m, avar)| (m, avar, noise_id::identify(&noise_id::block_means(x, m))))
+        .collect();
+    with_intervals(&raw, n, tau0_s, confidence)
+}
+
+/// The points of the octave grid from each τ's (m, σ̂², the noise of its own block means) for n
+/// samples: the noise carried from the longest τ identified where fewer than 30 block means
+/// remain, the EDF for that noise and the χ² interval at `confidence`.
+fn with_intervals(
+    raw: &[(usize, f64, Option<NoiseId>)],
+    n: usize,
+    tau0_s: f64,
+    confidence: f64,
+) -> Vec<AllanPoint> {
+    let mut out: Vec<AllanPoint> = raw
+        .iter()
+        .map(|&(m, avar, noise)| AllanPoint {
+            m,
+            tau_s: m as f64 * tau0_s,
+            adev: avar.sqrt(),
+            noise,
+            identified_here: noise.is_some(),
+            edf: None,
+            interval: None,
         })
         .collect();
     let mut last = None;
@@ -224,7 +243,41 @@ pub fn analyse(y: &[f64], tau0_s: f64, confidence: f64) -> Result<Analysis, Alla
         });
     }
     let x = deviation::phase(y);
-    let points = points(&x, tau0_s, confidence);
+    analyse_points(points(&x, tau0_s, confidence), y.len(), tau0_s, confidence)
+}
+
+/// Analyses the rate samples of a log read once ([`stream::AllanStream`]): `grid` holds each
+/// octave τ's (m, σ̂², the noise of its block means) for `samples` samples τ₀ = `tau0_s` apart.
+/// The rest is [`analyse`]'s: the same analysis wherever the grid holds the same numbers.
+///
+/// # Errors
+/// As [`analyse`].
+pub fn analyse_grid(
+    grid: &[(usize, f64, Option<NoiseId>)],
+    samples: usize,
+    tau0_s: f64,
+    confidence: f64,
+) -> Result<Analysis, AllanError> {
+    if !(confidence > 0.0 && confidence < 1.0) {
+        return Err(AllanError::Confidence(confidence));
+    }
+    if samples < MIN_SAMPLES {
+        return Err(AllanError::TooFewSamples {
+            found: samples,
+            needed: MIN_SAMPLES,
+        });
+    }
+    let points = with_intervals(grid, samples, tau0_s, confidence);
+    analyse_points(points, samples, tau0_s, confidence)
+}
+
+/// The fit and its reading on the points of a log of `samples` samples.
+fn analyse_points(
+    points: Vec<AllanPoint>,
+    samples: usize,
+    tau0_s: f64,
+    confidence: f64,
+) -> Result<Analysis, AllanError> {
     if points.iter().all(|p| p.adev == 0.0) {
         return Err(AllanError::Constant);
     }
@@ -242,17 +295,17 @@ pub fn analyse(y: &[f64], tau0_s: f64, confidence: f64) -> Result<Analysis, Alla
         .collect();
     let terms = fitted_terms(&points);
     let fit =
-        fit::fit(&fit_points, y.len(), tau0_s, &terms, confidence).ok_or(AllanError::Constant)?;
+        fit::fit(&fit_points, samples, tau0_s, &terms, confidence).ok_or(AllanError::Constant)?;
     let departures = reading::departures(&points, &fit);
     let features = reading::features(&points, &departures, &fit);
     let (reading, terms) = if fit.goodness.rejected {
-        let read = reading::ieee952(&points, &terms, y.len(), confidence);
+        let read = reading::ieee952(&points, &terms, samples, confidence);
         (Reading::Ieee952, read)
     } else {
         (Reading::Fit, fit.terms.clone())
     };
     Ok(Analysis {
-        samples: y.len(),
+        samples,
         sample_period_s: tau0_s,
         confidence,
         points,

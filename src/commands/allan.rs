@@ -6,7 +6,9 @@ use std::io::{IsTerminal, Write as _};
 use anyhow::{Context, Result};
 
 use crate::cli::AllanArgs;
-use accelcal::allan::imu::{self, Channel, ImuAnalysis, Sensor, read::read_imu_log};
+use accelcal::allan::imu::read::{CsvRecords, read_imu_log};
+use accelcal::allan::imu::stream::{ImuRecords, StreamError};
+use accelcal::allan::imu::{self, Channel, ImuAnalysis, Sensor};
 use accelcal::allan::{self, Term, export, log::read_static_log};
 use accelcal::format::{count, interval_digits, sig};
 use accelcal::logs::read::LogFile;
@@ -127,20 +129,8 @@ fn run_imu(args: &AllanArgs, path: &std::path::Path) -> Result<()> {
     let mut all: Vec<&str> = vec![JSON_FILE, TOML_FILE, YAML_FILE, PAGE_FILE];
     all.extend(axis_files.iter().map(String::as_str));
     accelcal::output::check_directory(&args.out, &all)?;
-    note("reading the log…");
-    let log = if imu::bag::is_recording(path) {
-        imu::bag::read_recording(path, args.topic.as_deref())?
-    } else if args.topic.is_some() {
-        return Err(super::logs::UsageError(format!(
-            "--topic names a topic of an MCAP file or a ROS 2 bag; {} is read as CSV",
-            path.display()
-        ))
-        .into());
-    } else {
-        read_imu_log(&LogFile::new(path))?
-    };
-    note("computing the Allan deviation and fitting the noise terms of every channel…");
-    let a = imu::analyse_imu(&log, args.confidence).with_context(|| path.display().to_string())?;
+    note("reading the log and computing every channel's Allan deviation…");
+    let a = analyse_imu_log(args, path)?;
     let name = path.display().to_string();
     let command = format!(
         "accelcal allan --imu {} --confidence {} --out {}",
@@ -175,6 +165,46 @@ fn run_imu(args: &AllanArgs, path: &std::path::Path) -> Result<()> {
     staged.commit()?;
     super::say(&imu_summary(&a, &args.out))?;
     Ok(())
+}
+
+/// The analysis of every channel of the log `path`: a regular file or a recording read twice
+/// from disk ([`imu::stream`]), a pipe or a ROS 1 bag read whole.
+fn analyse_imu_log(args: &AllanArgs, path: &std::path::Path) -> Result<ImuAnalysis> {
+    let source = LogFile::new(path);
+    let regular_file = std::fs::metadata(path).is_ok_and(|m| m.is_file());
+    let streamed: Option<Box<dyn ImuRecords + '_>> = if imu::bag::is_recording(path) {
+        imu::bag::open_recording(path, args.topic.as_deref())?
+            .map(|r| Box::new(r) as Box<dyn ImuRecords>)
+    } else if args.topic.is_some() {
+        return Err(super::logs::UsageError(format!(
+            "--topic names a topic of an MCAP file or a ROS 2 bag; {} is read as CSV",
+            path.display()
+        ))
+        .into());
+    } else if regular_file {
+        Some(Box::new(CsvRecords::open(&source)?))
+    } else {
+        None
+    };
+    let a = match streamed {
+        Some(records) => match imu::stream::analyse_records(records.as_ref(), args.confidence) {
+            Ok(a) => a,
+            Err(StreamError::Log(e)) => return Err(e.into()),
+            Err(StreamError::Channel(e)) => {
+                return Err(anyhow::Error::new(e).context(path.display().to_string()));
+            }
+        },
+        // A pipe is read once, into memory; a ROS 1 bag is read whole.
+        None => {
+            let log = if imu::bag::is_recording(path) {
+                imu::bag::read_recording(path, args.topic.as_deref())?
+            } else {
+                read_imu_log(&source)?
+            };
+            imu::analyse_imu(&log, args.confidence).with_context(|| path.display().to_string())?
+        }
+    };
+    Ok(a)
 }
 
 /// The printed lines of `allan --imu`: the extent, one line per channel, each sensor's keys.

@@ -11,6 +11,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use super::mcap_stream::{McapEvent, McapRecords, visit_mcap};
 use super::{Channel, ImuSamples};
 use crate::allan::log::{first_gap, median_step};
 use crate::logs::{LogError, LogProblem};
@@ -111,80 +112,29 @@ pub(super) fn unreadable(file: &str, message: String) -> LogError {
     LogError::of_file(file, LogProblem::Unreadable { message })
 }
 
-/// The longest record the MCAP reader accepts, bytes: a corrupt length then is an error, where
-/// `mcap::MessageStream` (0.26, no limit) panics on a length near 2⁶⁴.
-const RECORD_LIMIT: usize = 1 << 30;
-
-/// Reads the messages of one MCAP file into `topics`: the `mcap` crate's linear reader (chunks
-/// decompressed, their CRCs checked, records no longer than [`RECORD_LIMIT`]).
+/// Reads the messages of one MCAP file into `topics` (every `Imu` topic's decoded).
 fn read_mcap(path: &Path, topics: &mut Topics) -> Result<(), LogError> {
-    use mcap::records::Record;
-    use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| unreadable(&file, e.to_string()))?;
-    if !bytes.starts_with(MCAP_MAGIC) {
-        return Err(unreadable(
-            &file,
-            "expected an MCAP file (its magic bytes)".into(),
-        ));
-    }
-    let mut reader = LinearReader::new_with_options(
-        LinearReaderOptions::default()
-            .with_validate_chunk_crcs(true)
-            .with_record_length_limit(RECORD_LIMIT),
-    );
-    let mut rest = bytes.as_slice();
-    let mut schemas: BTreeMap<u16, String> = BTreeMap::new();
-    let mut channels: BTreeMap<u16, (String, String)> = BTreeMap::new();
-    let mut index = 0usize;
-    let broken = |index: usize, e: &dyn std::fmt::Display| {
-        unreadable(
-            &file,
-            format!("not a readable MCAP file at message {index}: {e}"),
-        )
-    };
-    while let Some(event) = reader.next_event() {
-        let (opcode, data) = match event.map_err(|e| broken(index, &e))? {
-            LinearReadEvent::ReadRequest(need) => {
-                let len = need.min(rest.len());
-                reader.insert(len).copy_from_slice(&rest[..len]);
-                reader.notify_read(len);
-                rest = &rest[len..];
-                continue;
-            }
-            LinearReadEvent::Record { opcode, data } => (opcode, data),
-        };
-        match mcap::parse_record(opcode, data).map_err(|e| broken(index, &e))? {
-            Record::Schema { header, .. } => {
-                schemas.insert(header.id, header.name);
-            }
-            Record::Channel(c) => {
-                let kind = schemas
-                    .get(&c.schema_id)
-                    .cloned()
-                    .unwrap_or_else(|| "(no schema)".to_string());
-                topics.types.entry(c.topic.clone()).or_insert(kind.clone());
-                channels.insert(c.id, (c.topic, kind));
-            }
-            Record::Message { header, data } => {
-                index += 1;
-                let Some((topic, kind)) = channels.get(&header.channel_id) else {
-                    let e = format!("channel {} is not defined before it", header.channel_id);
-                    return Err(broken(index - 1, &e));
-                };
-                if kind != IMU_TYPE {
-                    continue;
-                }
-                let list = topics.imu.entry(topic.clone()).or_default();
-                let decoded = decode_imu(&data).map_err(|e| {
-                    unreadable(&format!("{file}, topic {topic}, message {}", list.len()), e)
-                })?;
-                list.push(decoded);
-            }
-            _ => {}
+    visit_mcap(path, true, &mut |event| match event {
+        McapEvent::Channel(topic, kind) => {
+            topics
+                .types
+                .entry(topic.to_string())
+                .or_insert(kind.to_string());
+            Ok(())
         }
-    }
-    Ok(())
+        McapEvent::Message(topic, kind, data) => {
+            if kind != IMU_TYPE {
+                return Ok(());
+            }
+            let list = topics.imu.entry(topic.to_string()).or_default();
+            let decoded = decode_imu(data).map_err(|e| {
+                unreadable(&format!("{file}, topic {topic}, message {}", list.len()), e)
+            })?;
+            list.push(decoded);
+            Ok(())
+        }
+    })
 }
 
 /// The MCAP files of a ROS 2 bag directory, in name order (a split bag's parts in sequence).
@@ -267,6 +217,22 @@ pub fn read_recording(path: &Path, topic: Option<&str>) -> Result<ImuSamples, Lo
     } else {
         IMU_TYPE
     };
+    let chosen = choose_topic(&name, &topics, topic, imu_type)?;
+    let messages = &topics.imu[&chosen];
+    samples(&name, &chosen, messages)
+}
+
+/// The `Imu` topic read: `topic` when given, else the only one.
+///
+/// # Errors
+/// [`LogError`] naming `name` when `topic` is not an `Imu` topic of the recording, or none is
+/// given and it has none or several (the topics and their types listed).
+fn choose_topic(
+    name: &str,
+    topics: &Topics,
+    topic: Option<&str>,
+    imu_type: &str,
+) -> Result<String, LogError> {
     let listing = || {
         let all: Vec<String> = topics
             .types
@@ -279,39 +245,48 @@ pub fn read_recording(path: &Path, topic: Option<&str>) -> Result<ImuSamples, Lo
             format!("topics: {}", all.join(", "))
         }
     };
-    let chosen = match topic {
-        Some(t) => match topics.imu.get(t) {
-            Some(m) => (t.to_string(), m),
-            None => {
-                return Err(unreadable(
-                    &name,
-                    format!("no {imu_type} topic {t}; {}", listing()),
-                ));
-            }
-        },
-        None => match topics.imu.len() {
-            1 => {
-                let (t, m) = topics.imu.iter().next().expect("one");
-                (t.clone(), m)
-            }
-            0 => {
-                return Err(unreadable(
-                    &name,
-                    format!("no {imu_type} topic; {}", listing()),
-                ));
-            }
-            _ => {
-                return Err(unreadable(
-                    &name,
-                    format!(
-                        "several {imu_type} topics: choose one with --topic; {}",
-                        listing()
-                    ),
-                ));
-            }
-        },
+    let problem = match (topic, topics.imu.len()) {
+        (Some(t), _) if topics.imu.contains_key(t) => return Ok(t.to_string()),
+        (Some(t), _) => format!("no {imu_type} topic {t}; {}", listing()),
+        (None, 1) => return Ok(topics.imu.keys().next().expect("one").clone()),
+        (None, 0) => format!("no {imu_type} topic; {}", listing()),
+        (None, _) => format!(
+            "several {imu_type} topics: choose one with --topic; {}",
+            listing()
+        ),
     };
-    samples(&name, &chosen.0, chosen.1)
+    Err(unreadable(name, problem))
+}
+
+/// The `Imu` topic of the MCAP file or ROS 2 bag directory `path` as records read from disk
+/// each time ([`super::stream`]); `None` for a ROS 1 bag (read whole by [`read_recording`]).
+///
+/// # Errors
+/// As [`read_recording`] for the container and the choice of topic.
+pub fn open_recording(path: &Path, topic: Option<&str>) -> Result<Option<McapRecords>, LogError> {
+    let name = path.display().to_string();
+    let files = if path.is_dir() {
+        bag_files(path)?
+    } else {
+        vec![path.to_path_buf()]
+    };
+    if files
+        .iter()
+        .any(|f| f.is_file() && super::rosbag1::is_ros1(f))
+    {
+        return Ok(None);
+    }
+    let mut topics = Topics::default();
+    for f in &files {
+        for (t, kind) in super::mcap_stream::topics(f)? {
+            if kind == IMU_TYPE {
+                topics.imu.entry(t.clone()).or_default();
+            }
+            topics.types.entry(t).or_insert(kind);
+        }
+    }
+    let chosen = choose_topic(&name, &topics, topic, IMU_TYPE)?;
+    Ok(Some(McapRecords::new(name, files, chosen)))
 }
 
 /// The samples of the topic's messages, checked as a CSV log's rows are.

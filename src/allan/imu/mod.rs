@@ -12,8 +12,10 @@
 
 pub mod bag;
 pub mod export;
+pub mod mcap_stream;
 pub mod read;
 pub mod rosbag1;
+pub mod stream;
 
 use thiserror::Error;
 

@@ -2,9 +2,10 @@
 //! read and checked exactly as the one-column form reads its column ([`read_static_log`]:
 //! every row by the log reader, the steps against the median), from the text read once.
 
+use super::stream::{ImuRecords, Record};
 use super::{Channel, ImuSamples};
 use crate::allan::log::read_static_log;
-use crate::logs::read::LogSource;
+use crate::logs::read::{CsvReader, LogSource};
 use crate::logs::{LogError, LogProblem, echo};
 
 /// The log's text, held once and lent to each column's reading under the file's name.
@@ -114,6 +115,85 @@ pub fn read_imu_log(source: &dyn LogSource) -> Result<ImuSamples, LogError> {
         channels: channels.into_iter().map(|(c, s)| (c, s.values)).collect(),
         sample_period_s,
     })
+}
+
+/// A CSV log of a file, read as records of its channels each time it is read
+/// ([`super::stream`]).
+pub struct CsvRecords<'a> {
+    source: &'a dyn LogSource,
+    channels: Vec<Channel>,
+}
+
+impl<'a> CsvRecords<'a> {
+    /// The log `source` (read more than once: a file, not a pipe), its header read.
+    ///
+    /// # Errors
+    /// [`LogError`] as [`read_imu_log`] tells a header without a channel or an empty file.
+    pub fn open(source: &'a dyn LogSource) -> Result<Self, LogError> {
+        let mut header = String::new();
+        std::io::BufRead::read_line(&mut source.open()?, &mut header).map_err(|e| {
+            LogError::of_file(
+                source.name(),
+                LogProblem::Unreadable {
+                    message: e.to_string(),
+                },
+            )
+        })?;
+        let channels = channels_in(header.trim_end_matches(['\r', '\n']));
+        if channels.is_empty() {
+            // The whole-series reader tells what is wrong with the header.
+            read_imu_log(source)?;
+            return Err(LogError::of_file(source.name(), LogProblem::Changed));
+        }
+        Ok(Self { source, channels })
+    }
+
+    /// Reads with `N` columns, the time stamps' and N − 1 channels'.
+    fn read_n<const N: usize>(
+        &self,
+        visit: &mut dyn FnMut(&Record) -> Result<(), LogError>,
+    ) -> Result<(), LogError> {
+        let mut columns = ["t_s"; N];
+        for (c, channel) in columns[1..].iter_mut().zip(&self.channels) {
+            *c = channel.column();
+        }
+        let mut csv = CsvReader::open(self.source, columns)?;
+        while let Some((line, row)) = csv.next_row()? {
+            let mut values = [0.0; 6];
+            values[..N - 1].copy_from_slice(&row[1..]);
+            visit(&Record {
+                t_s: row[0],
+                values,
+                at: line,
+            })?;
+        }
+        Ok(())
+    }
+}
+
+impl ImuRecords for CsvRecords<'_> {
+    fn channels(&self) -> &[Channel] {
+        &self.channels
+    }
+
+    fn read(&self, visit: &mut dyn FnMut(&Record) -> Result<(), LogError>) -> Result<(), LogError> {
+        match self.channels.len() {
+            1 => self.read_n::<2>(visit),
+            2 => self.read_n::<3>(visit),
+            3 => self.read_n::<4>(visit),
+            4 => self.read_n::<5>(visit),
+            5 => self.read_n::<6>(visit),
+            _ => self.read_n::<7>(visit),
+        }
+    }
+
+    fn error_at(&self, at: u64, problem: LogProblem) -> LogError {
+        LogError::at(self.source.name(), at, problem)
+    }
+
+    fn error(&self, problem: LogProblem) -> LogError {
+        LogError::of_file(self.source.name(), problem)
+    }
 }
 
 #[cfg(test)]

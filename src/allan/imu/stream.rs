@@ -1,0 +1,192 @@
+//! `allan --imu` on a log read twice and held nowhere: a first read finds each channel's mean
+//! (the phase subtracts it, as the whole-series form does) and the median step, a second
+//! checks every step against that median and feeds each channel's [`AllanStream`]. Memory is
+//! that of the streams (the window of [`stream::EXACT_MAX_M`](crate::allan::stream::EXACT_MAX_M)
+//! phase points per channel), whatever the log's length; a log whose octave τ all lie within
+//! it gives the whole-series analysis bit for bit.
+
+use rayon::prelude::*;
+
+use super::{Channel, ChannelAnalysis, ImuAnalysis, ImuError};
+use crate::allan::analyse_grid;
+use crate::allan::stream::{AllanStream, StreamingMean};
+use crate::logs::steps::{ACCEPTED_STEP_RATIO, StepMedian};
+use crate::logs::{LogError, LogProblem};
+
+/// Samples of each channel handed to the streams at once.
+const BATCH: usize = 1 << 16;
+
+/// One sample of every channel present, and where it is (for messages).
+#[derive(Clone, Copy, Debug)]
+pub struct Record {
+    /// Time stamp, s.
+    pub t_s: f64,
+    /// The channels' values, in the order of [`ImuRecords::channels`].
+    pub values: [f64; 6],
+    /// Its line in a CSV file, or its message's index in a recording.
+    pub at: u64,
+}
+
+/// A log that can be read from its start more than once, record by record.
+pub trait ImuRecords {
+    /// The channels present, in [`Channel::ALL`]'s order.
+    fn channels(&self) -> &[Channel];
+
+    /// Hands every record to `visit` in order, stopping at its first error.
+    ///
+    /// # Errors
+    /// [`LogError`] of the reading (a malformed row or message) or of `visit`.
+    fn read(&self, visit: &mut dyn FnMut(&Record) -> Result<(), LogError>) -> Result<(), LogError>;
+
+    /// The error of `problem` at the record `at` (its line or its message).
+    fn error_at(&self, at: u64, problem: LogProblem) -> LogError;
+
+    /// The error of `problem` for the whole log.
+    fn error(&self, problem: LogProblem) -> LogError;
+}
+
+/// Why a streamed analysis stopped.
+#[derive(Debug)]
+pub enum StreamError {
+    /// The log.
+    Log(LogError),
+    /// A channel the analysis cannot use.
+    Channel(ImuError),
+}
+
+/// The checks of one read: strictly increasing stamps, finite values.
+fn checked(
+    records: &dyn ImuRecords,
+    r: &Record,
+    previous_s: &mut Option<f64>,
+) -> Result<Option<f64>, LogError> {
+    if let Some(p) = *previous_s
+        && r.t_s <= p
+    {
+        let problem = LogProblem::NotIncreasing {
+            t_s: r.t_s,
+            previous_s: p,
+        };
+        return Err(records.error_at(r.at, problem));
+    }
+    for (c, v) in records.channels().iter().zip(&r.values) {
+        if !v.is_finite() {
+            let problem = LogProblem::NotFinite {
+                column: c.column(),
+                text: v.to_string(),
+            };
+            return Err(records.error_at(r.at, problem));
+        }
+    }
+    Ok(previous_s.replace(r.t_s).map(|p| r.t_s - p))
+}
+
+/// The first read: each channel's mean and the median step, s, the stamps and values checked.
+fn first_read(records: &dyn ImuRecords) -> Result<(Vec<f64>, f64), LogError> {
+    let mut means = vec![StreamingMean::default(); records.channels().len()];
+    let mut steps = StepMedian::new();
+    let mut previous_s = None;
+    records.read(&mut |r| {
+        if let Some(step_s) = checked(records, r, &mut previous_s)? {
+            steps.add(step_s);
+        }
+        for (m, v) in means.iter_mut().zip(&r.values) {
+            m.push(*v);
+        }
+        Ok(())
+    })?;
+    let Some(median_s) = steps.median() else {
+        let problem = LogProblem::TooFewRows {
+            found: means.first().map_or(0, StreamingMean::count),
+            needed: 2,
+        };
+        return Err(records.error(problem));
+    };
+    Ok((means.iter().map(StreamingMean::mean).collect(), median_s))
+}
+
+/// Analyses every channel of `records` at `confidence`, reading them twice.
+///
+/// # Errors
+/// [`StreamError::Log`] for the first problem of the log (as the whole-series readers tell
+/// it: a malformed row first, then a step outside the accepted band around the median),
+/// [`StreamError::Channel`] naming the first channel the analysis cannot use.
+pub fn analyse_records(
+    records: &dyn ImuRecords,
+    confidence: f64,
+) -> Result<ImuAnalysis, StreamError> {
+    let channels = records.channels().to_vec();
+    let (means, median_s) = first_read(records).map_err(StreamError::Log)?;
+    let (lo, hi) = (
+        ACCEPTED_STEP_RATIO.0 * median_s,
+        ACCEPTED_STEP_RATIO.1 * median_s,
+    );
+    let mut streams: Vec<AllanStream> = means.into_iter().map(AllanStream::new).collect();
+    // The second read on this thread, the streams on the others: batches handed over a queue
+    // of two, so that reading and summing overlap.
+    let (send, receive) = std::sync::mpsc::sync_channel::<Vec<Vec<f64>>>(2);
+    let read = std::thread::scope(|scope| {
+        let summing = scope.spawn(|| {
+            for batch in receive {
+                streams
+                    .par_iter_mut()
+                    .zip(batch.par_iter())
+                    .for_each(|(s, b)| s.extend(b));
+            }
+        });
+        let empty = || vec![Vec::with_capacity(BATCH); channels.len()];
+        let mut batch = empty();
+        let mut previous_s: Option<f64> = None;
+        let read = records.read(&mut |r| {
+            if let Some(p) = previous_s.replace(r.t_s) {
+                let step_s = r.t_s - p;
+                if !(lo..=hi).contains(&step_s) {
+                    let problem = LogProblem::Gap {
+                        previous_s: p,
+                        t_s: r.t_s,
+                        step_s,
+                        ratio: step_s / median_s,
+                        median_s,
+                    };
+                    return Err(records.error_at(r.at, problem));
+                }
+            }
+            for (b, v) in batch.iter_mut().zip(&r.values) {
+                b.push(*v);
+            }
+            if batch[0].len() == BATCH {
+                // The receiver lives until every batch is sent.
+                send.send(std::mem::replace(&mut batch, empty()))
+                    .expect("the summing thread receives");
+            }
+            Ok(())
+        });
+        if read.is_ok() {
+            send.send(batch).expect("the summing thread receives");
+        }
+        drop(send);
+        summing.join().expect("the summing thread does not panic");
+        read
+    });
+    read.map_err(StreamError::Log)?;
+    let samples = streams.first().map_or(0, AllanStream::samples);
+    let analyses: Vec<ChannelAnalysis> = streams
+        .into_par_iter()
+        .zip(channels.par_iter())
+        .map(|(s, &channel)| {
+            analyse_grid(&s.finish(), samples, median_s, confidence)
+                .map(|analysis| ChannelAnalysis { channel, analysis })
+                .map_err(|source| ImuError {
+                    column: channel.column(),
+                    source,
+                })
+        })
+        .collect::<Result<_, _>>()
+        .map_err(StreamError::Channel)?;
+    Ok(ImuAnalysis {
+        samples,
+        sample_period_s: median_s,
+        confidence,
+        channels: analyses,
+    })
+}
