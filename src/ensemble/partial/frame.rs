@@ -8,9 +8,9 @@ use serde::Serialize;
 use super::{DIGEST_BYTES, FORMAT, HeaderDigest, MAGIC, MAGIC_1, MAX_HEADER_BYTES, PartialError};
 
 /// Writes the header of a partial file: the magic line, the header line and its digest line.
-/// Returns the header digest, which keys the digest of every block ([`write_block`]). The
-/// header is [`PartialHeader`] for the one-axis ensemble; the three-axis ensemble writes its own,
-/// with `"model": "ins"` ([`header_model`]).
+/// Returns the header digest, which keys the digest of every block ([`super::write_block`]).
+/// The header is [`super::PartialHeader`] for the one-axis ensemble; the three-axis ensemble
+/// writes its own, with `"model": "ins"` ([`header_model`]).
 ///
 /// # Errors
 /// The writer's error.
@@ -28,7 +28,7 @@ pub fn write_header(w: &mut impl Write, header: &impl Serialize) -> std::io::Res
 /// `block_bytes` bytes (index, count, sums), with its digest.
 ///
 /// # Errors
-/// As [`write_partial`].
+/// As [`super::write_partial`].
 pub fn write_blocks(
     w: &mut impl Write,
     header: &impl Serialize,
