@@ -375,17 +375,19 @@ fn fault(ended: &Ended) -> Option<String> {
 enum Surface {
     Logs,
     Imu,
+    Bag,
     Config,
     Partials,
     CommandLine,
 }
 
-const SURFACES: [(Surface, usize); 5] = [
-    (Surface::Logs, 220),
+const SURFACES: [(Surface, usize); 6] = [
+    (Surface::Logs, 200),
     (Surface::Imu, 100),
-    (Surface::Config, 260),
-    (Surface::Partials, 180),
-    (Surface::CommandLine, 240),
+    (Surface::Bag, 80),
+    (Surface::Config, 240),
+    (Surface::Partials, 160),
+    (Surface::CommandLine, 220),
 ];
 
 /// A finding: which input, what went wrong, and where its inputs are kept.
@@ -414,6 +416,8 @@ struct Base {
     gnss: Vec<u8>,
     partials: [Vec<u8>; 2],
     one: serde_json::Value,
+    /// A static IMU as MCAP files of ROS 2 `Imu` messages: chunked (with CRCs) and not.
+    bags: [Vec<u8>; 2],
 }
 
 fn base(dir: &Path) -> Base {
@@ -458,7 +462,114 @@ fn base(dir: &Path) -> Base {
         gnss: first_seconds("gnss.csv"),
         partials: [read("p1.bin"), read("p2.bin")],
         one: common::summary_without_timing(&dir.join("one.json")),
+        bags: [true, false].map(|chunked| {
+            let path = dir.join(format!("bag-{chunked}.mcap"));
+            imu_mcap(&path, BAG_MESSAGES, chunked);
+            let out = common::run_in(
+                dir,
+                &["allan", "-q", "--imu", path.to_str().unwrap()],
+                Some(1),
+            );
+            assert!(out.status.success(), "the unmutated bag: {out:?}");
+            read(path.file_name().unwrap().to_str().unwrap())
+        }),
     }
+}
+
+/// Messages in the bags the bag surface mutates: 30 s at 100 Hz.
+const BAG_MESSAGES: usize = 3_000;
+
+/// `sensor_msgs/msg/Imu` in CDR (little-endian): the stamp, a frame id, then the 37 doubles
+/// (orientation, its covariance, angular velocity at 13–15, its covariance, linear
+/// acceleration at 25–27, its covariance) at the 8-byte alignment after the 4-byte header.
+fn imu_cdr(t_ns: u64, gyro: [f64; 3], accel: [f64; 3]) -> Vec<u8> {
+    let mut b = vec![0, 1, 0, 0];
+    b.extend(((t_ns / 1_000_000_000) as u32).to_le_bytes());
+    b.extend(((t_ns % 1_000_000_000) as u32).to_le_bytes());
+    let frame = b"imu_link";
+    b.extend((frame.len() as u32 + 1).to_le_bytes());
+    b.extend(frame);
+    b.push(0);
+    while (b.len() - 4) % 8 != 0 {
+        b.push(0);
+    }
+    let mut values = [0.0; 37];
+    values[13..16].copy_from_slice(&gyro);
+    values[25..28].copy_from_slice(&accel);
+    values.iter().for_each(|v| b.extend(v.to_le_bytes()));
+    b
+}
+
+/// Writes a static IMU of `messages` at 100 Hz to the MCAP file `path` (white noise about gravity).
+fn imu_mcap(path: &Path, messages: usize, chunked: bool) {
+    let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let mut w = mcap::WriteOptions::new()
+        .use_chunks(chunked)
+        .create(file)
+        .unwrap();
+    let schema = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"").unwrap();
+    let channel = w
+        .add_channel(schema, "/imu", "cdr", &std::collections::BTreeMap::new())
+        .unwrap();
+    let mut rng = Rng::new(31);
+    let mut noise = || {
+        (0..12)
+            .map(|_| rng.below(1 << 20) as f64 / f64::from(1 << 20))
+            .sum::<f64>()
+            - 6.0
+    };
+    for k in 0..messages {
+        let t_ns = 1_700_000_000_000_000_000 + k as u64 * 10_000_000;
+        let gyro = [1e-3 * noise(), 1e-3 * noise(), 1e-3 * noise()];
+        let accel = [0.01 * noise(), 0.01 * noise(), 9.81 + 0.01 * noise()];
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: k as u32,
+            log_time: t_ns,
+            publish_time: t_ns,
+        };
+        w.write_to_known_channel(&header, &imu_cdr(t_ns, gyro, accel))
+            .unwrap();
+    }
+    w.finish().unwrap();
+}
+
+/// One bag case: a bag with bytes flipped, overwritten, deleted, duplicated or cut, through
+/// `allan --imu`.
+fn case_bag(rng: &mut Rng, base: &Base, dir: &Path) -> (Vec<String>, Vec<&'static str>) {
+    let mut bag = base.bags[rng.below(2)].clone();
+    for _ in 0..1 + rng.below(3) {
+        let at = rng.below(bag.len());
+        match rng.below(6) {
+            0 => bag[at] ^= 1 << rng.below(8),
+            1 => bag[at] = *rng.pick(&[0u8, 0xff, 0x7f, 0x80, 0x01]),
+            2 => {
+                let end = (at + 1 + rng.below(64)).min(bag.len());
+                bag.drain(at..end);
+            }
+            3 => bag.truncate(at),
+            4 => {
+                let end = (at + 1 + rng.below(400)).min(bag.len());
+                let copy = bag[at..end].to_vec();
+                bag.splice(at..at, copy);
+            }
+            _ => {
+                // A double of a message set to NaN, ±∞ or a huge value.
+                let v = *rng.pick(&[f64::NAN, f64::INFINITY, -f64::INFINITY, 1e300, -0.0]);
+                let end = (at + 8).min(bag.len());
+                let bytes = v.to_le_bytes();
+                bag[at..end].copy_from_slice(&bytes[..end - at]);
+            }
+        }
+    }
+    std::fs::write(dir.join("imu.mcap"), bag).unwrap();
+    let args = ["allan", "-q", "--imu", "imu.mcap", "--out", "allan3"]
+        .map(String::from)
+        .to_vec();
+    (
+        args,
+        vec!["allan3/allan.json", "allan3/imu.yaml", "allan3/noise.toml"],
+    )
 }
 
 /// The length of the three-axis recording the IMU surface mutates, s: 400 IMU rows and 40
@@ -891,6 +1002,7 @@ fn run_case(
     let (args, outputs) = match surface {
         Surface::Logs => case_logs(rng, base, dir),
         Surface::Imu => case_imu(rng, base, dir),
+        Surface::Bag => case_bag(rng, base, dir),
         Surface::Config => case_config(rng, dir, &tally.reports),
         Surface::Partials => case_partials(rng, base, dir),
         Surface::CommandLine => case_command_line(rng),
