@@ -14,7 +14,7 @@ use accelcal::ensemble::Engine;
 use accelcal::ensemble::partial::PartialError;
 use accelcal::error::ConfigError;
 use accelcal::export;
-use accelcal::ins::blocks::Blocks;
+use accelcal::ins::blocks;
 use accelcal::ins::ensemble::{self as ins_ensemble, InsSums, Track};
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::partial::{self, InsPartialHeader};
@@ -164,12 +164,12 @@ fn run_shard(
     path: &Path,
     quiet: bool,
 ) -> Result<()> {
-    let blocks = Blocks::new(study.realizations);
+    let blocks = blocks::partition(study.realizations);
     let shard = super::shards::parse_shard(shard, blocks.blocks, blocks.realizations)?;
-    let range = blocks.of_shard(shard);
+    let range = blocks.shard_blocks(shard);
     let realizations = range
         .clone()
-        .map(|b| blocks.realizations_of(b).count() as u64)
+        .map(|b| blocks.block_realizations(b).count() as u64)
         .sum();
     let (k, m) = (shard.index, shard.of);
     // Both files are made before the run: a destination that cannot be written is refused at

@@ -77,18 +77,27 @@ pub struct Partition {
     pub chunks_per_block: u64,
     /// Blocks, at most [`MAX_BLOCKS`].
     pub blocks: u64,
+    /// Realizations per chunk ([`CHUNK`] here; the three-axis ensemble's are smaller).
+    pub chunk: u64,
 }
 
 impl Partition {
     /// The partition of `n` realizations.
     pub fn new(n: u64) -> Self {
-        let chunks = n.div_ceil(CHUNK);
-        let chunks_per_block = chunks.div_ceil(MAX_BLOCKS).max(1);
+        Self::with_sizes(n, CHUNK, MAX_BLOCKS)
+    }
+
+    /// The partition of `n` realizations into chunks of `chunk` and at most `max_blocks`
+    /// blocks.
+    pub fn with_sizes(n: u64, chunk: u64, max_blocks: u64) -> Self {
+        let chunks = n.div_ceil(chunk);
+        let chunks_per_block = chunks.div_ceil(max_blocks).max(1);
         Self {
             realizations: n,
             chunks,
             chunks_per_block,
             blocks: chunks.div_ceil(chunks_per_block),
+            chunk,
         }
     }
 
@@ -99,7 +108,7 @@ impl Partition {
 
     /// The realization indices of chunk `c`.
     pub fn chunk_realizations(&self, c: u64) -> Range<u64> {
-        c * CHUNK..((c + 1) * CHUNK).min(self.realizations)
+        c * self.chunk..((c + 1) * self.chunk).min(self.realizations)
     }
 
     /// The realization indices of block `b`.

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 use crate::ensemble::normalized::{FixInput, NormalizedFix, NormalizedSums, StageInput};
 use crate::ensemble::{EnsembleStats, ResidualLayout};
 
-use super::blocks::{Blocks, CHUNK};
+use super::blocks::{self, CHUNK};
 use super::earth::offset;
 use super::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, POSITION, STATES, VELOCITY};
 use super::filter::{Ekf, FilterError};
@@ -27,6 +27,7 @@ use super::mech::{Increment, Pva};
 use super::sensors::Imu;
 use super::setup::Study;
 use super::truth::Truth;
+use crate::ensemble::Partition;
 
 /// The GNSS measurement's rows: position and velocity, NED.
 pub const MEASURED: usize = 6;
@@ -362,7 +363,7 @@ pub fn empty_sums(study: &Study, track: &Track) -> InsSums {
 pub fn run_blocks(
     study: &Study,
     track: &Track,
-    blocks: &Blocks,
+    blocks: &Partition,
     range: Range<u64>,
     mut progress: impl FnMut(u64),
     mut on_block: impl FnMut(u64, &InsSums),
@@ -370,7 +371,7 @@ pub fn run_blocks(
     let mut done = 0;
     for b in range {
         let mut sums = empty_sums(study, track);
-        let indices = blocks.realizations_of(b);
+        let indices = blocks.block_realizations(b);
         let mut first = indices.start;
         while first < indices.end {
             let last = (first + CHUNK).min(indices.end);
@@ -401,7 +402,7 @@ pub fn sums(
     realizations: u64,
     progress: impl FnMut(u64),
 ) -> Result<InsSums, RealizationError> {
-    let blocks = Blocks::new(realizations);
+    let blocks = blocks::partition(realizations);
     let mut total = empty_sums(study, track);
     run_blocks(study, track, &blocks, 0..blocks.blocks, progress, |_, s| {
         total.merge(s);

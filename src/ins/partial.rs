@@ -14,11 +14,12 @@ use std::io::{BufRead, Read};
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
-use super::blocks::Blocks;
+use super::blocks;
 use super::ensemble::{InsSums, MEASURED, Track, empty_sums};
 use super::error_state::STATES;
 use super::setup::Study;
 use crate::config::ins::InsConfig;
+use crate::ensemble::Partition;
 use crate::ensemble::partial::{
     self, HeaderDigest, PartialError, each_shard_once, first_difference, header_model,
     read_block_floats, read_header_line,
@@ -232,7 +233,7 @@ pub fn merge<R: BufRead>(files: Vec<(String, R)>) -> Result<InsMerged, PartialEr
             ),
         ));
     }
-    let blocks = Blocks::new(study.realizations);
+    let blocks = blocks::partition(study.realizations);
     for o in &opened {
         if let Some(why) = differs(&o.header, &first, &first_name, &blocks) {
             return Err(mismatch(&o.name, why));
@@ -263,7 +264,7 @@ fn differs(
     h: &InsPartialHeader,
     first: &InsPartialHeader,
     first_name: &str,
-    blocks: &Blocks,
+    blocks: &Partition,
 ) -> Option<String> {
     let (c, f) = (&h.config.ensemble, &first.config.ensemble);
     if h.config != first.config {
@@ -308,7 +309,7 @@ fn differs(
 /// of its shard of `blocks`, each with its realizations; its run time.
 fn fold_shard<R: BufRead>(
     o: Opened<R>,
-    blocks: &Blocks,
+    blocks: &Partition,
     empty: &InsSums,
     sums: &mut InsSums,
 ) -> Result<f64, PartialError> {
@@ -318,7 +319,7 @@ fn fold_shard<R: BufRead>(
         key,
         mut r,
     } = o;
-    let expected = blocks.of_shard(Shard {
+    let expected = blocks.shard_blocks(Shard {
         index: header.shard,
         of: header.shards,
     });
@@ -336,7 +337,7 @@ fn fold_shard<R: BufRead>(
                 why: format!("block {b} is missing"),
             });
         };
-        let want = blocks.realizations_of(b);
+        let want = blocks.block_realizations(b);
         if index != b || count != want.end - want.start {
             return Err(mismatch(
                 &name,
