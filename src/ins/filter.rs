@@ -17,6 +17,9 @@ use super::gnss::{self, Fix};
 use super::mech::{self, Increment, Pva};
 
 mod measured;
+mod parts;
+
+pub use parts::{LinearView, NOISE_GROUPS};
 
 /// A filter step that cannot go on.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -128,6 +131,9 @@ pub struct Ekf {
     /// Φ from the last update to the last covariance propagation, when tracked (a smoother
     /// needs it; [`Ekf::with_transition`]).
     transition: Option<Matrix15>,
+    /// Q_d from the last update split by noise group, each at unit density, when tracked (a
+    /// likelihood linearized about the run needs it; [`Ekf::with_noise_parts`]).
+    noise_parts: Option<Box<[Matrix15; NOISE_GROUPS]>>,
 }
 
 impl Ekf {
@@ -157,6 +163,7 @@ impl Ekf {
             fix_period_steps: None,
             before: None,
             transition: None,
+            noise_parts: None,
         }
     }
 
@@ -224,6 +231,7 @@ impl Ekf {
                 if let Some(t) = self.transition.as_mut() {
                     *t = phi * *t;
                 }
+                self.propagate_parts_dense(&phi, now.dt_s);
             }
             Propagation::Interval { interval_s } => self.gather(&f_b, now.dt_s, interval_s),
         }
@@ -297,6 +305,7 @@ impl Ekf {
         if let Some(t) = self.transition.as_mut() {
             *t = phi * *t;
         }
+        self.propagate_parts_interval(&phi, &big_f, p.t_s);
     }
 
     /// The update by `fix` (the pending steps first propagated): the innovation, the

@@ -346,6 +346,23 @@ pub fn maximize(
     })
 }
 
+/// The maximum of `f` over the box [lo, hi] from `u0` without intervals (the search of
+/// [`maximize`]): where, the value there and the evaluations it took. `None` when `f` is not
+/// finite at `u0`.
+pub fn climb(
+    f: &(dyn Fn(&[f64]) -> f64 + Sync),
+    (lo, hi): (&[f64], &[f64]),
+    u0: &[f64],
+) -> Option<(Vec<f64>, f64, u64)> {
+    let objective = Objective::new(f, lo.to_vec(), hi.to_vec());
+    if !objective.value(u0).is_finite() {
+        return None;
+    }
+    let free: Vec<usize> = (0..u0.len()).collect();
+    let best = objective.climb(u0, &free);
+    Some((best.u, best.value, objective.evaluations()))
+}
+
 /// One statistic's estimate from its maximum `u` (a logarithm) within [lo, hi] and its two
 /// interval ends.
 fn key_estimate(key: Key, (u, lo, hi): (f64, f64, f64), ends: &[profile::End]) -> KeyEstimate {

@@ -15,6 +15,7 @@
 pub mod align;
 pub mod config;
 pub mod gnss;
+pub mod linear;
 pub mod noise;
 pub mod read;
 pub mod run;

@@ -4,8 +4,11 @@
 //! A filter whose statistics are right has white innovations with covariance S, so the
 //! statistics that maximise ℓ(θ) = −½ Σ_k (m_k ln 2π + ln det S_k + ν_kᵀS_k⁻¹ν_k) are those the
 //! drive supports (Mehra, IEEE Trans. Automatic Control 15(2), 1970; the same likelihood as the
-//! one-axis `--estimate-noise`, `crate::likelihood`). Each evaluation runs the three-axis filter
-//! over the IMU steps held in memory. The σ's and random walks are searched in their
+//! one-axis `--estimate-noise`, `crate::likelihood`). ℓ is evaluated on the filter linearized
+//! about one run over the IMU steps held in memory ([`super::linear`]: the recursion over the
+//! fixes alone, equal to the run's ℓ at its own statistics); the search is repeated about a run
+//! at its maximum until the maximum stops moving (at most [`MAX_RUNS`] runs), and the intervals
+//! come from the model about the last. The σ's and random walks are searched in their
 //! logarithms within ×10^±2 of their starting values; the time offset linearly within
 //! ±[`MAX_TIME_OFFSET_S`]. An interval end that reaches the box is open, and the key is then
 //! reported as not identifiable.
@@ -15,9 +18,17 @@ use serde::Serialize;
 use super::Settings;
 use super::config::MAX_TIME_OFFSET_S;
 use super::gnss::GnssRow;
+use super::linear::Linearized;
 use super::read::{HeldSteps, ImuSpan, ImuStep};
 use super::run::{filter, shifted};
-use crate::likelihood::{Fit, maximize};
+use crate::likelihood::{Fit, climb, maximize};
+
+/// Runs of the filter the search linearizes about, at most.
+pub const MAX_RUNS: usize = 8;
+
+/// The maximum has stopped moving when no key's search variable moves more than this between
+/// two runs (a logarithm: 0.1 %; the offset: 0.1 ms).
+const SETTLED: f64 = 1e-3;
 
 /// A quantity `--estimate-noise` can estimate on the three-axis path.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -191,8 +202,12 @@ pub struct KeyEstimate {
 pub struct NoiseEstimate {
     /// ℓ at the maximum.
     pub log_likelihood: f64,
-    /// Evaluations of ℓ (each a run of the filter).
+    /// Evaluations of ℓ (each a recursion over the fixes of the linearized filter).
     pub evaluations: u64,
+    /// Runs of the filter over the IMU log the search linearized about.
+    pub filter_runs: usize,
+    /// Whether the maximum stopped moving within [`MAX_RUNS`] runs.
+    pub settled: bool,
     /// The intervals' confidence.
     pub confidence: f64,
     /// The fixes ℓ sums over.
@@ -240,16 +255,6 @@ pub fn estimate(
     keys: &[ImuKey],
     confidence: f64,
 ) -> Option<NoiseEstimate> {
-    let start = filter(
-        &shifted(rows, s.gnss_time_offset_s),
-        &mut HeldSteps::new(steps),
-        s,
-        "",
-    )
-    .ok()?
-    .plan
-    .start;
-    let fixes = fixes_in_reach(rows, span, start);
     let settings_at = |u: &[f64]| {
         let mut t = *s;
         for (k, x) in keys.iter().zip(u) {
@@ -257,11 +262,10 @@ pub fn estimate(
         }
         t
     };
-    let f = |u: &[f64]| log_likelihood(rows, steps, &settings_at(u), fixes);
     let bounds: Vec<(f64, f64)> = keys.iter().map(|k| k.bounds(k.get(s))).collect();
     let lo: Vec<f64> = bounds.iter().map(|b| b.0).collect();
     let hi: Vec<f64> = bounds.iter().map(|b| b.1).collect();
-    let u0: Vec<f64> = keys
+    let mut u: Vec<f64> = keys
         .iter()
         .map(|k| {
             if k.linear() {
@@ -271,7 +275,41 @@ pub fn estimate(
             }
         })
         .collect();
-    let fit: Fit = maximize(&f, (&lo, &hi), &u0, confidence)?;
+    let mut model = Linearized::new(rows, steps, s).ok()?;
+    let fixes = fixes_in_reach(rows, span, model.start);
+    let mut at_run = model.log_likelihood(s, fixes);
+    let (mut evaluations, mut filter_runs, mut settled) = (0, 1, false);
+    'search: while filter_runs < MAX_RUNS {
+        let f = |x: &[f64]| model.log_likelihood(&settings_at(x), fixes);
+        let (best, _, n) = climb(&f, (&lo, &hi), &u)?;
+        evaluations += n;
+        if best.iter().zip(&u).all(|(a, b)| (a - b).abs() <= SETTLED) {
+            settled = true;
+            break;
+        }
+        // A run at the model's maximum: taken when the likelihood of that run (its model's ℓ
+        // at its own statistics, equal to the filter's) beats the last run's; else halfway.
+        let mut step: Vec<f64> = best.iter().zip(&u).map(|(a, b)| a - b).collect();
+        while filter_runs < MAX_RUNS {
+            let candidate: Vec<f64> = u.iter().zip(&step).map(|(a, d)| a + d).collect();
+            let t = settings_at(&candidate);
+            filter_runs += 1;
+            if let Ok(next) = Linearized::new(rows, steps, &t) {
+                let value = next.log_likelihood(&t, fixes);
+                if value > at_run {
+                    (model, u, at_run) = (next, candidate, value);
+                    continue 'search;
+                }
+            }
+            step.iter_mut().for_each(|d| *d *= 0.5);
+            if step.iter().all(|d| d.abs() <= SETTLED) {
+                settled = true;
+                break 'search;
+            }
+        }
+    }
+    let f = |x: &[f64]| model.log_likelihood(&settings_at(x), fixes);
+    let fit: Fit = maximize(&f, (&lo, &hi), &u, confidence)?;
     let estimates = keys
         .iter()
         .enumerate()
@@ -290,7 +328,9 @@ pub fn estimate(
         .collect();
     Some(NoiseEstimate {
         log_likelihood: fit.value,
-        evaluations: fit.evaluations,
+        evaluations: evaluations + fit.evaluations,
+        filter_runs,
+        settled,
         confidence,
         fixes,
         keys: estimates,

@@ -11,7 +11,7 @@ use super::gnss::{GnssRow, read_gnss};
 use super::read::{HeldSteps, ImuLayout, ImuReader, ImuSpan, ImuStep, StepSource};
 pub use super::step::{FixRecord, bias_sigmas, euler_sigmas};
 use super::step::{Running, part, start, update, velocity_sigmas};
-use crate::ins::filter::{Ekf, FilterError};
+use crate::ins::filter::{Ekf, FilterError, LinearView};
 use crate::logs::read::LogSource;
 use crate::logs::{LogError, LogProblem};
 
@@ -71,6 +71,20 @@ pub struct Filtered {
     pub ekf: Ekf,
     /// The first fix not yet updated.
     pub next: usize,
+    /// The mean specific force over the alignment's window, body axes, m/s².
+    pub mean_f_b: Vector3<f64>,
+    /// The filter's view at its start, when tracked ([`filter_tracked`]).
+    pub start_view: Option<LinearView>,
+}
+
+/// The alignment's error sources at the heading's fix `rh` under the assumptions `s`.
+pub(super) fn alignment_sources(rh: &GnssRow, s: &Settings) -> Sources {
+    Sources {
+        velocity_sigma_m_s: velocity_sigmas(rh, s),
+        accel_bias_sigma_m_s2: s.accel_bias_sigma_m_s2,
+        vrw_m_s_per_sqrt_s: s.accel_vrw_m_s_per_sqrt_s,
+        heading_offset_sigma_rad: s.heading_offset_sigma_deg.to_radians(),
+    }
 }
 
 /// The GNSS rows with each fix's time moved by the receiver's offset `offset_s` (a fix stamped
@@ -95,6 +109,31 @@ pub fn filter(
     s: &Settings,
     gnss_name: &str,
 ) -> Result<Filtered, ImuCalibrateError> {
+    run_filter(rows, source, s, gnss_name, false)
+}
+
+/// [`filter`] with each record's [`FixRecord::linear`] filled: Q_d by noise group, H and the
+/// predicted measurement's rate, which a likelihood linearized about the run needs.
+///
+/// # Errors
+/// As [`filter`].
+pub fn filter_tracked(
+    rows: &[GnssRow],
+    source: &mut dyn StepSource,
+    s: &Settings,
+    gnss_name: &str,
+) -> Result<Filtered, ImuCalibrateError> {
+    run_filter(rows, source, s, gnss_name, true)
+}
+
+/// [`filter`], tracking what a linearized likelihood needs when `tracked`.
+fn run_filter(
+    rows: &[GnssRow],
+    source: &mut dyn StepSource,
+    s: &Settings,
+    gnss_name: &str,
+    tracked: bool,
+) -> Result<Filtered, ImuCalibrateError> {
     let mut first = source.next_step()?;
     let imu_first_s = source.first_s().unwrap_or(f64::INFINITY);
     let settings = AlignSettings {
@@ -105,6 +144,8 @@ pub fn filter(
     let plan = align::plan(rows, imu_first_s, &settings).ok_or_else(|| no_heading(gnss_name, s))?;
     let (ra, rh) = (&rows[plan.first], &rows[plan.start]);
     let mut sum_dv = Vector3::zeros();
+    let mut mean_f_b = Vector3::zeros();
+    let mut start_view = None;
     let mut started: Option<(Ekf, Alignment)> = None;
     let mut next = plan.start + 1;
     let mut records = Vec::with_capacity(rows.len() - next);
@@ -124,14 +165,11 @@ pub fn filter(
             if t1 < rh.t_s {
                 continue;
             }
-            let sources = Sources {
-                velocity_sigma_m_s: velocity_sigmas(rh, s),
-                accel_bias_sigma_m_s2: s.accel_bias_sigma_m_s2,
-                vrw_m_s_per_sqrt_s: s.accel_vrw_m_s_per_sqrt_s,
-                heading_offset_sigma_rad: settings.heading_offset_sigma_rad,
-            };
-            let a = align::align(ra, rh, &(sum_dv / (rh.t_s - ra.t_s)), &sources);
-            started = Some((start(rh, &a, s), a));
+            mean_f_b = sum_dv / (rh.t_s - ra.t_s);
+            let a = align::align(ra, rh, &mean_f_b, &alignment_sources(rh, s));
+            let ekf = start(rh, &a, s, tracked);
+            start_view = tracked.then(|| ekf.linear_view());
+            started = Some((ekf, a));
             from = rh.t_s;
         }
         let mut run = Running {
@@ -157,6 +195,8 @@ pub fn filter(
         missing,
         ekf,
         next,
+        mean_f_b,
+        start_view,
     })
 }
 
@@ -204,8 +244,11 @@ fn assemble(
     s: &Settings,
     gnss: &str,
 ) -> Result<Calibrated, ImuCalibrateError> {
-    check_span(rows, &span, gnss)?;
-    finish(rows.len(), &mut run, s, rows)?;
+    check_span(rows, &span, gnss, s.gnss_time_offset_s)?;
+    // A time offset can carry the last fixes past the log's end: those are left out.
+    let tolerance = 0.5 * span.median_step_s;
+    let within = rows.partition_point(|r| r.t_s <= span.last_s + tolerance);
+    finish(within, &mut run, s, rows)?;
     Ok(Calibrated {
         gnss_file: gnss.to_string(),
         span,
@@ -247,19 +290,22 @@ fn no_heading(gnss: &str, s: &Settings) -> ImuCalibrateError {
     }
 }
 
-/// Every fix within half a median step of the IMU log's span.
+/// Every fix of the log as written (its times before the receiver's offset `offset_s` moved
+/// them) within half a median step of the IMU log's span.
 ///
 /// # Errors
 /// [`LogProblem::FixOutsideSpan`] naming the first fix outside.
-fn check_span(rows: &[GnssRow], span: &ImuSpan, gnss: &str) -> Result<(), LogError> {
+fn check_span(rows: &[GnssRow], span: &ImuSpan, gnss: &str, offset_s: f64) -> Result<(), LogError> {
     let tolerance = 0.5 * span.median_step_s;
     let outside = rows
         .iter()
-        .find(|r| r.t_s < span.first_s - tolerance || r.t_s > span.last_s + tolerance);
+        .map(|r| r.t_s - offset_s)
+        .zip(rows)
+        .find(|(t, _)| *t < span.first_s - tolerance || *t > span.last_s + tolerance);
     match outside {
-        Some(r) => {
+        Some((t_s, r)) => {
             let problem = LogProblem::FixOutsideSpan {
-                t_s: r.t_s,
+                t_s,
                 first_s: span.first_s,
                 last_s: span.last_s,
                 tolerance_s: tolerance,

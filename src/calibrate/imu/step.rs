@@ -10,7 +10,7 @@ use crate::ins::discrete::NoiseDensities;
 use crate::ins::error_state::{
     ACCEL_BIAS, ATTITUDE, BiasDecay, GYRO_BIAS, Matrix15, POSITION, STATES,
 };
-use crate::ins::filter::{Ekf, FilterError};
+use crate::ins::filter::{Ekf, FilterError, LinearView, NOISE_GROUPS};
 use crate::ins::gnss::Fix;
 use crate::ins::mech::{Increment, Pva};
 
@@ -45,6 +45,18 @@ pub struct FixRecord {
     pub log_det_s: f64,
     /// The components measured.
     pub rows: usize,
+    /// What a likelihood linearized about this run needs of the fix; `None` unless the run
+    /// tracked it ([`crate::calibrate::imu::run::filter_tracked`]).
+    pub linear: Option<Box<LinearRecord>>,
+}
+
+/// One fix's part of a likelihood linearized about the filter's run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearRecord {
+    /// Q_d from the previous fix (or the start) split by noise group at unit density.
+    pub noise_parts: [Matrix15; NOISE_GROUPS],
+    /// H and the predicted measurement's rate before the update.
+    pub view: LinearView,
 }
 
 /// The increments of `inc` over the part of its step from `lo` to `hi` (its end `end`).
@@ -59,7 +71,7 @@ pub(super) fn part(inc: &Increment, end: f64, lo: f64, hi: f64) -> Increment {
 }
 
 /// The filter's noise densities and decays from `s`.
-fn noise(s: &Settings) -> (NoiseDensities, BiasDecay) {
+pub(super) fn noise(s: &Settings) -> (NoiseDensities, BiasDecay) {
     let density = |sigma: f64, k: f64, tau: Option<f64>| match tau {
         Some(t) => 2.0 * sigma * sigma / t,
         None => k * k,
@@ -89,7 +101,7 @@ fn noise(s: &Settings) -> (NoiseDensities, BiasDecay) {
 
 /// The fix of `row` with the σ's of the log or of `s`, and which velocity components it
 /// measures.
-fn fix_of(row: &GnssRow, s: &Settings) -> (Fix, [bool; 3]) {
+pub(super) fn fix_of(row: &GnssRow, s: &Settings) -> (Fix, [bool; 3]) {
     let measured = row.velocity_ned_m_s.map(|v| v.is_some());
     let v = row.velocity_ned_m_s.map(|v| v.unwrap_or(0.0));
     let ps = row.position_sigma_m;
@@ -108,10 +120,22 @@ fn fix_of(row: &GnssRow, s: &Settings) -> (Fix, [bool; 3]) {
     (fix, measured)
 }
 
-/// The filter at fix `h` from the alignment `a`: the IMU carried from the antenna's fix, the
-/// prior covariance of position, alignment and gyro biases.
-pub(super) fn start(h: &GnssRow, a: &Alignment, s: &Settings) -> Ekf {
+/// The prior covariance at fix `h` from the alignment `a`: the alignment's errors, the fix's
+/// position σ's and the gyro biases' prior.
+pub(super) fn initial_covariance(h: &GnssRow, a: &Alignment, s: &Settings) -> Matrix15 {
     let (fix, _) = fix_of(h, s);
+    let mut p0 = a.covariance;
+    for i in 0..3 {
+        p0[(POSITION + i, POSITION + i)] = fix.position_sigma_m[i].powi(2);
+        p0[(GYRO_BIAS + i, GYRO_BIAS + i)] = s.gyro_bias_sigma_rad_s.powi(2);
+    }
+    p0
+}
+
+/// The filter at fix `h` from the alignment `a`: the IMU carried from the antenna's fix, the
+/// prior covariance of position, alignment and gyro biases; tracking Q_d by noise group when
+/// `tracked`.
+pub(super) fn start(h: &GnssRow, a: &Alignment, s: &Settings, tracked: bool) -> Ekf {
     let [roll, pitch, yaw] = a.euler_rad;
     let attitude = crate::ins::attitude_from_euler(roll, pitch, yaw);
     let c: Matrix3<f64> = *attitude.to_rotation_matrix().matrix();
@@ -121,13 +145,16 @@ pub(super) fn start(h: &GnssRow, a: &Alignment, s: &Settings) -> Ekf {
         velocity_ned_m_s: Vector3::from(v),
         attitude,
     };
-    let mut p0 = a.covariance;
-    for i in 0..3 {
-        p0[(POSITION + i, POSITION + i)] = fix.position_sigma_m[i].powi(2);
-        p0[(GYRO_BIAS + i, GYRO_BIAS + i)] = s.gyro_bias_sigma_rad_s.powi(2);
-    }
     let (noise, decay) = noise(s);
-    Ekf::new(pva, p0, noise, decay, s.lever_arm()).with_transition()
+    let ekf = Ekf::new(
+        pva,
+        initial_covariance(h, a, s),
+        noise,
+        decay,
+        s.lever_arm(),
+    )
+    .with_transition();
+    if tracked { ekf.with_noise_parts() } else { ekf }
 }
 
 /// The running filter and where it is among the fixes.
@@ -189,6 +216,12 @@ pub(super) fn update(
     f.flush();
     let prior_covariance = f.covariance;
     let transition = f.take_transition().unwrap_or_else(Matrix15::identity);
+    let linear = f.take_noise_parts().map(|noise_parts| {
+        Box::new(LinearRecord {
+            noise_parts,
+            view: f.linear_view(),
+        })
+    });
     let nu = f.update_measured(&fix, measured)?;
     let (mut innovation, mut innovation_sigma) = ([f64::NAN; 6], [f64::NAN; 6]);
     let components: Vec<usize> = (0..6).filter(|&i| i < 3 || measured[i - 3]).collect();
@@ -215,6 +248,7 @@ pub(super) fn update(
             .cholesky()
             .map_or(f64::NAN, |c| 2.0 * c.l().diagonal().map(f64::ln).sum()),
         rows: components.len(),
+        linear,
     })
 }
 

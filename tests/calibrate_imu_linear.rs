@@ -1,0 +1,105 @@
+//! The likelihood linearized about one run of the three-axis filter (`calibrate::imu::linear`)
+//! against the likelihood of rerunning the filter: equal at the run's own statistics, close
+//! near them (within a tenth of the χ²₁ threshold an interval's end rests on), on the shipped
+//! comma2k19 minute and on a simulated drive.
+
+use accelcal::calibrate::imu::gnss::{GnssRow, read_gnss};
+use accelcal::calibrate::imu::linear::Linearized;
+use accelcal::calibrate::imu::noise::log_likelihood;
+use accelcal::calibrate::imu::read::{ImuStep, read_steps};
+use accelcal::calibrate::imu::{CONSUMER, Settings};
+use accelcal::config::ins::InsConfig;
+use accelcal::ins::logs::write_realization;
+use accelcal::ins::setup::Study;
+use accelcal::logs::read::LogText;
+
+/// The shipped minute, held.
+fn comma() -> (Vec<GnssRow>, Vec<ImuStep>) {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/comma2k19_3d");
+    let gnss = std::fs::read(format!("{dir}/gnss.csv")).expect("shipped");
+    let imu = std::fs::read(format!("{dir}/imu.csv")).expect("shipped");
+    let rows = read_gnss(&LogText::new("gnss.csv", gnss)).expect("reads");
+    let (steps, _, _) = read_steps(&LogText::new("imu.csv", imu), CONSUMER.axes).expect("reads");
+    (rows, steps)
+}
+
+/// The first 240 s of the simulated drive, held.
+fn simulated() -> (Vec<GnssRow>, Vec<ImuStep>) {
+    let mut config = InsConfig::default();
+    config.drive.duration_s = 240.0;
+    let study = Study::from_config(&config).expect("valid");
+    let (mut imu, mut gnss, mut truth) = (Vec::new(), Vec::new(), Vec::new());
+    write_realization(&study, 3, &mut imu, &mut gnss, &mut truth).expect("in memory");
+    let rows = read_gnss(&LogText::new("gnss.csv", gnss)).expect("reads");
+    let (steps, _, _) = read_steps(&LogText::new("imu.csv", imu), CONSUMER.axes).expect("reads");
+    (rows, steps)
+}
+
+/// Assumptions moved from `s`: each key the search takes changed by a factor or a shift.
+fn moves(s: &Settings) -> Vec<(&'static str, Settings)> {
+    let mut out = Vec::new();
+    let mut push = |name, f: &dyn Fn(&mut Settings)| {
+        let mut t = *s;
+        f(&mut t);
+        out.push((name, t));
+    };
+    push("horizontal sigma x1.5", &|t| {
+        t.gnss_position_sigma_m[0] *= 1.5;
+        t.gnss_position_sigma_m[1] *= 1.5;
+    });
+    push("vertical sigma x0.7", &|t| {
+        t.gnss_position_sigma_m[2] *= 0.7
+    });
+    push("velocity sigma x0.6", &|t| t.gnss_velocity_sigma_m_s *= 0.6);
+    push("vrw x2", &|t| t.accel_vrw_m_s_per_sqrt_s *= 2.0);
+    push("arw x0.5", &|t| t.gyro_arw_rad_per_sqrt_s *= 0.5);
+    push("gyro bias rw x3", &|t| {
+        t.gyro_bias_random_walk_rad_s_per_sqrt_s *= 3.0
+    });
+    push("offset +0.03 s", &|t| t.gnss_time_offset_s += 0.03);
+    push("offset -0.05 s", &|t| t.gnss_time_offset_s -= 0.05);
+    out
+}
+
+/// The χ²₁ quantile at 95 % over two: the fall in ℓ at a 95 % profile interval's end.
+const END_FALL: f64 = 1.92;
+
+/// The linearized ℓ against the rerun's: equal at the run's statistics (to 10⁻⁹ relative), and
+/// within `tolerance` at each move of [`moves`], each of which moves the rerun's ℓ by more than
+/// `tolerance` (the control: a model that ignored the statistics would fail).
+fn check((rows, steps): &(Vec<GnssRow>, Vec<ImuStep>), s: &Settings, tolerance: f64) {
+    let model = Linearized::new(rows, steps, s).expect("runs");
+    let fixes = model.len() - 2;
+    let exact = log_likelihood(rows, steps, s, fixes);
+    let linear = model.log_likelihood(s, fixes);
+    assert!(
+        (exact - linear).abs() <= 1e-9 * exact.abs(),
+        "at the run's own statistics: {exact} against {linear}"
+    );
+    for (what, t) in moves(s) {
+        let e = log_likelihood(rows, steps, &t, fixes);
+        let l = model.log_likelihood(&t, fixes);
+        eprintln!(
+            "{what}: rerun {e:.3}, linearized {l:.3}, rerun moved {:.3}",
+            e - exact
+        );
+        assert!((l - e).abs() <= tolerance, "{what}: {l} against {e}");
+        assert!(
+            (e - exact).abs() > tolerance,
+            "{what} does not move ℓ: {e} {exact}"
+        );
+    }
+}
+
+/// On the simulated drive, whose model the filter holds, the linearized ℓ stays within an
+/// eighth of an interval end's fall of the rerun's at every move.
+#[test]
+fn linear_likelihood_is_the_runs_on_a_simulated_drive() {
+    check(&simulated(), &CONSUMER, END_FALL / 8.0);
+}
+
+/// On the comma2k19 minute (a vibrating phone, smoothed fixes) within half an end's fall.
+#[test]
+fn linear_likelihood_is_the_runs_on_the_comma_minute() {
+    check(&comma(), &CONSUMER, END_FALL / 2.0);
+}
