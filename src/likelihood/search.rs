@@ -6,7 +6,9 @@
 //! m(m − 1)/2 evaluations for m free variables) converges in a handful of iterations, fewer
 //! evaluations than a quasi-Newton or a simplex method need for the same accuracy.
 
-use std::cell::Cell;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use rayon::prelude::*;
 
 /// Step of the finite differences, in the variables' units (logarithms: a relative 10⁻³).
 const STEP: f64 = 1e-3;
@@ -24,7 +26,7 @@ pub struct Objective<'f> {
     pub lo: Vec<f64>,
     /// Upper bounds.
     pub hi: Vec<f64>,
-    evaluations: Cell<u64>,
+    evaluations: AtomicU64,
 }
 
 /// A maximum of an [`Objective`] over some of its variables, the others held.
@@ -46,18 +48,18 @@ impl<'f> Objective<'f> {
             f,
             lo,
             hi,
-            evaluations: Cell::new(0),
+            evaluations: AtomicU64::new(0),
         }
     }
 
     /// Evaluations so far.
     pub fn evaluations(&self) -> u64 {
-        self.evaluations.get()
+        self.evaluations.load(Ordering::Relaxed)
     }
 
     /// f(u), a non-finite value as −∞.
     pub fn value(&self, u: &[f64]) -> f64 {
-        self.evaluations.set(self.evaluations.get() + 1);
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
         let v = (self.f)(u);
         if v.is_finite() { v } else { f64::NEG_INFINITY }
     }
@@ -69,31 +71,47 @@ impl<'f> Objective<'f> {
     }
 
     /// The gradient and Hessian over the variables `free` at `u` (value `fu`): central
-    /// differences for the gradient and the diagonal, forward differences for the rest.
+    /// differences for the gradient and the diagonal, forward differences for the rest; the
+    /// 2m + m(m − 1)/2 evaluations in parallel (each independent of the others, so the result
+    /// does not depend on the threads).
     fn derivatives(&self, u: &[f64], fu: f64, free: &[usize]) -> (Vec<f64>, Vec<Vec<f64>>) {
         let n = u.len();
         let mut g = vec![0.0; n];
         let mut h = vec![vec![0.0; n]; n];
-        let at = |moves: &[(usize, f64)]| {
-            let mut v = u.to_vec();
-            for &(i, d) in moves {
-                v[i] += d;
-            }
-            self.value(&v)
-        };
-        let mut plus = vec![0.0; n];
+        let mut moves: Vec<Vec<(usize, f64)>> = Vec::new();
         for &i in free {
-            let (fp, fm) = (at(&[(i, STEP)]), at(&[(i, -STEP)]));
+            moves.push(vec![(i, STEP)]);
+            moves.push(vec![(i, -STEP)]);
+        }
+        for (a, &i) in free.iter().enumerate() {
+            for &j in &free[a + 1..] {
+                moves.push(vec![(i, STEP), (j, STEP)]);
+            }
+        }
+        let values: Vec<f64> = moves
+            .par_iter()
+            .map(|m| {
+                let mut v = u.to_vec();
+                for &(i, d) in m {
+                    v[i] += d;
+                }
+                self.value(&v)
+            })
+            .collect();
+        let mut plus = vec![0.0; n];
+        for (k, &i) in free.iter().enumerate() {
+            let (fp, fm) = (values[2 * k], values[2 * k + 1]);
             plus[i] = fp;
             g[i] = (fp - fm) / (2.0 * STEP);
             h[i][i] = (fp - 2.0 * fu + fm) / (STEP * STEP);
         }
+        let mut k = 2 * free.len();
         for (a, &i) in free.iter().enumerate() {
             for &j in &free[a + 1..] {
-                let fij = at(&[(i, STEP), (j, STEP)]);
-                let hij = (fij - plus[i] - plus[j] + fu) / (STEP * STEP);
+                let hij = (values[k] - plus[i] - plus[j] + fu) / (STEP * STEP);
                 h[i][j] = hij;
                 h[j][i] = hij;
+                k += 1;
             }
         }
         (g, h)

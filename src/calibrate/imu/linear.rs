@@ -181,7 +181,7 @@ impl<'a> Linearized<'a> {
             m = fx.transition * (m - applied);
             p = transition_congruence(&fx.transition, &p);
             for (q, dg) in fx.noise_parts.iter().zip(d) {
-                p += q * dg;
+                p.zip_apply(q, |a, b| *a += dg * b);
             }
             let (fix, measured) = fix_of(&fx.row, t);
             let sigma = [fix.position_sigma_m, fix.velocity_sigma_m_s];
@@ -214,8 +214,8 @@ impl<'a> Linearized<'a> {
             // K = P Hᵀ S⁻¹ from S Kᵀ = H P; P⁺ = P − K H P.
             let k = chol.solve(&hp).transpose();
             m += k * y;
-            p -= k * hp;
-            p = (p + p.transpose()) * 0.5;
+            p.gemm(-1.0, &k, &hp, 1.0);
+            symmetrize(&mut p);
             applied = fx.correction;
         }
         -0.5 * sum
@@ -264,4 +264,15 @@ fn specific_force_integral(steps: &[ImuStep], step: usize, from: f64, to: f64) -
         sum += overlap(st);
     }
     sum * sign
+}
+
+/// P ← (P + Pᵀ)/2 in place.
+fn symmetrize(p: &mut Matrix15) {
+    for i in 0..STATES {
+        for j in i + 1..STATES {
+            let v = 0.5 * (p[(i, j)] + p[(j, i)]);
+            p[(i, j)] = v;
+            p[(j, i)] = v;
+        }
+    }
 }

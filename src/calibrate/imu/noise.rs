@@ -24,7 +24,7 @@ use super::run::{filter, shifted};
 use crate::likelihood::{Fit, climb, maximize};
 
 /// Runs of the filter the search linearizes about, at most.
-pub const MAX_RUNS: usize = 8;
+pub const MAX_RUNS: usize = 12;
 
 /// The maximum has stopped moving when no key's search variable moves more than this between
 /// two runs (a logarithm: 0.1 %; the offset: 0.1 ms).
