@@ -6,6 +6,7 @@
 mod allan;
 mod calibrate;
 mod config;
+mod interrupt;
 mod monte_carlo;
 
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
