@@ -36,16 +36,20 @@ def _get(table: Any, log: str, column: str) -> Any:
     """``table[column]``, or ``_MISSING`` when the table has no such column."""
     if table is None:
         raise ValueError(f"{log}: None; expected a table of columns (a dict of arrays, a DataFrame)")
-    if not hasattr(table, "__getitem__"):
-        raise ValueError(
-            f"{log}: a {type(table).__name__}; expected a table of columns indexed by name "
-            "(a dict of arrays, a DataFrame)"
-        )
+    not_a_table = ValueError(
+        f"{log}: a {type(table).__name__}; expected a table of columns indexed by name "
+        "(a dict of arrays, a DataFrame, a numpy structured array)"
+    )
+    if not hasattr(table, "__getitem__") or isinstance(table, (str, bytes)):
+        raise not_a_table
     try:
         return table[column]
-    except (KeyError, IndexError, ValueError):
+    except (KeyError, ValueError):
         # KeyError: a dict, a DataFrame; ValueError: a numpy structured array's missing field.
         return _MISSING
+    except (TypeError, IndexError):
+        # A list or a plain array: indexed by position, not by name.
+        raise not_a_table from None
 
 
 def _array(name: str, x: Any, allow_nan: bool) -> np.ndarray:
