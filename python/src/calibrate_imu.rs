@@ -24,8 +24,9 @@ use crate::config::Source;
 const IMU_NAME: &str = "imu";
 const GNSS_NAME: &str = "gnss";
 
-/// A finished three-axis calibration: what `summary.json`, `estimates.csv` and the page hold.
-#[pyclass(frozen, unsendable, module = "accelcal._accelcal")]
+/// A finished three-axis calibration: what `summary.json`, `estimates.csv` and the page hold
+/// (plain numbers: any Python thread may use it).
+#[pyclass(frozen, module = "accelcal._accelcal")]
 pub(crate) struct ImuCalibrationResult {
     calibrated: Calibrated,
     summary: Summary,

@@ -232,3 +232,15 @@ def test_bad_estimate_key_and_both_forms():
         accelcal.calibrate(imu["t_s"], imu=imu, gnss=gnss)
     with pytest.raises(ValueError, match=r"^gnss: None"):
         accelcal.calibrate(imu=imu)
+
+
+def test_the_result_is_usable_from_another_thread():
+    import threading
+
+    imu, gnss = comma()
+    r = accelcal.calibrate(imu=imu, gnss=gnss)
+    pages = []
+    worker = threading.Thread(target=lambda: pages.append(r.html()))
+    worker.start()
+    worker.join()
+    assert pages and pages[0] == r.html()
