@@ -2,7 +2,7 @@
 
 A Rust core with numpy arrays in and out; every function gives the numbers of the command line
 (``accelcal allan``, ``accelcal ensemble``, ``accelcal simulate --logs``,
-``accelcal calibrate``) on the same input, bit for bit.
+``accelcal calibrate``, ``accelcal calibrate --imu --gnss``) on the same input, bit for bit.
 
 Arrays: a 1-D float64 contiguous array is read in place; any other real dtype (integers,
 float32) or a strided view is converted to float64 once. A dtype that is not a real number
@@ -11,7 +11,9 @@ or time stamps that do not increase raise ``ValueError`` naming the argument and
 Configurations: ``None`` (the defaults), a path (``str`` or ``os.PathLike``), TOML text, or a
 dict with the keys of the TOML file. A configuration file that does not exist raises
 ``FileNotFoundError``; every other bad input raises ``ValueError`` with the command line's
-message. Long work releases the GIL.
+message. Long work releases the GIL, and Ctrl-C raises KeyboardInterrupt within 0.1 s: an
+ensemble or an Allan analysis stops (its workers poll a flag between blocks); a noise estimate
+or a three-axis calibration goes on in the background until it ends, its result dropped.
 """
 
 from __future__ import annotations
@@ -19,17 +21,19 @@ from __future__ import annotations
 import io
 import json
 import os
-from typing import Any, Dict, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from accelcal import _accelcal
+from accelcal import _accelcal, _imu
 from accelcal._accelcal import __version__
+from accelcal._imu import ImuCalibrationResult
 
 __all__ = [
     "__version__",
     "AllanResult",
     "CalibrationResult",
+    "ImuCalibrationResult",
     "Term",
     "allan",
     "calibrate",
@@ -263,24 +267,57 @@ class CalibrationResult:
 
 
 def calibrate(
-    accel_t: Any,
-    accel: Any,
-    gps_t: Any,
-    gps_position: Any,
-    gps_velocity: Any,
+    accel_t: Any = None,
+    accel: Any = None,
+    gps_t: Any = None,
+    gps_position: Any = None,
+    gps_velocity: Any = None,
     *,
+    imu: Any = None,
+    gnss: Any = None,
     config: ConfigLike = None,
     estimate_noise: Union[None, bool, Sequence[str]] = None,
     confidence: float = 0.95,
-) -> CalibrationResult:
-    """Calibrates the accelerometer's bias from its samples (``accel_t`` s, ``accel`` m/s²)
-    and the GPS fixes (``gps_t`` s, ``gps_position`` m, ``gps_velocity`` m/s): the filter, the
-    smoother and the NIS test of ``accelcal calibrate``.
+) -> Union[CalibrationResult, ImuCalibrationResult]:
+    """Calibrates an accelerometer or a whole IMU with GPS: ``accelcal calibrate``.
 
+    One axis: the accelerometer's samples (``accel_t`` s, ``accel`` m/s²) and the GPS fixes
+    (``gps_t`` s, ``gps_position`` m, ``gps_velocity`` m/s): the filter, the smoother and the
+    NIS test of ``accelcal calibrate --accel --gps``; returns a :class:`CalibrationResult`.
+
+    Three axes (``accelcal calibrate --imu --gnss``): ``imu`` and ``gnss`` are tables of
+    columns (a dict of 1-D arrays, a pandas DataFrame: anything indexed by column name) with
+    the logs' columns. ``imu``: ``t_s`` (s) and either the rates ``ax_m_s2, ay_m_s2, az_m_s2``
+    (m/s²), ``gx_rad_s, gy_rad_s, gz_rad_s`` (rad/s) or the increments ``dvx_m_s, dvy_m_s,
+    dvz_m_s`` (m/s), ``dthx_rad, dthy_rad, dthz_rad`` (rad) over the step ending at ``t_s``.
+    ``gnss``: ``t_s`` (s), ``lat_deg``, ``lon_deg`` (°, WGS-84), ``height_m`` (m, ellipsoidal)
+    and optionally ``vn_m_s, ve_m_s, vd_m_s`` (m/s) and the σ's ``sigma_n_m, sigma_e_m,
+    sigma_d_m`` (m), ``sigma_vn_m_s, sigma_ve_m_s, sigma_vd_m_s`` (m/s), NaN where not
+    measured. Returns an :class:`ImuCalibrationResult`. Messages call the logs ``imu`` and
+    ``gnss`` and row ``i`` their line ``i + 2`` (as in the CSV, after its header).
+
+    ``config``: the configuration (for three axes, the keys of ``calibrate --imu --config``).
     ``estimate_noise``: None or False for the configured statistics; True for
-    ``--estimate-noise`` (the default statistics); a list of [filter] keys for
-    ``--estimate-noise --estimate KEYS``. ``confidence``: of the noise estimate's intervals.
+    ``--estimate-noise`` (the default statistics); a list of keys for ``--estimate-noise
+    --estimate KEYS``. ``confidence``: of the noise estimate's intervals, in (0, 1).
+
+    Ctrl-C raises KeyboardInterrupt within 0.1 s; a noise estimate or a three-axis filter then
+    ends in the background (their loops poll no flag), its result dropped.
     """
+    if imu is not None or gnss is not None:
+        given = [n for n, x in zip(_ONE_AXIS, (accel_t, accel, gps_t, gps_position, gps_velocity)) if x is not None]
+        if given:
+            raise ValueError(
+                f"{given[0]} given with imu/gnss: the one-axis arrays and the three-axis tables "
+                "are two forms of the call; give one"
+            )
+        return _calibrate_imu(imu, gnss, config, estimate_noise, confidence)
+    missing = [n for n, x in zip(_ONE_AXIS, (accel_t, accel, gps_t, gps_position, gps_velocity)) if x is None]
+    if missing:
+        raise ValueError(
+            f"{missing[0]} is missing: give accel_t, accel, gps_t, gps_position, gps_velocity "
+            "(one axis) or imu=…, gnss=… (three axes)"
+        )
     at = _times("accel_t", accel_t)
     a = _vector("accel", accel)
     _same_length("accel_t", at, "accel", a)
@@ -289,24 +326,51 @@ def calibrate(
     gv = _vector("gps_velocity", gps_velocity)
     _same_length("gps_t", gt, "gps_position", gp)
     _same_length("gps_t", gt, "gps_velocity", gv)
-    if estimate_noise is None or estimate_noise is False:
-        keys = None
-    elif estimate_noise is True:
-        keys = []
-    elif isinstance(estimate_noise, str):
-        keys = [k for k in estimate_noise.split(",") if k.strip()]
-    else:
-        keys = [str(k) for k in estimate_noise]
+    keys = _keys(estimate_noise)
     kind, value = _config(config)
     command = "accelcal.calibrate(accel_t, accel, gps_t, gps_position, gps_velocity"
-    if kind == "file":
-        command += f", config={value!r}"
-    elif kind is not None:
-        command += ", config=…"
-    if keys is not None:
-        command += f", estimate_noise={keys if keys else True!r}"
-        if confidence != 0.95:
-            command += f", confidence={confidence!r}"
-    command += ")"
+    command += _command_options(kind, value, keys, confidence) + ")"
     result = _accelcal.calibrate_arrays(at, a, gt, gp, gv, kind, value, keys, float(confidence))
     return CalibrationResult(result, command)
+
+
+_ONE_AXIS = ("accel_t", "accel", "gps_t", "gps_position", "gps_velocity")
+
+
+def _keys(estimate_noise: Union[None, bool, str, Sequence[str]]) -> Optional[List[str]]:
+    """The keys of ``--estimate`` (empty: the defaults), or None for no estimation."""
+    if estimate_noise is None or estimate_noise is False:
+        return None
+    if estimate_noise is True:
+        return []
+    if isinstance(estimate_noise, str):
+        return [k.strip() for k in estimate_noise.split(",") if k.strip()]
+    return [str(k) for k in estimate_noise]
+
+
+def _command_options(kind: Optional[str], value: Optional[str], keys: Optional[List[str]], confidence: float) -> str:
+    """The keyword arguments of the call, as the page's command line shows them."""
+    out = ""
+    if kind == "file":
+        out += f", config={value!r}"
+    elif kind is not None:
+        out += ", config=…"
+    if keys is not None:
+        out += f", estimate_noise={keys if keys else True!r}"
+        if confidence != 0.95:
+            out += f", confidence={confidence!r}"
+    return out
+
+
+def _calibrate_imu(
+    imu: Any, gnss: Any, config: ConfigLike, estimate_noise: Any, confidence: float
+) -> ImuCalibrationResult:
+    t, columns, layout = _imu.imu_columns(imu)
+    required, optional = _imu.gnss_columns(gnss)
+    keys = _keys(estimate_noise)
+    kind, value = _config(config)
+    command = "accelcal.calibrate(imu=imu, gnss=gnss" + _command_options(kind, value, keys, confidence) + ")"
+    result = _accelcal.calibrate_imu_arrays(
+        t, columns, layout, required, optional, kind, value, keys, float(confidence)
+    )
+    return ImuCalibrationResult(result, command)

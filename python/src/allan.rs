@@ -30,7 +30,8 @@ impl AllanAnalysis {
 
 /// The overlapping Allan deviation, its intervals and the noise terms of rate samples `y`
 /// (m/s², float64 and contiguous: the Python layer converts once) τ₀ = `tau0_s` apart. The GIL
-/// is released during the analysis.
+/// is released during the analysis; Ctrl-C stops it between stretches of its pass
+/// (`crate::interrupt::until_stopped`).
 #[pyfunction]
 pub(crate) fn allan_analysis(
     py: Python<'_>,
@@ -39,8 +40,9 @@ pub(crate) fn allan_analysis(
     confidence: f64,
 ) -> PyResult<AllanAnalysis> {
     let y = y.as_slice().map_err(crate::bad_input)?;
-    let analysis = py
-        .detach(|| allan::analyse(y, tau0_s, confidence))
-        .map_err(crate::bad_input)?;
+    let analysis = crate::interrupt::until_stopped(py, |cancel| {
+        allan::analyse_cancellable(y, tau0_s, confidence, cancel)
+    })?
+    .map_err(crate::bad_input)?;
     Ok(AllanAnalysis(analysis))
 }

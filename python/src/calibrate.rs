@@ -97,10 +97,31 @@ fn csv(columns: &[&str], values: &[&[f64]]) -> String {
     out
 }
 
+/// The calibration of the accelerometer samples `at`, `a` with the GPS fixes `gt`, `gp`, `gv`
+/// and its `estimates.csv`.
+fn calibrate_slices(
+    [at, a, gt, gp, gv]: [&[f64]; 5],
+    settings: &Settings,
+    request: Option<&Request>,
+) -> PyResult<(Calibration, String)> {
+    let accel_log = AccelArrays::new("accel", at, a).map_err(crate::bad_input)?;
+    let gps_log = LogText::new("gps", csv(&GPS_COLUMNS, &[gt, gp, gv]));
+    let prepared = calibrate::prepare_with(&accel_log, &gps_log, settings, request)
+        .map_err(crate::bad_input)?;
+    let mut estimates = Vec::new();
+    prepared
+        .write_fix_estimates(&mut estimates)
+        .map_err(crate::bad_input)?;
+    let estimates = String::from_utf8(estimates).map_err(crate::bad_input)?;
+    Ok((prepared.calibration(), estimates))
+}
+
 /// The calibration of the accelerometer samples (`accel_t` s, `accel` m/s²) with the GPS fixes
 /// (`gps_t` s, `gps_position` m, `gps_velocity` m/s); `estimate` as [`request`]. The arrays
-/// are float64 and contiguous (the Python layer converts once and checks them). The GIL is
-/// released during the work.
+/// are float64 and contiguous (the Python layer converts once and checks them) and read in
+/// place, the GIL released during the work. With a noise estimate the arrays are copied once
+/// and the work runs on a thread of its own that Ctrl-C leaves behind
+/// (`crate::interrupt::leaving_behind`): the likelihood's search polls no flag.
 #[pyfunction]
 #[pyo3(signature = (accel_t, accel, gps_t, gps_position, gps_velocity, config_kind, config_value, estimate, confidence))]
 #[allow(clippy::too_many_arguments)]
@@ -119,27 +140,25 @@ pub(crate) fn calibrate_arrays(
     let source = config_kind.zip(config_value).map(|(k, v)| Source::of(k, v));
     let settings = settings(source).map_err(crate::config_error)?;
     let request = request(estimate, confidence, &settings)?;
-    let (at, a) = (
-        accel_t.as_slice().map_err(crate::bad_input)?,
-        accel.as_slice().map_err(crate::bad_input)?,
-    );
-    let (gt, gp, gv) = (
-        gps_t.as_slice().map_err(crate::bad_input)?,
-        gps_position.as_slice().map_err(crate::bad_input)?,
-        gps_velocity.as_slice().map_err(crate::bad_input)?,
-    );
-    let (calibration, estimates_csv) = py.detach(|| {
-        let accel_log = AccelArrays::new("accel", at, a).map_err(crate::bad_input)?;
-        let gps_log = LogText::new("gps", csv(&GPS_COLUMNS, &[gt, gp, gv]));
-        let prepared = calibrate::prepare_with(&accel_log, &gps_log, &settings, request.as_ref())
-            .map_err(crate::bad_input)?;
-        let mut estimates = Vec::new();
-        prepared
-            .write_fix_estimates(&mut estimates)
-            .map_err(crate::bad_input)?;
-        let estimates = String::from_utf8(estimates).map_err(crate::bad_input)?;
-        Ok::<_, PyErr>((prepared.calibration(), estimates))
-    })?;
+    let arrays = [&accel_t, &accel, &gps_t, &gps_position, &gps_velocity];
+    let mut slices: [&[f64]; 5] = [&[]; 5];
+    for (s, a) in slices.iter_mut().zip(arrays) {
+        *s = a.as_slice().map_err(crate::bad_input)?;
+    }
+    let (calibration, estimates_csv) = match request {
+        None => py.detach(|| calibrate_slices(slices, &settings, None))?,
+        Some(request) => {
+            // Owned: an interrupted search goes on after the arrays may be gone.
+            let owned = slices.map(<[f64]>::to_vec);
+            crate::interrupt::leaving_behind(py, move |_| {
+                calibrate_slices(
+                    owned.each_ref().map(Vec::as_slice),
+                    &settings,
+                    Some(&request),
+                )
+            })??
+        }
+    };
     Ok(CalibrationResult {
         calibration,
         estimates_csv,

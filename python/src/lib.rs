@@ -5,7 +5,9 @@
 
 mod allan;
 mod calibrate;
+mod calibrate_imu;
 mod config;
+mod interrupt;
 mod monte_carlo;
 
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
@@ -38,6 +40,8 @@ fn _accelcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(monte_carlo::ensemble_json, m)?)?;
     m.add_function(wrap_pyfunction!(monte_carlo::simulate_logs, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate_arrays, m)?)?;
+    m.add_class::<calibrate_imu::ImuCalibrationResult>()?;
+    m.add_function(wrap_pyfunction!(calibrate_imu::calibrate_imu_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(config::default_config, m)?)?;
     m.add_function(wrap_pyfunction!(config::toml_of_json, m)?)?;
     Ok(())

@@ -1,10 +1,6 @@
 //! `accelcal.ensemble` and `accelcal.simulate`: the model loaded as the command line loads it
 //! (`accelcal ensemble`, `accelcal simulate --logs`), the same JSON and the same logs.
 
-use std::sync::mpsc::{self, RecvTimeoutError};
-use std::time::Duration;
-
-use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 
@@ -16,10 +12,6 @@ use accelcal::model::Model;
 use accelcal::{export, simulation, study};
 
 use crate::config::{self, Source};
-
-/// No progress is shown: a notebook cell has no terminal bar.
-struct Silent;
-impl accelcal::progress::Progress for Silent {}
 
 /// The model of `source` with the seed and the number of realizations set over it, an error in
 /// the file pointing at its line as the command line's does (a value set by argument points
@@ -56,7 +48,7 @@ fn source(kind: Option<&str>, value: Option<String>) -> Option<Source> {
 }
 
 /// The JSON `accelcal ensemble` writes to `--json`, as text. The GIL is released during the
-/// run.
+/// run; Ctrl-C stops it between blocks (`crate::interrupt::until_stopped`).
 #[pyfunction]
 #[pyo3(signature = (config_kind, config_value, realizations, seed, engine))]
 pub(crate) fn ensemble_json(
@@ -80,11 +72,13 @@ pub(crate) fn ensemble_json(
         .map_err(crate::config_error)?;
     let schedule =
         FilterSchedule::new(&model.timeline, &model.filter_stats).map_err(crate::bad_input)?;
-    interruptible(py, move || {
-        let outcome = study::run_case(
-            &Ensemble::new(&model, &schedule).with_engine(engine),
-            &mut Silent,
-        );
+    crate::interrupt::until_stopped(py, |cancel| {
+        // study::run_case with a flag: the workers stop between blocks once Ctrl-C raised it.
+        let ensemble = Ensemble::new(&model, &schedule).with_engine(engine);
+        let run = ensemble
+            .try_run(cancel, |_| {})
+            .map_err(|e| e.to_string())?;
+        let outcome = study::judge_case(&model, &schedule, run);
         let doc = export::ensemble_doc(&model.config, &schedule, &outcome);
         let mut out = Vec::new();
         export::write_ensemble_json(&mut out, &model.config, &doc)
@@ -92,39 +86,6 @@ pub(crate) fn ensemble_json(
         String::from_utf8(out).map_err(|e| e.to_string())
     })?
     .map_err(crate::bad_input)
-}
-
-/// How often a waiting call looks for Ctrl-C.
-const SIGNAL_POLL: Duration = Duration::from_millis(100);
-
-/// Runs `work` on a thread of its own while this one, without the GIL, waits for it and looks
-/// for a signal every [`SIGNAL_POLL`]: Ctrl-C raises `KeyboardInterrupt` at once. The library
-/// has no way to stop an ensemble midway, so an interrupted run goes on in the background until
-/// it ends, and its result is dropped.
-fn interruptible<T: Send + 'static>(
-    py: Python<'_>,
-    work: impl FnOnce() -> T + Send + 'static,
-) -> PyResult<T> {
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        // The receiver is gone when the call was interrupted: nothing is waiting for the result.
-        let _ = tx.send(work());
-    });
-    let mut rx = rx;
-    loop {
-        // The receiver is moved in and out: it is Send, not Sync.
-        let (received, back) = py.detach(move || (rx.recv_timeout(SIGNAL_POLL), rx));
-        rx = back;
-        match received {
-            Ok(result) => return Ok(result),
-            Err(RecvTimeoutError::Timeout) => py.check_signals()?,
-            Err(RecvTimeoutError::Disconnected) => {
-                return Err(PyRuntimeError::new_err(
-                    "the ensemble's thread ended without a result (a defect: please report it)",
-                ));
-            }
-        }
-    }
 }
 
 /// The three logs `accelcal simulate --logs` writes (accelerometer.csv, gps.csv, truth.csv) for

@@ -42,6 +42,8 @@ pub mod stream;
 use rayon::prelude::*;
 use thiserror::Error;
 
+use crate::progress::{Cancel, Cancelled};
+
 pub use fit::{Fit, FitPoint, Term, TermEstimate};
 pub use noise_id::NoiseId;
 pub use reading::{Departure, Feature, Reading};
@@ -73,6 +75,9 @@ pub enum AllanError {
     /// A simulated log written as CSV text did not read back (a defect, not bad input).
     #[error("the simulated static log did not read back: {0}")]
     SimulatedLog(String),
+    /// The analysis was stopped by its [`Cancel`] flag.
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
 }
 
 /// The Allan deviation at one τ.
@@ -162,16 +167,25 @@ impl Analysis {
 
 /// The deviation, noise type, EDF and interval at every τ of the octave grid, from the phase
 /// `x` (in samples) of n rate samples.
-fn points(x: &[f64], tau0_s: f64, confidence: f64) -> Vec<AllanPoint> {
+/// `cancel` is polled before each stretch of the deviation's pass and each τ's identification.
+fn points(
+    x: &[f64],
+    tau0_s: f64,
+    confidence: f64,
+    cancel: &Cancel,
+) -> Result<Vec<AllanPoint>, Cancelled> {
     let n = x.len() - 1;
     let factors = deviation::octave_factors(n);
-    let avars = deviation::overlapping_avars(x, &factors);
+    let avars = deviation::overlapping_avars_polled(x, &factors, cancel)?;
     let raw: Vec<(usize, f64, Option<NoiseId>)> = factors
         .par_iter()
         .zip(avars)
-        .map(|(&m, avar)| (m, avar, noise_id::identify(&noise_id::block_means(x, m))))
-        .collect();
-    with_intervals(&raw, n, tau0_s, confidence)
+        .map(|(&m, avar)| {
+            cancel.check()?;
+            Ok((m, avar, noise_id::identify(&noise_id::block_means(x, m))))
+        })
+        .collect::<Result<_, Cancelled>>()?;
+    Ok(with_intervals(&raw, n, tau0_s, confidence))
 }
 
 /// The points of the octave grid from each τ's (m, σ̂², the noise of its own block means) for n
@@ -233,6 +247,21 @@ fn fitted_terms(points: &[AllanPoint]) -> Vec<Term> {
 /// [`AllanError`] for fewer than [`MIN_SAMPLES`] samples, a constant log or a confidence
 /// outside (0, 1).
 pub fn analyse(y: &[f64], tau0_s: f64, confidence: f64) -> Result<Analysis, AllanError> {
+    analyse_cancellable(y, tau0_s, confidence, &Cancel::new())
+}
+
+/// [`analyse`] that stops when `cancel` is raised: it is polled after the phase, before each
+/// stretch of the deviation's pass and before each τ's noise identification, so a raised flag
+/// ends the call within one of those pieces (each O(n / threads) at most).
+///
+/// # Errors
+/// As [`analyse`], and [`AllanError::Cancelled`] when `cancel` was raised first.
+pub fn analyse_cancellable(
+    y: &[f64],
+    tau0_s: f64,
+    confidence: f64,
+    cancel: &Cancel,
+) -> Result<Analysis, AllanError> {
     if !(confidence > 0.0 && confidence < 1.0) {
         return Err(AllanError::Confidence(confidence));
     }
@@ -243,7 +272,9 @@ pub fn analyse(y: &[f64], tau0_s: f64, confidence: f64) -> Result<Analysis, Alla
         });
     }
     let x = deviation::phase(y);
-    analyse_points(points(&x, tau0_s, confidence), y.len(), tau0_s, confidence)
+    cancel.check()?;
+    let points = points(&x, tau0_s, confidence, cancel)?;
+    analyse_points(points, y.len(), tau0_s, confidence)
 }
 
 /// Analyses the rate samples of a log read once ([`stream::AllanStream`]): `grid` holds each

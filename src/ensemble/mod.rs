@@ -44,6 +44,7 @@ use std::time::Instant;
 use crate::config::TruthModel;
 use crate::filter::FilterSchedule;
 use crate::model::Model;
+use crate::progress::{Cancel, Cancelled};
 pub use engine::Engine;
 use engine::Prepared;
 use epoch::EpochPlan;
@@ -288,7 +289,8 @@ impl<'a> Ensemble<'a> {
         progress: impl FnMut(u64) + Send,
         on_block: impl FnMut(u64, &Accumulator) + Send,
     ) {
-        workers::run_blocks(self, progress, on_block);
+        // Without a flag nothing stops the run.
+        let _ = workers::run_blocks(self, None, progress, on_block);
     }
 
     /// The sums of the shard's realizations, the fold of its blocks in block order; `progress` as
@@ -299,14 +301,47 @@ impl<'a> Ensemble<'a> {
         total
     }
 
+    /// [`Ensemble::sums`] that stops when `cancel` is raised: no block starts after it, so the
+    /// call returns within one block's time.
+    ///
+    /// # Errors
+    /// [`Cancelled`] when `cancel` was raised before the last block was summed.
+    pub fn try_sums(
+        &self,
+        cancel: &Cancel,
+        progress: impl FnMut(u64) + Send,
+    ) -> Result<Accumulator, Cancelled> {
+        let mut total = self.empty_sums();
+        workers::run_blocks(self, Some(cancel), progress, |_, block| total.merge(block))?;
+        Ok(total)
+    }
+
     /// The statistics of the shard's realizations and how fast they ran; `progress` as in
     /// [`Ensemble::blocks`].
     pub fn run(&self, progress: impl FnMut(u64) + Send) -> EnsembleRun {
         let start = Instant::now();
         let sums = self.sums(progress);
+        self.finish_run(&sums, start)
+    }
+
+    /// [`Ensemble::run`] that stops when `cancel` is raised, as [`Ensemble::try_sums`].
+    ///
+    /// # Errors
+    /// [`Cancelled`] when `cancel` was raised before the last block was summed.
+    pub fn try_run(
+        &self,
+        cancel: &Cancel,
+        progress: impl FnMut(u64) + Send,
+    ) -> Result<EnsembleRun, Cancelled> {
+        let start = Instant::now();
+        let sums = self.try_sums(cancel, progress)?;
+        Ok(self.finish_run(&sums, start))
+    }
+
+    fn finish_run(&self, sums: &Accumulator, start: Instant) -> EnsembleRun {
         let elapsed_s = start.elapsed().as_secs_f64();
         EnsembleRun {
-            stats: EnsembleStats::from_sums(&sums, self.schedule),
+            stats: EnsembleStats::from_sums(sums, self.schedule),
             elapsed_s,
             engine: self.engine(),
         }

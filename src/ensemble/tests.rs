@@ -1,6 +1,7 @@
 use super::*;
 
 use crate::config::Config;
+use crate::progress::{Cancel, Cancelled};
 use crate::simulation::{FixState, Observer, run_realization};
 use crate::state::{ErrorState, StateVector};
 
@@ -204,4 +205,40 @@ fn with_truth_runs_the_other_truth() {
         );
         assert_ne!(own.sums_of(range.clone()), of_model.sums_of(range));
     }
+}
+
+/// A raised [`Cancel`] stops the run: raised from the progress callback after the first block,
+/// no block is started afterwards beyond those already claimed (one per thread at most), and the
+/// call ends with `Cancelled`; a flag never raised gives the whole run's sums (the control).
+#[test]
+fn a_raised_cancel_stops_the_run_within_a_block_per_thread() {
+    let (m, s) = small();
+    let e = Ensemble::new(&m, &s)
+        .with_engine(Engine::Epoch)
+        .with_seed(3)
+        .with_realizations(200 * CHUNK);
+    let blocks = e.partition().blocks;
+    assert!(blocks >= 100, "{blocks} blocks: too few to see the stop");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let cancel = Cancel::new();
+    let mut done = 0;
+    let stopped = pool.install(|| {
+        e.try_sums(&cancel, |d| {
+            done = d;
+            cancel.cancel();
+        })
+    });
+    assert_eq!(stopped, Err(Cancelled));
+    // The block handed over first and, per thread, the one it was summing and a finished one
+    // waiting for its turn (BLOCKS_AHEAD_PER_THREAD = 2).
+    let block = e.partition().block_realizations(0).end;
+    assert!(done <= 5 * block, "{done} realizations after the flag");
+
+    let never = Cancel::new();
+    let whole = pool.install(|| e.try_sums(&never, |_| {}));
+    assert_eq!(whole, Ok(pool.install(|| e.sums(|_| {}))));
+    assert_eq!(Cancel::new().check(), Ok(()));
 }

@@ -13,6 +13,7 @@ use super::engine::{Scratch, accumulate_into};
 use super::layout::ResidualLayout;
 use super::sums::{Accumulator, FixSums};
 use super::{Ensemble, Partition};
+use crate::progress::{Cancel, Cancelled};
 
 /// Memory the sums of the blocks in flight may take together, bytes.
 const WINDOW_BYTES: u64 = 256 << 20;
@@ -83,6 +84,8 @@ struct Shared<'e, 'a, P, B> {
     emitter: Mutex<Emitter<P, B>>,
     /// Signalled when blocks are handed over or a worker fails.
     turn: Condvar,
+    /// Polled before each block is claimed: once raised, no further block starts.
+    cancel: Option<&'e Cancel>,
 }
 
 /// Set in each worker: if the worker panics, it marks the run failed, lets no further block be
@@ -107,6 +110,10 @@ impl<P, B> Shared<'_, '_, P, B> {
 }
 
 impl<P: FnMut(u64), B: FnMut(u64, &Accumulator)> Shared<'_, '_, P, B> {
+    fn cancelled(&self) -> bool {
+        self.cancel.is_some_and(Cancel::is_cancelled)
+    }
+
     /// One worker: claims blocks until none is left (or a worker failed), sums each, hands it over.
     fn work(&self) {
         let _abort = Abort(self);
@@ -133,13 +140,24 @@ impl<P: FnMut(u64), B: FnMut(u64, &Accumulator)> Shared<'_, '_, P, B> {
         if b >= self.end {
             return None;
         }
+        if self.cancelled() {
+            // Block b will not be handed over: wake the workers waiting for it, under the lock
+            // so that none misses the call between its test and its wait.
+            let _e = self.lock();
+            self.turn.notify_all();
+            return None;
+        }
         // Every block before b is claimed by a running worker, so the wait ends (or a worker
         // failed, and the run with it).
         let mut e = self
             .turn
-            .wait_while(self.lock(), |e| !e.failed && b >= e.next + self.window)
+            .wait_while(self.lock(), |e| {
+                !e.failed && !self.cancelled() && b >= e.next + self.window
+            })
             .unwrap_or_else(|e| e.into_inner());
-        if e.failed {
+        if e.failed || self.cancelled() {
+            drop(e);
+            self.turn.notify_all();
             return None;
         }
         let acc = e
@@ -152,12 +170,17 @@ impl<P: FnMut(u64), B: FnMut(u64, &Accumulator)> Shared<'_, '_, P, B> {
 
 /// Runs the blocks of `ensemble`'s shard in parallel and hands each block's sums to `on_block`
 /// as it is finished, in block order; `progress` is called with the number of realizations
-/// handed over so far.
+/// handed over so far. With `cancel`, no block starts once it is raised (the blocks being summed
+/// are finished, so a run stops within one block's time).
+///
+/// # Errors
+/// [`Cancelled`] when `cancel` stopped the run before its last block was handed over.
 pub(super) fn run_blocks(
     ensemble: &Ensemble,
+    cancel: Option<&Cancel>,
     progress: impl FnMut(u64) + Send,
     on_block: impl FnMut(u64, &Accumulator) + Send,
-) {
+) -> Result<(), Cancelled> {
     let blocks: Range<u64> = ensemble.block_range();
     let layout = ensemble.layout();
     let shared = Shared {
@@ -177,6 +200,11 @@ pub(super) fn run_blocks(
             on_block,
         }),
         turn: Condvar::new(),
+        cancel,
     };
     rayon::broadcast(|_| shared.work());
+    if shared.lock().next < blocks.end {
+        return Err(Cancelled);
+    }
+    Ok(())
 }

@@ -236,39 +236,51 @@ fn parse_row(
     for (k, &p) in required.iter().enumerate() {
         r[k] = field(fields[p], GNSS_COLUMNS[k], false)?.unwrap_or(f64::NAN);
     }
-    within("lat_deg", r[1], -90.0, 90.0, "latitude in [−90, 90]°")?;
-    within("lon_deg", r[2], -180.0, 360.0, "longitude in [−180, 360]°")?;
-    let (lo, hi) = HEIGHT_RANGE_M;
-    within("height_m", r[3], lo, hi, "height in [−12 000, 100 000] m")?;
+    check_required(&r)?;
     let mut o = [None; 9];
     for (k, p) in optional.iter().enumerate() {
         if let Some(p) = p {
             o[k] = field(fields[*p], GNSS_OPTIONAL[k], true)?;
-            if k >= 3
-                && let Some(s) = o[k]
-            {
-                within(
-                    GNSS_OPTIONAL[k],
-                    s,
-                    f64::MIN_POSITIVE,
-                    1e6,
-                    "a σ in (0, 10⁶]",
-                )?;
-            }
-            if k < 3
-                && let Some(v) = o[k]
-            {
-                within(
-                    GNSS_OPTIONAL[k],
-                    v,
-                    -1e4,
-                    1e4,
-                    "a speed in [−10 000, 10 000] m/s",
-                )?;
-            }
+            check_optional(k, o[k])?;
         }
     }
-    Ok(GnssRow {
+    Ok(row_of(line, r, o))
+}
+
+/// The ranges of the required values `r` ([`GNSS_COLUMNS`]).
+fn check_required(r: &[f64; 4]) -> Result<(), LogProblem> {
+    within("lat_deg", r[1], -90.0, 90.0, "latitude in [−90, 90]°")?;
+    within("lon_deg", r[2], -180.0, 360.0, "longitude in [−180, 360]°")?;
+    let (lo, hi) = HEIGHT_RANGE_M;
+    within("height_m", r[3], lo, hi, "height in [−12 000, 100 000] m")
+}
+
+/// The range of the optional column `k` ([`GNSS_OPTIONAL`]) where it holds a value.
+fn check_optional(k: usize, value: Option<f64>) -> Result<(), LogProblem> {
+    let Some(x) = value else { return Ok(()) };
+    if k >= 3 {
+        within(
+            GNSS_OPTIONAL[k],
+            x,
+            f64::MIN_POSITIVE,
+            1e6,
+            "a σ in (0, 10⁶]",
+        )
+    } else {
+        within(
+            GNSS_OPTIONAL[k],
+            x,
+            -1e4,
+            1e4,
+            "a speed in [−10 000, 10 000] m/s",
+        )
+    }
+}
+
+/// The row on `line` of the required values `r` ([`GNSS_COLUMNS`]) and the optional ones `o`
+/// ([`GNSS_OPTIONAL`], `None` where not measured), their ranges checked.
+fn row_of(line: u64, r: [f64; 4], o: [Option<f64>; 9]) -> GnssRow {
+    GnssRow {
         line,
         t_s: r[0],
         position: Geodetic {
@@ -279,5 +291,80 @@ fn parse_row(
         velocity_ned_m_s: [o[0], o[1], o[2]],
         position_sigma_m: [o[3], o[4], o[5]],
         velocity_sigma_m_s: [o[6], o[7], o[8]],
-    })
+    }
+}
+
+/// The columns of a GNSS log held in memory (the Python package's arrays): the required ones
+/// `required` in the order of [`GNSS_COLUMNS`] and those of [`GNSS_OPTIONAL`] that are given,
+/// NaN where not measured (as an empty cell or `nan` in the file). Row `i` is the row on line
+/// `i + 2` of the log written as CSV: the checks and the rows are [`read_gnss`]'s, so they
+/// equal those of the log written as text with each number in its shortest round-trip form.
+///
+/// # Errors
+/// As [`read_gnss`]: [`LogProblem::NotFinite`] for a NaN or infinity in a required column or an
+/// infinity in an optional one, the ranges, time stamps that do not increase, no fix; and
+/// [`LogProblem::Unreadable`] when a column's length differs from `t_s`'s.
+pub fn held_gnss(
+    name: &str,
+    required: [&[f64]; 4],
+    optional: [Option<&[f64]>; 9],
+) -> Result<Vec<GnssRow>, LogError> {
+    let n = required[0].len();
+    let lengths = required.iter().zip(GNSS_COLUMNS).chain(
+        optional
+            .iter()
+            .zip(GNSS_OPTIONAL)
+            .filter_map(|(c, k)| Some((c.as_ref()?, k))),
+    );
+    for (c, column) in lengths {
+        if c.len() != n {
+            let message = format!(
+                "{column} has {} values and t_s has {n}: expected one value per time stamp",
+                c.len()
+            );
+            return Err(LogError::of_file(name, LogProblem::Unreadable { message }));
+        }
+    }
+    let not_finite = |column: &'static str, x: f64| LogProblem::NotFinite {
+        column,
+        text: x.to_string(),
+    };
+    let mut rows: Vec<GnssRow> = Vec::with_capacity(n);
+    for i in 0..n {
+        let line = i as u64 + 2;
+        let at = |problem| LogError::at(name, line, problem);
+        let r = required.map(|c| c[i]);
+        if let Some(k) = r.iter().position(|x| !x.is_finite()) {
+            return Err(at(not_finite(GNSS_COLUMNS[k], r[k])));
+        }
+        check_required(&r).map_err(at)?;
+        let mut o = [None; 9];
+        for (k, c) in optional.iter().enumerate() {
+            let Some(x) = c.map(|c| c[i]) else { continue };
+            if x.is_infinite() {
+                return Err(at(not_finite(GNSS_OPTIONAL[k], x)));
+            }
+            o[k] = (!x.is_nan()).then_some(x);
+            check_optional(k, o[k]).map_err(at)?;
+        }
+        let row = row_of(line, r, o);
+        if let Some(p) = rows.last()
+            && row.t_s <= p.t_s
+        {
+            let problem = LogProblem::NotIncreasing {
+                t_s: row.t_s,
+                previous_s: p.t_s,
+            };
+            return Err(at(problem));
+        }
+        rows.push(row);
+    }
+    if rows.is_empty() {
+        let problem = LogProblem::TooFewRows {
+            found: 0,
+            needed: 1,
+        };
+        return Err(LogError::of_file(name, problem));
+    }
+    Ok(rows)
 }

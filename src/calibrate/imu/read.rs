@@ -74,6 +74,12 @@ pub struct ImuStep {
 /// The IMU log as a stream of steps.
 pub struct ImuReader<'a> {
     csv: CsvReader<'a, 7>,
+    rows: Rows,
+}
+
+/// The rows of an IMU log turned into steps, and what the steps' check needs: the one
+/// arithmetic of the reader and of columns held in memory ([`held_steps`]).
+struct Rows {
     layout: ImuLayout,
     axes: Axes,
     /// The line and time of the previous row.
@@ -115,20 +121,13 @@ impl<'a> ImuReader<'a> {
         };
         Ok(Self {
             csv,
-            layout,
-            axes,
-            previous: None,
-            first_s: None,
-            rows: 0,
-            steps: StepMedian::new(),
-            shortest: None,
-            longest: None,
+            rows: Rows::new(layout, axes),
         })
     }
 
     /// What the rows hold.
     pub fn layout(&self) -> ImuLayout {
-        self.layout
+        self.rows.layout
     }
 
     /// The name of the file in messages.
@@ -138,7 +137,7 @@ impl<'a> ImuReader<'a> {
 
     /// The first time stamp, once a row is read.
     pub fn first_s(&self) -> Option<f64> {
-        self.first_s
+        self.rows.first_s
     }
 
     /// The next step; `None` at the end of the log.
@@ -150,49 +149,11 @@ impl<'a> ImuReader<'a> {
             let Some((line, v)) = self.csv.next_row()? else {
                 return Ok(None);
             };
-            let t_s = v[0];
-            self.rows += 1;
-            let Some((_, previous_s)) = self.previous.replace((line, t_s)) else {
-                self.first_s = Some(t_s);
-                continue;
-            };
-            if t_s <= previous_s {
-                let problem = LogProblem::NotIncreasing { t_s, previous_s };
-                return Err(self.csv.error(problem));
+            match self.rows.step(line, &v) {
+                Ok(Some(step)) => return Ok(Some(step)),
+                Ok(None) => continue,
+                Err(problem) => return Err(self.csv.error(problem)),
             }
-            let dt_s = t_s - previous_s;
-            let at = StepAt {
-                sample: self.rows - 1,
-                line,
-                previous_s,
-                t_s,
-            };
-            self.steps.add_at(dt_s, at);
-            if self.shortest.is_none_or(|s| dt_s < s.step_s()) {
-                self.shortest = Some(at);
-            }
-            if self.longest.is_none_or(|s| dt_s > s.step_s()) {
-                self.longest = Some(at);
-            }
-            let sign = match self.axes {
-                Axes::Frd => Vector3::new(1.0, 1.0, 1.0),
-                Axes::Flu => Vector3::new(1.0, -1.0, -1.0),
-            };
-            let scale = match self.layout {
-                ImuLayout::Rates => dt_s,
-                ImuLayout::Increments => 1.0,
-            };
-            let f = Vector3::new(v[1], v[2], v[3]).component_mul(&sign) * scale;
-            let w = Vector3::new(v[4], v[5], v[6]).component_mul(&sign) * scale;
-            return Ok(Some(ImuStep {
-                line,
-                t_s,
-                increment: Increment {
-                    dtheta_rad: w,
-                    dvel_m_s: f,
-                    dt_s,
-                },
-            }));
         }
     }
 
@@ -203,7 +164,73 @@ impl<'a> ImuReader<'a> {
     /// [`LogProblem::TooFewRows`] for fewer than two rows; [`LogProblem::Gap`] naming the line
     /// of the first step outside the band.
     pub fn finish(self) -> Result<ImuSpan, LogError> {
-        let file = self.csv.file().to_string();
+        self.rows.finish(self.csv.file())
+    }
+}
+
+impl Rows {
+    fn new(layout: ImuLayout, axes: Axes) -> Self {
+        Self {
+            layout,
+            axes,
+            previous: None,
+            first_s: None,
+            rows: 0,
+            steps: StepMedian::new(),
+            shortest: None,
+            longest: None,
+        }
+    }
+
+    /// The step that row `v` (`t_s` and the six values, on `line`) ends; `None` for the first
+    /// row, which only starts the first step.
+    fn step(&mut self, line: u64, v: &[f64; 7]) -> Result<Option<ImuStep>, LogProblem> {
+        let t_s = v[0];
+        self.rows += 1;
+        let Some((_, previous_s)) = self.previous.replace((line, t_s)) else {
+            self.first_s = Some(t_s);
+            return Ok(None);
+        };
+        if t_s <= previous_s {
+            return Err(LogProblem::NotIncreasing { t_s, previous_s });
+        }
+        let dt_s = t_s - previous_s;
+        let at = StepAt {
+            sample: self.rows - 1,
+            line,
+            previous_s,
+            t_s,
+        };
+        self.steps.add_at(dt_s, at);
+        if self.shortest.is_none_or(|s| dt_s < s.step_s()) {
+            self.shortest = Some(at);
+        }
+        if self.longest.is_none_or(|s| dt_s > s.step_s()) {
+            self.longest = Some(at);
+        }
+        let sign = match self.axes {
+            Axes::Frd => Vector3::new(1.0, 1.0, 1.0),
+            Axes::Flu => Vector3::new(1.0, -1.0, -1.0),
+        };
+        let scale = match self.layout {
+            ImuLayout::Rates => dt_s,
+            ImuLayout::Increments => 1.0,
+        };
+        let f = Vector3::new(v[1], v[2], v[3]).component_mul(&sign) * scale;
+        let w = Vector3::new(v[4], v[5], v[6]).component_mul(&sign) * scale;
+        Ok(Some(ImuStep {
+            line,
+            t_s,
+            increment: Increment {
+                dtheta_rad: w,
+                dvel_m_s: f,
+                dt_s,
+            },
+        }))
+    }
+
+    /// [`ImuReader::finish`] of the log named `file`.
+    fn finish(self, file: &str) -> Result<ImuSpan, LogError> {
         let (Some(first_s), Some((_, last_s)), Some(median_step_s)) =
             (self.first_s, self.previous, self.steps.median())
         else {
@@ -211,7 +238,7 @@ impl<'a> ImuReader<'a> {
                 found: self.rows,
                 needed: 2,
             };
-            return Err(LogError::of_file(&file, problem));
+            return Err(LogError::of_file(file, problem));
         };
         let (lo, hi) = (
             ACCEPTED_STEP_RATIO.0 * median_step_s,
@@ -235,7 +262,7 @@ impl<'a> ImuReader<'a> {
                 ratio: step_s / median_step_s,
                 median_s: median_step_s,
             };
-            return Err(LogError::at(&file, at.line, problem));
+            return Err(LogError::at(file, at.line, problem));
         }
         Ok(ImuSpan {
             first_s,
@@ -313,4 +340,59 @@ pub fn read_steps(
         steps.push(step);
     }
     Ok((steps, reader.finish()?, layout))
+}
+
+/// The columns of an IMU log held in memory (the Python package's arrays): `t_s` (s) and the
+/// six columns of `layout`, in the order of [`RATE_COLUMNS`] or [`INCREMENT_COLUMNS`], in body
+/// axes `axes`. Row `i` is the row on line `i + 2` of the log written as CSV (after its header):
+/// the steps, the span and the checks are the reader's, so every number equals that of the log
+/// written as text with each number in its shortest round-trip form.
+///
+/// # Errors
+/// [`LogProblem::Unreadable`] when a column's length differs from `t_s`'s;
+/// [`LogProblem::NotFinite`] naming the column and line of a NaN or an infinity; the reader's
+/// for time stamps that do not increase, fewer than two rows and a gap.
+pub fn held_steps(
+    name: &str,
+    t_s: &[f64],
+    columns: [&[f64]; 6],
+    layout: ImuLayout,
+    axes: Axes,
+) -> Result<(Vec<ImuStep>, ImuSpan, ImuLayout), LogError> {
+    let names = match layout {
+        ImuLayout::Rates => RATE_COLUMNS,
+        ImuLayout::Increments => INCREMENT_COLUMNS,
+    };
+    if let Some(k) = columns.iter().position(|c| c.len() != t_s.len()) {
+        let message = format!(
+            "{} has {} values and t_s has {}: expected one value per time stamp",
+            names[k + 1],
+            columns[k].len(),
+            t_s.len()
+        );
+        return Err(LogError::of_file(name, LogProblem::Unreadable { message }));
+    }
+    let mut rows = Rows::new(layout, axes);
+    let mut steps = Vec::with_capacity(t_s.len().saturating_sub(1));
+    for (i, &t) in t_s.iter().enumerate() {
+        let line = i as u64 + 2;
+        let mut v = [t, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        for (x, c) in v[1..].iter_mut().zip(columns) {
+            *x = c[i];
+        }
+        if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+            let problem = LogProblem::NotFinite {
+                column: names[k],
+                text: v[k].to_string(),
+            };
+            return Err(LogError::at(name, line, problem));
+        }
+        if let Some(step) = rows
+            .step(line, &v)
+            .map_err(|p| LogError::at(name, line, p))?
+        {
+            steps.push(step);
+        }
+    }
+    Ok((steps, rows.finish(name)?, layout))
 }
