@@ -37,6 +37,7 @@ pub mod noise_stream;
 pub mod reading;
 pub mod section;
 pub mod simulate;
+pub mod spill;
 pub mod stream;
 
 use rayon::prelude::*;

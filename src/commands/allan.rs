@@ -187,9 +187,19 @@ fn analyse_imu_log(args: &AllanArgs, path: &std::path::Path) -> Result<ImuAnalys
         None
     };
     let a = match streamed {
-        Some(records) => match imu::stream::analyse_records(records.as_ref(), args.confidence) {
+        Some(records) => match imu::stream::analyse_records(
+            records.as_ref(),
+            args.confidence,
+            &spill_directory(&args.out),
+        ) {
             Ok(a) => a,
             Err(StreamError::Log(e)) => return Err(e.into()),
+            Err(StreamError::Spill(e)) => {
+                return Err(anyhow::Error::new(e).context(format!(
+                    "the temporary file of the phase in {}",
+                    spill_directory(&args.out).display()
+                )));
+            }
             Err(StreamError::Channel(e)) => {
                 return Err(anyhow::Error::new(e).context(path.display().to_string()));
             }
@@ -205,6 +215,22 @@ fn analyse_imu_log(args: &AllanArgs, path: &std::path::Path) -> Result<ImuAnalys
         }
     };
     Ok(a)
+}
+
+/// Where a long log's phase is kept while it is analysed: beside the output directory (on the
+/// disk the results go to, where a temporary directory may be memory), else the system's
+/// temporary directory.
+fn spill_directory(out: &std::path::Path) -> std::path::PathBuf {
+    let parent = match out.parent() {
+        Some(p) if p.as_os_str().is_empty() => std::path::Path::new("."),
+        Some(p) => p,
+        None => out,
+    };
+    if parent.is_dir() {
+        parent.to_path_buf()
+    } else {
+        std::env::temp_dir()
+    }
 }
 
 /// The printed lines of `allan --imu`: the extent, one line per channel, each sensor's keys.
