@@ -22,7 +22,7 @@ use std::path::Path;
 use super::deviation::{self, BLOCK, STRETCH};
 
 /// Phase points gathered before they are written.
-const PENDING: usize = 1 << 16;
+const PENDING: usize = 1 << 13;
 
 /// The phase of one channel, written point by point to a temporary file.
 #[derive(Debug)]
