@@ -3,14 +3,17 @@
 //! through a memory map, leaving the connections' fields and the messages to decode as here,
 //! and brings bzip2's C library; a flat scan of the records is about as much code as using it.
 //! The file is read from disk record by record, a chunk at a time ([`visit_ros1`]): memory is
-//! one chunk's, whatever the bag's length; [`Ros1Records`] reads it so for [`super::stream`].
+//! one chunk's, whatever the bag's length; `rosbag1_stream::Ros1Records` reads it so for
+//! [`super::stream`]. A chunk is plain or compressed as rosbag compresses: lz4 (the LZ4 frame
+//! format, the `lz4` crate) or bz2 (the `bzip2` crate on its pure-Rust `libbz2-rs-sys`).
 //!
 //! # Formula
 //! ROS bag format 2.0 (wiki.ros.org/Bags/Format/2.0): after `#ROSBAG V2.0\n`, records of a
 //! little-endian u32 header length, the header's fields (each a u32 length then `name=value`),
 //! a u32 data length and the data. `op` = 0x05 a chunk (its data the records 0x07 connection —
 //! `conn`, `topic`, the type in its data's fields — and 0x02 message — `conn`, its data the
-//! message), 0x03 the bag header, 0x04 and 0x06 indices. A `sensor_msgs/Imu` message is ROS 1
+//! message; the header's `compression` none, lz4 or bz2 and `size` the records' length), 0x03
+//! the bag header (`index_pos`), 0x04 and 0x06 indices. A `sensor_msgs/Imu` message is ROS 1
 //! serialized (little-endian, unaligned): header {u32 seq, u32 sec, u32 nsec, string frame_id as
 //! u32 length + bytes}, then 37 float64 (orientation, its covariance, angular velocity, its
 //! covariance, linear acceleration, its covariance).
@@ -178,25 +181,36 @@ impl Reading {
     ) -> Result<(), LogError> {
         let place = format!("the chunk at byte {at}");
         let compression = header.get(&b"compression"[..]).copied().unwrap_or(b"none");
+        // The chunk header's `size` is the records' length once decompressed: no more is
+        // decompressed than it says (a corrupt chunk cannot fill the memory).
+        let size = header.get(&b"size"[..]).and_then(|c| u32_at(c, 0));
+        let limit = u64::from(size.unwrap_or(u32::MAX));
+        let inflate = |name: &str, reader: std::io::Result<Box<dyn std::io::Read + '_>>| {
+            let mut out = Vec::new();
+            reader
+                .and_then(|r| {
+                    std::io::Read::read_to_end(&mut std::io::Read::take(r, limit), &mut out)
+                })
+                .map_err(|e| {
+                    unreadable(
+                        file,
+                        format!("{place}: {name} data that does not decompress: {e}"),
+                    )
+                })?;
+            Ok::<_, LogError>(std::borrow::Cow::Owned(out))
+        };
         let plain = match compression {
             b"none" => std::borrow::Cow::Borrowed(data),
-            b"lz4" => {
-                let mut out = Vec::new();
-                lz4::Decoder::new(data)
-                    .and_then(|mut d| std::io::Read::read_to_end(&mut d, &mut out))
-                    .map_err(|e| {
-                        unreadable(
-                            file,
-                            format!("{place}: lz4 data that does not decompress: {e}"),
-                        )
-                    })?;
-                std::borrow::Cow::Owned(out)
-            }
+            b"lz4" => inflate(
+                "lz4",
+                lz4::Decoder::new(data).map(|d| Box::new(d) as Box<dyn std::io::Read>),
+            )?,
+            b"bz2" => inflate("bz2", Ok(Box::new(bzip2::read::BzDecoder::new(data))))?,
             other => {
                 return Err(unreadable(
                     file,
                     format!(
-                        "{place} is compressed with {}: expected none or lz4 (rosbag compress --lz4, or rosbag decompress)",
+                        "{place} is compressed with {}: expected none, lz4 or bz2 (rosbag's compressions)",
                         String::from_utf8_lossy(other)
                     ),
                 ));
@@ -211,7 +225,8 @@ impl Reading {
 ///
 /// # Errors
 /// [`LogError`] naming the file and the byte offset of a record that is cut short or malformed
-/// (a length past the file's end included), a chunk compressed otherwise than plain or lz4, a
+/// (a length past the file's end included), a chunk compressed otherwise than plain, lz4 or bz2
+/// or whose data does not decompress, a
 /// message on no connection, or `visit`'s error.
 pub(super) fn visit_ros1(path: &Path, visit: &mut Visit<'_>) -> Result<(), LogError> {
     use std::io::Read as _;
