@@ -28,6 +28,7 @@ pub mod deviation;
 pub mod edf;
 pub mod export;
 pub mod fit;
+pub mod gauss_markov;
 pub mod goodness;
 pub mod imu;
 pub mod log;
