@@ -9,10 +9,14 @@ at RATE Hz, serialized as CDR (the layout rosbags writes, built here with numpy:
 white noise plus a random walk (accelerometer N = 2e-3 m/s/sqrt(s), K = 1e-3 m/s^2/sqrt(s) on
 gravity; gyro N = 1e-4 rad/sqrt(s), K = 5e-5 rad/s/sqrt(s)).
 
-Then, REPEATS times each: the binary on the file under /usr/bin/time -v (wall, peak RSS), and
-allantools.oadev (octave tau, in memory, the samples generated again) on the six channels one after
-the other. Prints the medians, and the largest relative difference of the binary's deviation from
-allantools' at the tau computed exactly (m <= 2^18) and at the strided ones.
+Then, REPEATS times each: the binary on the file under /usr/bin/time -v (wall, peak RSS, and the
+temporary disk it used: the least free space of --out's file system during the run, polled every
+20 ms, against the free space before), and allantools.oadev (octave tau, in memory, the samples
+generated again) on the six channels one after the other. Prints the medians, and the largest
+relative difference of the binary's deviation from allantools' within the window (m <= 2^18) and
+beyond it (the tau summed from the phase on disk). With --reference, also from a long-double
+reference (numpy.longdouble, 64-bit significand: the mean, the phase and each tau's sum of squared
+second differences), at every tau, for both.
 """
 
 import argparse
@@ -22,6 +26,7 @@ import re
 import statistics
 import subprocess
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -81,17 +86,50 @@ def write_mcap(path, n, rate):
         w.finish()
 
 
+def free_bytes(path):
+    st = os.statvfs(path)
+    return st.f_bavail * st.f_frsize
+
+
 def run_binary(binary, path):
     out = Path(tempfile.mkdtemp(prefix="allan-imu-long-"))
     cmd = ["/usr/bin/time", "-v", binary, "allan", "--imu", str(path), "--out", str(out),
            "--quiet"]
+    before = free_bytes(out)
+    least = [before]
+    done = threading.Event()
+
+    def poll():
+        while not done.wait(0.02):
+            least[0] = min(least[0], free_bytes(out))
+
+    watcher = threading.Thread(target=poll)
+    watcher.start()
     start = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True, check=True)
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, check=True)
+    finally:
+        done.set()
+        watcher.join()
     wall = time.perf_counter() - start
+    disk_mb = (before - least[0]) / 1e6
     rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr).group(1))
     cpu = sum(float(re.search(rf"{k} time \(seconds\): ([\d.]+)", p.stderr).group(1))
               for k in ("User", "System"))
-    return wall, rss_kb / 1024, cpu, json.loads((out / "allan.json").read_text())
+    return wall, rss_kb / 1024, cpu, json.loads((out / "allan.json").read_text()), disk_mb
+
+
+def long_double_adev(y, ms):
+    """The overlapping Allan deviation at each m, every step in numpy.longdouble."""
+    y = y.astype(np.longdouble)
+    x = np.concatenate([np.zeros(1, np.longdouble), np.cumsum(y - y.mean())])
+    out = []
+    for m in ms:
+        m = int(m)
+        d = x[2 * m:] - 2 * x[m:-m] + x[:-2 * m]
+        mm = np.longdouble(m)
+        out.append(np.sqrt(np.sum(d * d) / (2 * len(d) * mm * mm)))
+    return np.array(out)
 
 
 def main():
@@ -101,6 +139,8 @@ def main():
     ap.add_argument("--dir", default="/tmp/accelcal-long")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--bin", default="target/release/accelcal")
+    ap.add_argument("--reference", action="store_true",
+                    help="compare both with a long-double computation too")
     a = ap.parse_args()
     n = int(round(a.hours * 3600 * a.rate))
     d = Path(a.dir)
@@ -120,10 +160,11 @@ def main():
     print(f"accelcal allan --imu: wall median {statistics.median(walls):.2f} s "
           f"(min {min(walls):.2f}, max {max(walls):.2f}), CPU median "
           f"{statistics.median(cpus):.2f} s, peak RSS median {statistics.median(rss):.0f} MB "
-          f"(max {max(rss):.0f})")
+          f"(max {max(rss):.0f}), temporary disk at most {max(r[4] for r in runs):.0f} MB "
+          f"(the phase: {6 * 8 * (n + 1) / 1e6:.0f} MB)")
 
     y = np.concatenate([c for _, c in channels(n, a.rate, PIECE)])
-    times, cpu, worst_exact, worst_strided = [], [], 0.0, 0.0
+    times, cpu = [], []
     for rep in range(a.repeats):
         start, c0 = time.perf_counter(), time.process_time()
         devs = []
@@ -133,20 +174,30 @@ def main():
             devs.append(dev)
         times.append(time.perf_counter() - start)
         cpu.append(time.process_time() - c0)
-    columns = ["ax_m_s2", "ay_m_s2", "az_m_s2", "gx_rad_s", "gy_rad_s", "gz_rad_s"]
-    for k, column in enumerate(columns):
-        ch = runs[0][3]["channels"][column]
-        ours = np.array(ch["adev_m_s2" if k < 3 else "adev_rad_s"])
-        m = np.rint(np.array(ch["tau_s"]) * a.rate)
-        rel = np.abs(ours / devs[k][: len(ours)] - 1.0)
-        worst_exact = max(worst_exact, rel[m <= EXACT_MAX_M].max())
-        if (m > EXACT_MAX_M).any():
-            worst_strided = max(worst_strided, rel[m > EXACT_MAX_M].max())
     print(f"allantools.oadev, six channels in memory: wall median {statistics.median(times):.2f} s "
           f"(min {min(times):.2f}, max {max(times):.2f}), CPU median {statistics.median(cpu):.2f} s")
     print("load average after: %.1f %.1f %.1f" % os.getloadavg())
-    print(f"largest |accelcal/allantools - 1|: {worst_exact:.1e} at m <= 2^18 (exact), "
-          f"{worst_strided:.1e} beyond (strided)")
+    columns = ["ax_m_s2", "ay_m_s2", "az_m_s2", "gx_rad_s", "gy_rad_s", "gz_rad_s"]
+    worst = {"allantools": [0.0, 0.0], "long double": [0.0, 0.0],
+             "allantools vs long double": [0.0, 0.0]}
+    for k, column in enumerate(columns):
+        ch = runs[0][3]["channels"][column]
+        ours = np.array(ch["adev_m_s2" if k < 3 else "adev_rad_s"])
+        m = np.rint(np.array(ch["tau_s"]) * a.rate).astype(np.int64)
+        pairs = [("allantools", ours, devs[k][: len(ours)])]
+        if a.reference:
+            ref = long_double_adev(y[:, k], m).astype(np.float64)
+            pairs += [("long double", ours, ref),
+                      ("allantools vs long double", devs[k][: len(ours)], ref)]
+        for name, got, want in pairs:
+            rel = np.abs(got / want - 1.0)
+            worst[name][0] = max(worst[name][0], rel[m <= EXACT_MAX_M].max())
+            if (m > EXACT_MAX_M).any():
+                worst[name][1] = max(worst[name][1], rel[m > EXACT_MAX_M].max())
+    for name, (inside, beyond) in worst.items():
+        if name == "allantools" or a.reference:
+            print(f"largest relative difference, {name}: {inside:.1e} at m <= 2^18 (window), "
+                  f"{beyond:.1e} beyond (phase on disk)")
 
 
 if __name__ == "__main__":

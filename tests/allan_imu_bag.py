@@ -171,7 +171,7 @@ def main():
     write_csv(out / "imu.csv", stamps, acc, gyr)
     write_bag1(out / "imu.bag", stamps, acc, gyr)
     write_bag1(out / "imu_lz4.bag", stamps, acc, gyr, Bag1Writer.CompressionFormat.LZ4)
-    write_bag1(out / "imu_bz2.bag", stamps[:50], acc, gyr, Bag1Writer.CompressionFormat.BZ2)
+    write_bag1(out / "imu_bz2.bag", stamps, acc, gyr, Bag1Writer.CompressionFormat.BZ2)
     bad = gyr.copy()
     bad[7, 1] = float("nan")
     write_mcap(out / "nan.mcap", stamps[:50], acc, bad, topics=("/imu",))

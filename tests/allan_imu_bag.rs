@@ -1,7 +1,7 @@
 //! `accelcal allan --imu` on ROS recordings made by the ROS tools' own Python packages
 //! (`tests/allan_imu_bag.py`: rosbags writes the bags and the messages, mcap the MCAP file): a
 //! ROS 2 bag directory with MCAP storage, an MCAP file (lz4 chunks, two Imu topics with another
-//! frame id, hence another CDR alignment), ROS 1 bags (plain and lz4 chunks) and the CSV export
+//! frame id, hence another CDR alignment), ROS 1 bags (plain, lz4 and bz2 chunks) and the CSV export
 //! of the same messages give the same allan.json byte for byte; bad containers and messages exit with 2 naming the file, the topic
 //! and the message.
 //!
@@ -139,8 +139,9 @@ fn a_bag_its_mcap_and_its_csv_give_the_same_allan_json() {
     mutations_never_panic(d);
 }
 
-/// Bytes of the MCAP file and the ROS 1 bag changed at random (a byte flipped, a stretch cut
-/// out, the end cut off; 24 each from a fixed seed): every run ends with 0 or 2, never a panic.
+/// Bytes of the MCAP file and the ROS 1 bags changed at random (a byte flipped, a stretch cut
+/// out, the end cut off; 24 each from a fixed seed, 6 of the bz2 bag): every run ends with 0 or
+/// 2, never a panic.
 fn mutations_never_panic(d: &Path) {
     let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
     let mut next = |n: usize| {
@@ -149,9 +150,10 @@ fn mutations_never_panic(d: &Path) {
         state ^= state << 17;
         (state % n as u64) as usize
     };
-    for name in ["imu.mcap", "imu.bag"] {
+    // bz2 decompresses at ~20 MB/s: 6 mutations of that bag keep the test's time short.
+    for (name, count) in [("imu.mcap", 24), ("imu.bag", 24), ("imu_bz2.bag", 6)] {
         let bytes = std::fs::read(d.join(name)).unwrap();
-        for k in 0..24 {
+        for k in 0..count {
             let mut b = bytes.clone();
             let at = next(b.len());
             match k % 3 {
@@ -184,21 +186,44 @@ fn mutations_never_panic(d: &Path) {
     }
 }
 
-/// ROS 1 bags of the same messages (plain and lz4 chunks) give the CSV's allan.json; bz2 chunks
+/// ROS 1 bags of the same messages (plain, lz4 and bz2 chunks, rosbags' three) give the CSV's
+/// allan.json byte for byte; a chunk of another compression, a bz2 chunk whose data is damaged
 /// and a truncated bag are refused with the byte offset of the record.
 fn ros1_bags(d: &Path, csv: &[u8]) {
-    for bag in ["imu.bag", "imu_lz4.bag"] {
+    for bag in ["imu.bag", "imu_lz4.bag", "imu_bz2.bag"] {
         let json = allan_json(&d.join(bag), None, &d.join(format!("o-{bag}")));
         assert!(json == csv, "{bag} and the CSV export differ");
     }
+    let bz2 = std::fs::read(d.join("imu_bz2.bag")).unwrap();
+    let named = bz2
+        .windows(15)
+        .position(|w| w == b"compression=bz2")
+        .unwrap();
+    let mut other = bz2.clone();
+    other[named + 12..named + 15].copy_from_slice(b"xz9");
+    std::fs::write(d.join("xz9.bag"), &other).unwrap();
     refused(
-        &d.join("imu_bz2.bag"),
+        &d.join("xz9.bag"),
         None,
         &[
-            "imu_bz2.bag",
+            "xz9.bag",
             "the chunk at byte",
-            "bz2",
-            "expected none or lz4",
+            "compressed with xz9",
+            "expected none, lz4 or bz2",
+        ],
+    );
+    // The first chunk's bzip2 stream ("BZh9", then its blocks): a byte of its blocks changed.
+    let stream = bz2.windows(4).position(|w| w == b"BZh9").unwrap();
+    let mut damaged = bz2.clone();
+    damaged[stream + 40] ^= 0x55;
+    std::fs::write(d.join("damaged.bag"), &damaged).unwrap();
+    refused(
+        &d.join("damaged.bag"),
+        None,
+        &[
+            "damaged.bag",
+            "the chunk at byte",
+            "bz2 data that does not decompress",
         ],
     );
     let bytes = std::fs::read(d.join("imu.bag")).unwrap();

@@ -416,8 +416,9 @@ struct Base {
     gnss: Vec<u8>,
     partials: [Vec<u8>; 2],
     one: serde_json::Value,
-    /// A static IMU as MCAP files of ROS 2 `Imu` messages: chunked (with CRCs) and not.
-    bags: [Vec<u8>; 2],
+    /// A static IMU as MCAP files of ROS 2 `Imu` messages, chunked (with CRCs) and not, and as
+    /// ROS 1 bags with plain, lz4 and bz2 chunks.
+    bags: [Vec<u8>; 5],
 }
 
 fn base(dir: &Path) -> Base {
@@ -462,16 +463,26 @@ fn base(dir: &Path) -> Base {
         gnss: first_seconds("gnss.csv"),
         partials: [read("p1.bin"), read("p2.bin")],
         one: common::summary_without_timing(&dir.join("one.json")),
-        bags: [true, false].map(|chunked| {
-            let path = dir.join(format!("bag-{chunked}.mcap"));
-            imu_mcap(&path, BAG_MESSAGES, chunked);
+        bags: [
+            "bag-true.mcap",
+            "bag-false.mcap",
+            "none.bag",
+            "lz4.bag",
+            "bz2.bag",
+        ]
+        .map(|name| {
+            let path = dir.join(name);
+            match name.strip_suffix(".bag") {
+                Some(compression) => imu_ros1(&path, BAG_MESSAGES, compression),
+                None => imu_mcap(&path, BAG_MESSAGES, name == "bag-true.mcap"),
+            }
             let out = common::run_in(
                 dir,
                 &["allan", "-q", "--imu", path.to_str().unwrap()],
                 Some(1),
             );
-            assert!(out.status.success(), "the unmutated bag: {out:?}");
-            read(path.file_name().unwrap().to_str().unwrap())
+            assert!(out.status.success(), "the unmutated bag {name}: {out:?}");
+            read(name)
         }),
     }
 }
@@ -534,10 +545,120 @@ fn imu_mcap(path: &Path, messages: usize, chunked: bool) {
     w.finish().unwrap();
 }
 
-/// One bag case: a bag with bytes flipped, overwritten, deleted, duplicated or cut, through
-/// `allan --imu`.
+/// Appends a ROS 1 bag record: its header's fields `name=value`, then its data.
+fn record(out: &mut Vec<u8>, fields: &[(&str, &[u8])], data: &[u8]) {
+    let mut header = Vec::new();
+    for (name, value) in fields {
+        header.extend((name.len() as u32 + 1 + value.len() as u32).to_le_bytes());
+        header.extend(name.as_bytes());
+        header.push(b'=');
+        header.extend(*value);
+    }
+    out.extend((header.len() as u32).to_le_bytes());
+    out.extend(header);
+    out.extend((data.len() as u32).to_le_bytes());
+    out.extend(data);
+}
+
+/// A ROS 1 serialized `sensor_msgs/Imu`: header (seq, stamp, frame id), then the 37 doubles
+/// with white noise about gravity in the angular velocity (13–15) and acceleration (25–27).
+fn ros1_imu(rng: &mut Rng, seq: u32, sec: u32, nsec: u32) -> Vec<u8> {
+    let mut noise = || {
+        (0..12)
+            .map(|_| rng.below(1 << 20) as f64 / f64::from(1 << 20))
+            .sum::<f64>()
+            - 6.0
+    };
+    let mut m = Vec::new();
+    for w in [seq, sec, nsec, 8] {
+        m.extend(w.to_le_bytes());
+    }
+    m.extend(b"imu_link");
+    let mut values = [0.0; 37];
+    values[3] = 1.0;
+    for at in [13, 14, 15] {
+        values[at] = 1e-3 * noise();
+    }
+    for at in [25, 26, 27] {
+        values[at] = 0.01 * noise() + if at == 27 { 9.81 } else { 0.0 };
+    }
+    values.iter().for_each(|v| m.extend(v.to_le_bytes()));
+    m
+}
+
+/// Writes a static IMU of `messages` at 100 Hz as a ROS 1 bag (format 2.0,
+/// wiki.ros.org/Bags/Format/2.0) to `path`: the bag header without an index, then chunks of
+/// 500 `sensor_msgs/Imu` messages (ROS 1 serialization) compressed with `compression` — none,
+/// lz4 (LZ4 frames, as roslz4 writes) or bz2 —, each with the connection record first.
+fn imu_ros1(path: &Path, messages: usize, compression: &str) {
+    use std::io::Write as _;
+    let mut bag = b"#ROSBAG V2.0\n".to_vec();
+    let header = [
+        ("op", &[3u8][..]),
+        ("index_pos", &[0; 8]),
+        ("conn_count", &[1, 0, 0, 0]),
+        ("chunk_count", &[0; 4]),
+    ];
+    record(&mut bag, &header, &[b' '; 64]);
+    let mut rng = Rng::new(37);
+    let conn = 0u32.to_le_bytes();
+    let mut kind = Vec::new();
+    for f in [
+        "type=sensor_msgs/Imu",
+        "md5sum=6a62c6daae103f4ff57a132d6f95cec2",
+    ] {
+        kind.extend((f.len() as u32).to_le_bytes());
+        kind.extend(f.as_bytes());
+    }
+    for first in (0..messages).step_by(500) {
+        let mut chunk = Vec::new();
+        record(
+            &mut chunk,
+            &[("op", &[7]), ("conn", &conn), ("topic", b"/imu")],
+            &kind,
+        );
+        for k in first..(first + 500).min(messages) {
+            let (sec, nsec) = (
+                1_700_000_000 + (k / 100) as u32,
+                (k % 100) as u32 * 10_000_000,
+            );
+            let m = ros1_imu(&mut rng, k as u32, sec, nsec);
+            let time = (u64::from(sec) | u64::from(nsec) << 32).to_le_bytes();
+            record(
+                &mut chunk,
+                &[("op", &[2]), ("conn", &conn), ("time", &time)],
+                &m,
+            );
+        }
+        let size = (chunk.len() as u32).to_le_bytes();
+        let data = match compression {
+            "lz4" => {
+                let mut e = lz4::EncoderBuilder::new().build(Vec::new()).unwrap();
+                e.write_all(&chunk).unwrap();
+                e.finish().0
+            }
+            "bz2" => {
+                let mut e = bzip2::write::BzEncoder::new(Vec::new(), bzip2::Compression::default());
+                e.write_all(&chunk).unwrap();
+                e.finish().unwrap()
+            }
+            _ => chunk,
+        };
+        let fields = [
+            ("op", &[5u8][..]),
+            ("compression", compression.as_bytes()),
+            ("size", &size),
+        ];
+        record(&mut bag, &fields, &data);
+    }
+    std::fs::write(path, bag).unwrap();
+}
+
+/// One bag case: an MCAP file or a ROS 1 bag with bytes flipped, overwritten, deleted,
+/// duplicated or cut, through `allan --imu`.
 fn case_bag(rng: &mut Rng, base: &Base, dir: &Path) -> (Vec<String>, Vec<&'static str>) {
-    let mut bag = base.bags[rng.below(2)].clone();
+    let which = rng.below(base.bags.len());
+    let mut bag = base.bags[which].clone();
     for _ in 0..1 + rng.below(3) {
         let at = rng.below(bag.len());
         match rng.below(6) {
@@ -562,8 +683,9 @@ fn case_bag(rng: &mut Rng, base: &Base, dir: &Path) -> (Vec<String>, Vec<&'stati
             }
         }
     }
-    std::fs::write(dir.join("imu.mcap"), bag).unwrap();
-    let args = ["allan", "-q", "--imu", "imu.mcap", "--out", "allan3"]
+    let name = if which < 2 { "imu.mcap" } else { "imu.bag" };
+    std::fs::write(dir.join(name), bag).unwrap();
+    let args = ["allan", "-q", "--imu", name, "--out", "allan3"]
         .map(String::from)
         .to_vec();
     (

@@ -122,12 +122,18 @@ pub const STRETCH: usize = 1 << 16;
 /// Σ over one block of k of the squared second differences at m, with eight running sums.
 #[inline(always)]
 fn block_sum(x: &[f64], m: usize, start: usize, end: usize) -> f64 {
-    let len = end - start;
-    let (a, b, c) = (
+    block_sum_of(
         &x[start..end],
         &x[start + m..end + m],
         &x[start + 2 * m..end + 2 * m],
-    );
+    )
+}
+
+/// Σ (c_i − 2b_i + a_i)² over one block of equal-length slices (the phase at k, k + m and
+/// k + 2m), with eight running sums: [`block_sum`]'s arithmetic for slices held apart.
+#[inline(always)]
+pub(crate) fn block_sum_of(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
+    let len = a.len();
     let mut lanes = [0.0f64; 8];
     let whole = len / 8 * 8;
     for ((a8, b8), c8) in a[..whole]

@@ -28,6 +28,7 @@ pub mod deviation;
 pub mod edf;
 pub mod export;
 pub mod fit;
+pub mod gauss_markov;
 pub mod goodness;
 pub mod imu;
 pub mod log;
@@ -37,6 +38,7 @@ pub mod noise_stream;
 pub mod reading;
 pub mod section;
 pub mod simulate;
+pub mod spill;
 pub mod stream;
 
 use rayon::prelude::*;

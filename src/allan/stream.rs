@@ -5,31 +5,24 @@
 //! # Formula
 //! Up to [`EXACT_MAX_M`] the estimator is [`deviation`]'s (NIST SP 1065, eq. 11), summed in the
 //! same stretches and blocks over a window of the phase 2·[`EXACT_MAX_M`] + [`STRETCH`] long: the
-//! same bits as [`deviation::overlapping_avars`] on the whole phase. Beyond, at τ = mτ₀ with
-//! m > [`EXACT_MAX_M`], the second differences are taken at the offsets k that are multiples of
-//! the stride s = m / [`OFFSETS_PER_TAU`] only: NIST SP 1065's eq. (11) with a step of s between
-//! its terms (s = 1 is eq. (11) itself, s = m the non-overlapping Allan variance of the same
-//! handbook):
-//!
-//! σ̂²(mτ₀) = Σ_{k ∈ sℤ, 0 ≤ k ≤ n − 2m} (x_{k+2m} − 2x_{k+m} + x_k)² / (2 T m²),  T the terms.
-//!
-//! Each such τ keeps 2·[`OFFSETS_PER_TAU`] + 1 phase values at its stride. Terms s apart share
-//! all but a fraction s/m = 1/[`OFFSETS_PER_TAU`] of their samples, so the strided estimate
-//! averages nearly the same information as the full one; its departure from the exact value is
-//! measured in `tests/allan_imu_stream.rs` and stated in docs/guide/allan.md.
+//! same bits as [`deviation::overlapping_avars`] on the whole phase. The longer τ of a log with
+//! more than 2·[`EXACT_MAX_M`] samples are summed at the end from the phase written to a
+//! temporary file as it grows ([`spill`](super::spill)), again in the same stretches and blocks:
+//! every τ has the whole-series form's bits.
 //!
 //! The phase is the one of [`deviation::phase`] given the log's mean ȳ (found by a first read):
 //! x_0 = 0, the running sum of y − ȳ in stretches of [`STRETCH`] samples.
 
+use std::io;
+use std::path::Path;
+
 use super::deviation::{self, BLOCK, STRETCH};
 use super::noise_id::NoiseId;
 use super::noise_stream::StreamingNoiseId;
+use super::spill::{self, PhaseSpill};
 
 /// The largest averaging factor computed exactly (every offset): τ up to 655 s at 400 Hz.
 pub const EXACT_MAX_M: usize = 1 << 18;
-
-/// Offsets per τ beyond [`EXACT_MAX_M`]: the stride is m / 4096.
-pub const OFFSETS_PER_TAU: usize = 1 << 12;
 
 /// The mean of a log read piece by piece, with the same bits as [`deviation::mean`] of the whole.
 #[derive(Clone, Debug)]
@@ -78,47 +71,9 @@ impl StreamingMean {
     }
 }
 
-/// One τ beyond [`EXACT_MAX_M`]: the phase at its stride over the last 2m, and its sum.
-#[derive(Clone, Debug)]
-struct StridedTau {
-    m: usize,
-    stride: usize,
-    /// x at indices q·stride, slot q mod (2·OFFSETS_PER_TAU + 1).
-    ring: Vec<f64>,
-    sum: f64,
-    terms: u64,
-}
-
-const RING: usize = 2 * OFFSETS_PER_TAU + 1;
-
-impl StridedTau {
-    /// The τ whose phase at its stride, indices 0, s, …, 2m, is `history`.
-    fn start(m: usize, history: &[f64]) -> Self {
-        debug_assert_eq!(history.len(), RING);
-        let mut t = Self {
-            m,
-            stride: m / OFFSETS_PER_TAU,
-            ring: history.to_vec(),
-            sum: 0.0,
-            terms: 0,
-        };
-        t.term(2 * OFFSETS_PER_TAU);
-        t
-    }
-
-    /// The term whose newest phase value sits at stride index q (already stored).
-    #[inline]
-    fn term(&mut self, q: usize) {
-        let at = |k: usize| self.ring[k % RING];
-        let d = at(q) - 2.0 * at(q - OFFSETS_PER_TAU) + at(q - 2 * OFFSETS_PER_TAU);
-        self.sum += d * d;
-        self.terms += 1;
-    }
-}
-
 /// The Allan variance and noise identification of every octave τ of one channel, fed its
 /// samples in order.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct AllanStream {
     mean: f64,
     /// Samples n so far; the phase has n + 1 points.
@@ -134,9 +89,8 @@ pub struct AllanStream {
     next_k: usize,
     /// Per exact factor 1, 2, …, EXACT_MAX_M: Σ over processed stretches, in stretch order.
     exact_sums: Vec<f64>,
-    /// τ beyond EXACT_MAX_M that have started, and the phase at the next one's stride.
-    strided: Vec<StridedTau>,
-    history: Vec<f64>,
+    /// The whole phase on disk, when the log has τ beyond EXACT_MAX_M.
+    spill: Option<PhaseSpill>,
     /// Per octave m = 2^j: the block means' identification and the phase at the last boundary.
     noise: Vec<(StreamingNoiseId, f64)>,
 }
@@ -147,9 +101,25 @@ fn exact_factors() -> impl Iterator<Item = usize> {
 }
 
 impl AllanStream {
-    /// An empty stream whose samples have the mean `mean_y` (the phase subtracts it).
-    pub fn new(mean_y: f64) -> Self {
-        Self {
+    /// An empty stream for a log of `samples` samples whose mean is `mean_y` (the phase
+    /// subtracts it). When that many samples have octave τ beyond [`EXACT_MAX_M`], the phase is
+    /// also written to a temporary file in `spill_dir` (8 bytes a sample, removed with the
+    /// stream).
+    ///
+    /// # Errors
+    /// The [`io::Error`] of creating the temporary file.
+    pub fn new(mean_y: f64, samples: usize, spill_dir: &Path) -> io::Result<Self> {
+        let long = deviation::octave_factors(samples)
+            .iter()
+            .any(|&m| m > EXACT_MAX_M);
+        let spill = if long {
+            let mut spill = PhaseSpill::create(spill_dir)?;
+            spill.push(0.0);
+            Some(spill)
+        } else {
+            None
+        };
+        Ok(Self {
             mean: mean_y,
             samples: 0,
             phase: 0.0,
@@ -161,16 +131,9 @@ impl AllanStream {
             exact_sums: exact_factors()
                 .map(|_| std::iter::empty::<f64>().sum())
                 .collect(),
-            strided: Vec::new(),
-            history: vec![0.0],
+            spill,
             noise: Vec::new(),
-        }
-    }
-
-    /// The next factor beyond the exact ones that has not started, and its stride.
-    fn next_strided(&self) -> (usize, usize) {
-        let m = EXACT_MAX_M << (self.strided.len() + 1);
-        (m, m / OFFSETS_PER_TAU)
+        })
     }
 
     /// Counts the next samples.
@@ -210,22 +173,8 @@ impl AllanStream {
             *last = x;
             j += 1;
         }
-        // Strides are powers of two: a mask, not a division, per sample.
-        for t in &mut self.strided {
-            if i & (t.stride - 1) == 0 {
-                let q = i / t.stride;
-                t.ring[q % RING] = x;
-                t.term(q);
-            }
-        }
-        let (next_m, next_stride) = self.next_strided();
-        if i & (next_stride - 1) == 0 {
-            self.history.push(x);
-            if i == 2 * next_m {
-                self.strided.push(StridedTau::start(next_m, &self.history));
-                // The next factor's stride is twice this one's: every other value so far.
-                self.history = self.history.iter().step_by(2).copied().collect();
-            }
+        if let Some(spill) = &mut self.spill {
+            spill.push(x);
         }
     }
 
@@ -266,9 +215,14 @@ impl AllanStream {
     }
 
     /// The variance and noise at every factor of the octave grid of the samples counted
-    /// ([`deviation::octave_factors`]), in order: (m, σ̂², the noise of its block means). The
-    /// estimate is the exact one for m ≤ [`EXACT_MAX_M`], the strided one beyond.
-    pub fn finish(mut self) -> Vec<(usize, f64, Option<NoiseId>)> {
+    /// ([`deviation::octave_factors`]), in order: (m, σ̂², the noise of its block means), each
+    /// σ̂² the whole-series estimate's bits.
+    ///
+    /// # Errors
+    /// The [`io::Error`] of the temporary file (writing it, or reading it back), or
+    /// [`io::ErrorKind::InvalidInput`] when more samples came than [`AllanStream::new`] was told
+    /// and the log has τ it kept no phase for.
+    pub fn finish(mut self) -> io::Result<Vec<(usize, f64, Option<NoiseId>)>> {
         let n = self.samples;
         let grid = deviation::octave_factors(n);
         let factors: Vec<usize> = exact_factors().collect();
@@ -283,22 +237,30 @@ impl AllanStream {
             self.add_stretch(&factors, from, to, &terms);
             from += STRETCH;
         }
-        grid.iter()
+        let long: Vec<usize> = grid.iter().copied().filter(|&m| m > EXACT_MAX_M).collect();
+        let long_sums = match (&mut self.spill, long.is_empty()) {
+            (_, true) => Vec::new(),
+            (Some(spill), false) => spill::second_difference_sums(spill, &long)?,
+            (None, false) => {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    format!("{n} samples: more than the stream was created for"),
+                ));
+            }
+        };
+        Ok(grid
+            .iter()
             .enumerate()
             .map(|(j, &m)| {
                 let noise = self.noise.get(j).and_then(|(id, _)| id.identify());
-                if m <= EXACT_MAX_M {
-                    let avar = self.exact_sums[j] / (2.0 * terms[j] as f64 * (m * m) as f64);
-                    (m, avar, noise)
+                let sum = if m <= EXACT_MAX_M {
+                    self.exact_sums[j]
                 } else {
-                    let t = self
-                        .strided
-                        .iter()
-                        .find(|t| t.m == m)
-                        .expect("started at 2m ≤ n");
-                    (m, t.sum / (2.0 * t.terms as f64 * (m * m) as f64), noise)
-                }
+                    long_sums[j - factors.len()]
+                };
+                let terms = (n + 1 - 2 * m) as f64;
+                (m, sum / (2.0 * terms * (m * m) as f64), noise)
             })
-            .collect()
+            .collect())
     }
 }

@@ -6,7 +6,8 @@ use std::io::{IsTerminal, Write as _};
 use anyhow::{Context, Result};
 
 use crate::cli::AllanArgs;
-use accelcal::allan::imu::read::{CsvRecords, read_imu_log};
+use accelcal::allan::imu::piped::PipedLog;
+use accelcal::allan::imu::read::CsvRecords;
 use accelcal::allan::imu::stream::{ImuRecords, StreamError};
 use accelcal::allan::imu::{self, Channel, ImuAnalysis, Sensor};
 use accelcal::allan::{self, Term, export, log::read_static_log};
@@ -168,13 +169,14 @@ fn run_imu(args: &AllanArgs, path: &std::path::Path) -> Result<()> {
 }
 
 /// The analysis of every channel of the log `path`: a regular file or a recording read twice
-/// from disk ([`imu::stream`]), a pipe or a ROS 1 bag read whole.
+/// from disk ([`imu::stream`]), a pipe copied once to a temporary file read twice.
 fn analyse_imu_log(args: &AllanArgs, path: &std::path::Path) -> Result<ImuAnalysis> {
     let source = LogFile::new(path);
     let regular_file = std::fs::metadata(path).is_ok_and(|m| m.is_file());
-    let streamed: Option<Box<dyn ImuRecords + '_>> = if imu::bag::is_recording(path) {
+    let spill_dir = spill_directory(&args.out);
+    let piped: PipedLog;
+    let records: Box<dyn ImuRecords + '_> = if imu::bag::is_recording(path) {
         imu::bag::open_recording(path, args.topic.as_deref())?
-            .map(|r| Box::new(r) as Box<dyn ImuRecords>)
     } else if args.topic.is_some() {
         return Err(super::logs::UsageError(format!(
             "--topic names a topic of an MCAP file or a ROS 2 bag; {} is read as CSV",
@@ -182,29 +184,39 @@ fn analyse_imu_log(args: &AllanArgs, path: &std::path::Path) -> Result<ImuAnalys
         ))
         .into());
     } else if regular_file {
-        Some(Box::new(CsvRecords::open(&source)?))
+        Box::new(CsvRecords::open(&source)?)
     } else {
-        None
+        // A pipe is read once, into a temporary file read twice.
+        piped = PipedLog::copy(path, &spill_dir)?;
+        Box::new(CsvRecords::open(&piped)?)
     };
-    let a = match streamed {
-        Some(records) => match imu::stream::analyse_records(records.as_ref(), args.confidence) {
-            Ok(a) => a,
-            Err(StreamError::Log(e)) => return Err(e.into()),
-            Err(StreamError::Channel(e)) => {
-                return Err(anyhow::Error::new(e).context(path.display().to_string()));
-            }
-        },
-        // A pipe is read once, into memory; a ROS 1 bag is read whole.
-        None => {
-            let log = if imu::bag::is_recording(path) {
-                imu::bag::read_recording(path, args.topic.as_deref())?
-            } else {
-                read_imu_log(&source)?
-            };
-            imu::analyse_imu(&log, args.confidence).with_context(|| path.display().to_string())?
+    match imu::stream::analyse_records(records.as_ref(), args.confidence, &spill_dir) {
+        Ok(a) => Ok(a),
+        Err(StreamError::Log(e)) => Err(e.into()),
+        Err(StreamError::Spill(e)) => Err(anyhow::Error::new(e).context(format!(
+            "the temporary file of the phase in {}",
+            spill_dir.display()
+        ))),
+        Err(StreamError::Channel(e)) => {
+            Err(anyhow::Error::new(e).context(path.display().to_string()))
         }
+    }
+}
+
+/// Where a long log's phase is kept while it is analysed: beside the output directory (on the
+/// disk the results go to, where a temporary directory may be memory), else the system's
+/// temporary directory.
+fn spill_directory(out: &std::path::Path) -> std::path::PathBuf {
+    let parent = match out.parent() {
+        Some(p) if p.as_os_str().is_empty() => std::path::Path::new("."),
+        Some(p) => p,
+        None => out,
     };
-    Ok(a)
+    if parent.is_dir() {
+        parent.to_path_buf()
+    } else {
+        std::env::temp_dir()
+    }
 }
 
 /// The printed lines of `allan --imu`: the extent, one line per channel, each sensor's keys.

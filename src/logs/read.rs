@@ -44,7 +44,9 @@ const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
 ///
 /// # Errors
 /// The operating system's when the first bytes cannot be read.
-fn decompressed<'a>(mut reader: Box<dyn BufRead + 'a>) -> std::io::Result<Box<dyn BufRead + 'a>> {
+pub(crate) fn decompressed<'a>(
+    mut reader: Box<dyn BufRead + 'a>,
+) -> std::io::Result<Box<dyn BufRead + 'a>> {
     if reader.fill_buf()?.starts_with(&GZIP_MAGIC) {
         let decoder = flate2::bufread::MultiGzDecoder::new(reader);
         return Ok(Box::new(BufReader::with_capacity(1 << 16, decoder)));

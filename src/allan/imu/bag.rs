@@ -12,6 +12,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::mcap_stream::{McapEvent, McapRecords, visit_mcap};
+use super::stream::ImuRecords;
 use super::{Channel, ImuSamples};
 use crate::allan::log::{first_gap, median_step};
 use crate::logs::{LogError, LogProblem};
@@ -258,35 +259,41 @@ fn choose_topic(
     Err(unreadable(name, problem))
 }
 
-/// The `Imu` topic of the MCAP file or ROS 2 bag directory `path` as records read from disk
-/// each time ([`super::stream`]); `None` for a ROS 1 bag (read whole by [`read_recording`]).
+/// The `Imu` topic of the MCAP file, ROS 2 bag directory or ROS 1 bag `path` as records read
+/// from disk each time ([`super::stream`]).
 ///
 /// # Errors
 /// As [`read_recording`] for the container and the choice of topic.
-pub fn open_recording(path: &Path, topic: Option<&str>) -> Result<Option<McapRecords>, LogError> {
+pub fn open_recording(path: &Path, topic: Option<&str>) -> Result<Box<dyn ImuRecords>, LogError> {
     let name = path.display().to_string();
     let files = if path.is_dir() {
         bag_files(path)?
     } else {
         vec![path.to_path_buf()]
     };
-    if files
-        .iter()
-        .any(|f| f.is_file() && super::rosbag1::is_ros1(f))
-    {
-        return Ok(None);
-    }
+    let ros1 = path.is_file() && super::rosbag1::is_ros1(path);
     let mut topics = Topics::default();
     for f in &files {
-        for (t, kind) in super::mcap_stream::topics(f)? {
-            if kind == IMU_TYPE {
+        let listed = if ros1 {
+            super::rosbag1::topics(f)?
+        } else {
+            super::mcap_stream::topics(f)?
+        };
+        for (t, kind) in listed {
+            if kind == IMU_TYPE || kind == super::rosbag1::IMU_TYPE {
                 topics.imu.entry(t.clone()).or_default();
             }
             topics.types.entry(t).or_insert(kind);
         }
     }
+    if ros1 {
+        let chosen = choose_topic(&name, &topics, topic, super::rosbag1::IMU_TYPE)?;
+        return Ok(Box::new(super::rosbag1_stream::Ros1Records::new(
+            path, chosen,
+        )));
+    }
     let chosen = choose_topic(&name, &topics, topic, IMU_TYPE)?;
-    Ok(Some(McapRecords::new(name, files, chosen)))
+    Ok(Box::new(McapRecords::new(name, files, chosen)))
 }
 
 /// The samples of the topic's messages, checked as a CSV log's rows are.

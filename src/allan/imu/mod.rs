@@ -13,8 +13,10 @@
 pub mod bag;
 pub mod export;
 pub mod mcap_stream;
+pub mod piped;
 pub mod read;
 pub mod rosbag1;
+pub mod rosbag1_stream;
 pub mod stream;
 
 use thiserror::Error;

@@ -2,13 +2,18 @@
 //! crate (0.6.3): that crate hands out the same raw records (chunks, connections, messages)
 //! through a memory map, leaving the connections' fields and the messages to decode as here,
 //! and brings bzip2's C library; a flat scan of the records is about as much code as using it.
+//! The file is read from disk record by record, a chunk at a time ([`visit_ros1`]): memory is
+//! one chunk's, whatever the bag's length; `rosbag1_stream::Ros1Records` reads it so for
+//! [`super::stream`]. A chunk is plain or compressed as rosbag compresses: lz4 (the LZ4 frame
+//! format, the `lz4` crate) or bz2 (the `bzip2` crate on its pure-Rust `libbz2-rs-sys`).
 //!
 //! # Formula
 //! ROS bag format 2.0 (wiki.ros.org/Bags/Format/2.0): after `#ROSBAG V2.0\n`, records of a
 //! little-endian u32 header length, the header's fields (each a u32 length then `name=value`),
 //! a u32 data length and the data. `op` = 0x05 a chunk (its data the records 0x07 connection —
 //! `conn`, `topic`, the type in its data's fields — and 0x02 message — `conn`, its data the
-//! message), 0x03 the bag header, 0x04 and 0x06 indices. A `sensor_msgs/Imu` message is ROS 1
+//! message; the header's `compression` none, lz4 or bz2 and `size` the records' length), 0x03
+//! the bag header (`index_pos`), 0x04 and 0x06 indices. A `sensor_msgs/Imu` message is ROS 1
 //! serialized (little-endian, unaligned): header {u32 seq, u32 sec, u32 nsec, string frame_id as
 //! u32 length + bytes}, then 37 float64 (orientation, its covariance, angular velocity, its
 //! covariance, linear acceleration, its covariance).
@@ -52,9 +57,9 @@ fn fields(b: &[u8]) -> Option<BTreeMap<&[u8], &[u8]>> {
 }
 
 /// One record: its header's fields and its data, and where the next starts.
-type Record<'a> = (BTreeMap<&'a [u8], &'a [u8]>, &'a [u8], usize);
+type RawRecord<'a> = (BTreeMap<&'a [u8], &'a [u8]>, &'a [u8], usize);
 
-fn record(b: &[u8], at: usize) -> Option<Record<'_>> {
+fn record(b: &[u8], at: usize) -> Option<RawRecord<'_>> {
     let header_len = u32_at(b, at)? as usize;
     let header = fields(b.get(at + 4..at + 4 + header_len)?)?;
     let data_at = at + 4 + header_len;
@@ -79,6 +84,17 @@ fn decode(data: &[u8]) -> Option<ImuMessage> {
     })
 }
 
+/// What [`visit_ros1`] hands on: a connection (topic, type), then each message on it.
+pub(super) enum Ros1Event<'a> {
+    /// A connection: its topic and its type.
+    Connection(&'a str, &'a str),
+    /// A message: its topic, its type, and its bytes.
+    Message(&'a str, &'a str, &'a [u8]),
+}
+
+/// The visitor of [`visit_ros1`].
+type Visit<'v> = dyn FnMut(Ros1Event<'_>) -> Result<(), LogError> + 'v;
+
 /// What the records read so far say.
 #[derive(Default)]
 struct Reading {
@@ -87,15 +103,59 @@ struct Reading {
 }
 
 impl Reading {
-    /// Takes in the records of `b` (a bag's or a chunk's), `place` saying where they lie.
+    /// Takes in one record (its header's fields and its data) found at byte `at` of `place`.
+    fn record(
+        &mut self,
+        file: &str,
+        header: &BTreeMap<&[u8], &[u8]>,
+        data: &[u8],
+        (at, place): (usize, &str),
+        visit: &mut Visit<'_>,
+    ) -> Result<(), LogError> {
+        let conn = header.get(&b"conn"[..]).and_then(|c| u32_at(c, 0));
+        match header.get(&b"op"[..]).and_then(|o| o.first()) {
+            Some(0x05) => self.chunk(file, header, data, at, visit)?,
+            Some(0x07) => {
+                let kind = fields(data)
+                    .and_then(|f| f.get(&b"type"[..]).map(|t| t.to_vec()))
+                    .unwrap_or_default();
+                let topic = header
+                    .get(&b"topic"[..])
+                    .map(|t| t.to_vec())
+                    .unwrap_or_default();
+                let (topic, kind) = (
+                    String::from_utf8_lossy(&topic).into_owned(),
+                    String::from_utf8_lossy(&kind).into_owned(),
+                );
+                visit(Ros1Event::Connection(&topic, &kind))?;
+                self.connections
+                    .insert(conn.unwrap_or(u32::MAX), (topic, kind));
+            }
+            Some(0x02) => {
+                let Some((topic, kind)) = conn.and_then(|c| self.connections.get(&c)) else {
+                    return Err(unreadable(
+                        file,
+                        format!(
+                            "{place}: the message at byte {at} names no connection defined before it"
+                        ),
+                    ));
+                };
+                visit(Ros1Event::Message(topic, kind, data))?;
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// Takes in the records of `b` (a chunk's, decompressed), `place` saying where it lies.
     fn records(
         &mut self,
         file: &str,
         b: &[u8],
-        mut at: usize,
         place: &str,
-        topics: &mut Topics,
+        visit: &mut Visit<'_>,
     ) -> Result<(), LogError> {
+        let mut at = 0;
         while at < b.len() {
             let Some((header, data, next)) = record(b, at) else {
                 return Err(unreadable(
@@ -105,48 +165,7 @@ impl Reading {
                     ),
                 ));
             };
-            let conn = header.get(&b"conn"[..]).and_then(|c| u32_at(c, 0));
-            match header.get(&b"op"[..]).and_then(|o| o.first()) {
-                Some(0x05) => self.chunk(file, &header, data, at, topics)?,
-                Some(0x07) => {
-                    let kind = fields(data)
-                        .and_then(|f| f.get(&b"type"[..]).map(|t| t.to_vec()))
-                        .unwrap_or_default();
-                    let topic = header
-                        .get(&b"topic"[..])
-                        .map(|t| t.to_vec())
-                        .unwrap_or_default();
-                    let (topic, kind) = (
-                        String::from_utf8_lossy(&topic).into_owned(),
-                        String::from_utf8_lossy(&kind).into_owned(),
-                    );
-                    topics.types.entry(topic.clone()).or_insert(kind.clone());
-                    self.connections
-                        .insert(conn.unwrap_or(u32::MAX), (topic, kind));
-                }
-                Some(0x02) => {
-                    let Some((topic, kind)) = conn.and_then(|c| self.connections.get(&c)) else {
-                        return Err(unreadable(
-                            file,
-                            format!(
-                                "{place}: the message at byte {at} names no connection defined before it"
-                            ),
-                        ));
-                    };
-                    if kind == IMU_TYPE {
-                        let list = topics.imu.entry(topic.clone()).or_default();
-                        let Some(m) = decode(data) else {
-                            let at = format!("{file}, topic {topic}, message {}", list.len());
-                            return Err(unreadable(
-                                &at,
-                                format!("{} bytes: too short for a {IMU_TYPE} message", data.len()),
-                            ));
-                        };
-                        list.push(m);
-                    }
-                }
-                _ => {}
-            }
+            self.record(file, &header, data, (at, place), visit)?;
             at = next;
         }
         Ok(())
@@ -158,45 +177,206 @@ impl Reading {
         header: &BTreeMap<&[u8], &[u8]>,
         data: &[u8],
         at: usize,
-        topics: &mut Topics,
+        visit: &mut Visit<'_>,
     ) -> Result<(), LogError> {
         let place = format!("the chunk at byte {at}");
         let compression = header.get(&b"compression"[..]).copied().unwrap_or(b"none");
+        // The chunk header's `size` is the records' length once decompressed: no more is
+        // decompressed than it says (a corrupt chunk cannot fill the memory).
+        let size = header.get(&b"size"[..]).and_then(|c| u32_at(c, 0));
+        let limit = u64::from(size.unwrap_or(u32::MAX));
+        let inflate = |name: &str, reader: std::io::Result<Box<dyn std::io::Read + '_>>| {
+            let mut out = Vec::new();
+            reader
+                .and_then(|r| {
+                    std::io::Read::read_to_end(&mut std::io::Read::take(r, limit), &mut out)
+                })
+                .map_err(|e| {
+                    unreadable(
+                        file,
+                        format!("{place}: {name} data that does not decompress: {e}"),
+                    )
+                })?;
+            Ok::<_, LogError>(std::borrow::Cow::Owned(out))
+        };
         let plain = match compression {
-            b"none" => data.to_vec(),
-            b"lz4" => {
-                let mut out = Vec::new();
-                lz4::Decoder::new(data)
-                    .and_then(|mut d| std::io::Read::read_to_end(&mut d, &mut out))
-                    .map_err(|e| {
-                        unreadable(
-                            file,
-                            format!("{place}: lz4 data that does not decompress: {e}"),
-                        )
-                    })?;
-                out
-            }
+            b"none" => std::borrow::Cow::Borrowed(data),
+            b"lz4" => inflate(
+                "lz4",
+                lz4::Decoder::new(data).map(|d| Box::new(d) as Box<dyn std::io::Read>),
+            )?,
+            b"bz2" => inflate("bz2", Ok(Box::new(bzip2::read::BzDecoder::new(data))))?,
             other => {
                 return Err(unreadable(
                     file,
                     format!(
-                        "{place} is compressed with {}: expected none or lz4 (rosbag compress --lz4, or rosbag decompress)",
+                        "{place} is compressed with {}: expected none, lz4 or bz2 (rosbag's compressions)",
                         String::from_utf8_lossy(other)
                     ),
                 ));
             }
         };
-        self.records(file, &plain, 0, &place, topics)
+        self.records(file, &plain, &place, visit)
     }
+}
+
+/// Reads the records of the ROS 1 bag at `path` in order from disk, one top-level record (a
+/// chunk, decompressed) at a time, handing its connections and messages to `visit`.
+///
+/// # Errors
+/// [`LogError`] naming the file and the byte offset of a record that is cut short or malformed
+/// (a length past the file's end included), a chunk compressed otherwise than plain, lz4 or bz2
+/// or whose data does not decompress, a
+/// message on no connection, or `visit`'s error.
+pub(super) fn visit_ros1(path: &Path, visit: &mut Visit<'_>) -> Result<(), LogError> {
+    use std::io::Read as _;
+    let file = path.display().to_string();
+    let io = |e: std::io::Error| unreadable(&file, e.to_string());
+    let f = std::fs::File::open(path).map_err(io)?;
+    let len = f.metadata().map_err(io)?.len();
+    let mut input = std::io::BufReader::with_capacity(1 << 20, f);
+    let mut magic = [0u8; ROSBAG_MAGIC.len()];
+    if input.read_exact(&mut magic).is_err() || magic != ROSBAG_MAGIC {
+        return Err(unreadable(
+            &file,
+            "expected a ROS 1 bag (#ROSBAG V2.0)".into(),
+        ));
+    }
+    let mut at = ROSBAG_MAGIC.len() as u64;
+    let mut reading = Reading::default();
+    let (mut header, mut data) = (Vec::new(), Vec::new());
+    let cut = |at: u64| {
+        unreadable(
+            &file,
+            format!(
+                "the bag: the record at byte {at} is cut short or malformed: expected a ROS bag 2.0 record"
+            ),
+        )
+    };
+    loop {
+        let mut word = [0u8; 4];
+        match input.read(&mut word[..1]).map_err(io)? {
+            0 => return Ok(()),
+            _ => input.read_exact(&mut word[1..]).map_err(|_| cut(at))?,
+        }
+        // A length is trusted only as far as the file goes: a corrupt one allocates nothing.
+        let header_len = u32::from_le_bytes(word);
+        part(&mut input, &mut header, at + 4, header_len, len).map_err(|()| cut(at))?;
+        let data_at = at + 4 + u64::from(header_len);
+        let mut word = [0u8; 4];
+        input.read_exact(&mut word).map_err(|_| cut(at))?;
+        let data_len = u32::from_le_bytes(word);
+        part(&mut input, &mut data, data_at + 4, data_len, len).map_err(|()| cut(at))?;
+        let fields = fields(&header).ok_or_else(|| cut(at))?;
+        let place = (usize::try_from(at).unwrap_or(usize::MAX), "the bag");
+        reading.record(&file, &fields, &data, place, visit)?;
+        at = data_at + 4 + u64::from(data_len);
+    }
+}
+
+/// Reads `length` bytes at `from` into `buffer`, when the file of `file_len` bytes holds them.
+fn part(
+    input: &mut impl std::io::Read,
+    buffer: &mut Vec<u8>,
+    from: u64,
+    length: u32,
+    file_len: u64,
+) -> Result<(), ()> {
+    if from + u64::from(length) > file_len {
+        return Err(());
+    }
+    buffer.resize(length as usize, 0);
+    input.read_exact(buffer).map_err(|_| ())
+}
+
+/// The topics of the ROS 1 bag at `path` and their types, from the connection records of its
+/// index (the bag header's `index_pos`) when it has one, else by reading it through.
+///
+/// # Errors
+/// As [`visit_ros1`].
+pub(super) fn topics(path: &Path) -> Result<BTreeMap<String, String>, LogError> {
+    if let Some(t) = index_topics(path) {
+        return Ok(t);
+    }
+    let mut out = BTreeMap::new();
+    visit_ros1(path, &mut |event| {
+        if let Ros1Event::Connection(topic, kind) = event {
+            out.entry(topic.to_string()).or_insert(kind.to_string());
+        }
+        Ok(())
+    })?;
+    Ok(out)
+}
+
+/// The topics the connection records after `index_pos` name; `None` without an index or when
+/// it does not parse.
+fn index_topics(path: &Path) -> Option<BTreeMap<String, String>> {
+    use std::io::{Read as _, Seek, SeekFrom};
+    let mut f = std::fs::File::open(path).ok()?;
+    let mut head = vec![0u8; 4096 + ROSBAG_MAGIC.len()];
+    let n = f.read(&mut head).ok()?;
+    let (header, _, _) = record(&head[..n], ROSBAG_MAGIC.len())?;
+    if header.get(&b"op"[..])?.first() != Some(&0x03) {
+        return None;
+    }
+    let index_pos = u64::from_le_bytes(header.get(&b"index_pos"[..])?.get(..8)?.try_into().ok()?);
+    let len = f.metadata().ok()?.len();
+    if index_pos == 0 || index_pos >= len {
+        return None;
+    }
+    f.seek(SeekFrom::Start(index_pos)).ok()?;
+    let mut index = Vec::new();
+    f.read_to_end(&mut index).ok()?;
+    let mut out = BTreeMap::new();
+    let mut at = 0;
+    while at < index.len() {
+        let (header, data, next) = record(&index, at)?;
+        if header.get(&b"op"[..])?.first() == Some(&0x07) {
+            let topic = String::from_utf8_lossy(header.get(&b"topic"[..])?).into_owned();
+            let kind = String::from_utf8_lossy(fields(data)?.get(&b"type"[..])?).into_owned();
+            out.entry(topic).or_insert(kind);
+        }
+        at = next;
+    }
+    (!out.is_empty()).then_some(out)
 }
 
 /// Reads the connections and `Imu` messages of the ROS 1 bag at `path` into `topics`.
 ///
 /// # Errors
-/// [`LogError`] naming the file and the byte offset of a record that is cut short or malformed,
-/// a chunk compressed otherwise than plain or lz4, or a message too short for an `Imu`.
+/// As [`visit_ros1`], and a message too short for an `Imu`.
 pub(super) fn read_ros1(path: &Path, topics: &mut Topics) -> Result<(), LogError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| unreadable(&file, e.to_string()))?;
-    Reading::default().records(&file, &bytes, ROSBAG_MAGIC.len(), "the bag", topics)
+    visit_ros1(path, &mut |event| {
+        match event {
+            Ros1Event::Connection(topic, kind) => {
+                topics
+                    .types
+                    .entry(topic.to_string())
+                    .or_insert(kind.to_string());
+            }
+            Ros1Event::Message(topic, kind, data) if kind == IMU_TYPE => {
+                let list = topics.imu.entry(topic.to_string()).or_default();
+                list.push(decode_message(&file, topic, list.len(), data)?);
+            }
+            Ros1Event::Message(..) => {}
+        }
+        Ok(())
+    })
+}
+
+/// The `Imu` message `index` of `topic`, or the error naming it.
+pub(super) fn decode_message(
+    file: &str,
+    topic: &str,
+    index: usize,
+    data: &[u8],
+) -> Result<ImuMessage, LogError> {
+    decode(data).ok_or_else(|| {
+        let at = format!("{file}, topic {topic}, message {index}");
+        unreadable(
+            &at,
+            format!("{} bytes: too short for a {IMU_TYPE} message", data.len()),
+        )
+    })
 }

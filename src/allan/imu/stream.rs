@@ -1,9 +1,10 @@
 //! `allan --imu` on a log read twice and held nowhere: a first read finds each channel's mean
-//! (the phase subtracts it, as the whole-series form does) and the median step, a second
-//! checks every step against that median and feeds each channel's [`AllanStream`]. Memory is
-//! that of the streams (the window of [`stream::EXACT_MAX_M`](crate::allan::stream::EXACT_MAX_M)
-//! phase points per channel), whatever the log's length; a log whose octave τ all lie within
-//! it gives the whole-series analysis bit for bit.
+//! (the phase subtracts it, as the whole-series form does), the count and the median step, a
+//! second checks every step against that median and feeds each channel's [`AllanStream`].
+//! Memory is that of the streams (the window of
+//! [`stream::EXACT_MAX_M`](crate::allan::stream::EXACT_MAX_M) phase points per channel; a longer
+//! log's phase goes to a temporary file), whatever the log's length; every τ is the
+//! whole-series analysis's, bit for bit.
 
 use rayon::prelude::*;
 
@@ -52,6 +53,8 @@ pub enum StreamError {
     Log(LogError),
     /// A channel the analysis cannot use.
     Channel(ImuError),
+    /// The temporary file of a long log's phase (creating, writing or reading it).
+    Spill(std::io::Error),
 }
 
 /// The checks of one read: strictly increasing stamps, finite values.
@@ -82,7 +85,7 @@ fn checked(
 }
 
 /// The first read: each channel's mean and the median step, s, the stamps and values checked.
-fn first_read(records: &dyn ImuRecords) -> Result<(Vec<f64>, f64), LogError> {
+fn first_read(records: &dyn ImuRecords) -> Result<(Vec<f64>, usize, f64), LogError> {
     let mut means = vec![StreamingMean::default(); records.channels().len()];
     let mut steps = StepMedian::new();
     let mut previous_s = None;
@@ -102,26 +105,35 @@ fn first_read(records: &dyn ImuRecords) -> Result<(Vec<f64>, f64), LogError> {
         };
         return Err(records.error(problem));
     };
-    Ok((means.iter().map(StreamingMean::mean).collect(), median_s))
+    let samples = means.first().map_or(0, StreamingMean::count) as usize;
+    let means = means.iter().map(StreamingMean::mean).collect();
+    Ok((means, samples, median_s))
 }
 
-/// Analyses every channel of `records` at `confidence`, reading them twice.
+/// Analyses every channel of `records` at `confidence`, reading them twice; the phase of a log
+/// with τ beyond the streams' window is written to a temporary file in `spill_dir`.
 ///
 /// # Errors
 /// [`StreamError::Log`] for the first problem of the log (as the whole-series readers tell
 /// it: a malformed row first, then a step outside the accepted band around the median),
-/// [`StreamError::Channel`] naming the first channel the analysis cannot use.
+/// [`StreamError::Channel`] naming the first channel the analysis cannot use,
+/// [`StreamError::Spill`] for the temporary file.
 pub fn analyse_records(
     records: &dyn ImuRecords,
     confidence: f64,
+    spill_dir: &std::path::Path,
 ) -> Result<ImuAnalysis, StreamError> {
     let channels = records.channels().to_vec();
-    let (means, median_s) = first_read(records).map_err(StreamError::Log)?;
+    let (means, count, median_s) = first_read(records).map_err(StreamError::Log)?;
     let (lo, hi) = (
         ACCEPTED_STEP_RATIO.0 * median_s,
         ACCEPTED_STEP_RATIO.1 * median_s,
     );
-    let mut streams: Vec<AllanStream> = means.into_iter().map(AllanStream::new).collect();
+    let mut streams: Vec<AllanStream> = means
+        .into_iter()
+        .map(|mean| AllanStream::new(mean, count, spill_dir))
+        .collect::<Result<_, _>>()
+        .map_err(StreamError::Spill)?;
     // The second read on this thread, the streams on the others: batches handed over a queue
     // of two, so that reading and summing overlap.
     let (send, receive) = std::sync::mpsc::sync_channel::<Vec<Vec<f64>>>(2);
@@ -170,11 +182,16 @@ pub fn analyse_records(
     });
     read.map_err(StreamError::Log)?;
     let samples = streams.first().map_or(0, AllanStream::samples);
-    let analyses: Vec<ChannelAnalysis> = streams
+    let grids: Vec<_> = streams
         .into_par_iter()
+        .map(AllanStream::finish)
+        .collect::<Result<_, _>>()
+        .map_err(StreamError::Spill)?;
+    let analyses: Vec<ChannelAnalysis> = grids
+        .par_iter()
         .zip(channels.par_iter())
-        .map(|(s, &channel)| {
-            analyse_grid(&s.finish(), samples, median_s, confidence)
+        .map(|(grid, &channel)| {
+            analyse_grid(grid, samples, median_s, confidence)
                 .map(|analysis| ChannelAnalysis { channel, analysis })
                 .map_err(|source| ImuError {
                     column: channel.column(),

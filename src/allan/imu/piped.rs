@@ -1,0 +1,87 @@
+//! A log that can be read only once — a pipe, a FIFO, a device — copied as it arrives to an
+//! anonymous temporary file, which is then read as a file is, as often as the analysis needs
+//! ([`super::stream`] reads it twice): memory stays that of the streams, whatever the length.
+
+use std::fs::File;
+use std::io::{BufRead, BufReader, Read};
+use std::path::Path;
+
+use crate::logs::read::{LogSource, decompressed};
+use crate::logs::{LogError, LogProblem};
+
+/// The bytes of a log read once, kept in a temporary file (unlinked at creation: removed
+/// however the process ends).
+#[derive(Debug)]
+pub struct PipedLog {
+    name: String,
+    file: File,
+}
+
+impl PipedLog {
+    /// Copies every byte of `path` (as it is: gzip is told when the copy is read) to a temporary
+    /// file in `spill_dir`.
+    ///
+    /// # Errors
+    /// [`LogProblem::Unreadable`] naming `path` when it cannot be read, or the temporary file
+    /// when it cannot be made or written.
+    pub fn copy(path: &Path, spill_dir: &Path) -> Result<Self, LogError> {
+        let name = path.display().to_string();
+        let unreadable = |what: &str, e: std::io::Error| {
+            let message = format!("{what}: {e}");
+            LogError::of_file(&name, LogProblem::Unreadable { message })
+        };
+        let mut file = tempfile::tempfile_in(spill_dir).map_err(|e| {
+            unreadable(
+                &format!("its copy in {} cannot be made", spill_dir.display()),
+                e,
+            )
+        })?;
+        let mut input = File::open(path).map_err(|e| unreadable("cannot be opened", e))?;
+        std::io::copy(&mut input, &mut file).map_err(|e| unreadable("cannot be copied", e))?;
+        Ok(Self { name, file })
+    }
+}
+
+/// The copy read from its start, by positioned reads (no shared offset).
+struct FromStart<'a> {
+    file: &'a File,
+    at: u64,
+}
+
+impl Read for FromStart<'_> {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        let k = read_at(self.file, out, self.at)?;
+        self.at += k as u64;
+        Ok(k)
+    }
+}
+
+#[cfg(unix)]
+fn read_at(file: &File, out: &mut [u8], at: u64) -> std::io::Result<usize> {
+    std::os::unix::fs::FileExt::read_at(file, out, at)
+}
+
+#[cfg(windows)]
+fn read_at(file: &File, out: &mut [u8], at: u64) -> std::io::Result<usize> {
+    std::os::windows::fs::FileExt::seek_read(file, out, at)
+}
+
+impl LogSource for PipedLog {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn open(&self) -> Result<Box<dyn BufRead + '_>, LogError> {
+        let reader = BufReader::with_capacity(
+            1 << 16,
+            FromStart {
+                file: &self.file,
+                at: 0,
+            },
+        );
+        decompressed(Box::new(reader)).map_err(|e| {
+            let message = e.to_string();
+            LogError::of_file(&self.name, LogProblem::Unreadable { message })
+        })
+    }
+}
