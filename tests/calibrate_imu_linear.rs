@@ -6,7 +6,7 @@
 use accelcal::calibrate::imu::gnss::{GnssRow, read_gnss};
 use accelcal::calibrate::imu::linear::Linearized;
 use accelcal::calibrate::imu::noise::log_likelihood;
-use accelcal::calibrate::imu::read::{ImuStep, read_steps};
+use accelcal::calibrate::imu::read::{ImuSpan, ImuStep, read_steps};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ins::InsConfig;
 use accelcal::ins::logs::write_realization;
@@ -25,14 +25,20 @@ fn comma() -> (Vec<GnssRow>, Vec<ImuStep>) {
 
 /// The first 240 s of the simulated drive, held.
 fn simulated() -> (Vec<GnssRow>, Vec<ImuStep>) {
+    let (rows, steps, _) = simulated_with_span();
+    (rows, steps)
+}
+
+/// [`simulated`] with the IMU log's span.
+fn simulated_with_span() -> (Vec<GnssRow>, Vec<ImuStep>, ImuSpan) {
     let mut config = InsConfig::default();
     config.drive.duration_s = 240.0;
     let study = Study::from_config(&config).expect("valid");
     let (mut imu, mut gnss, mut truth) = (Vec::new(), Vec::new(), Vec::new());
     write_realization(&study, 3, &mut imu, &mut gnss, &mut truth).expect("in memory");
     let rows = read_gnss(&LogText::new("gnss.csv", gnss)).expect("reads");
-    let (steps, _, _) = read_steps(&LogText::new("imu.csv", imu), CONSUMER.axes).expect("reads");
-    (rows, steps)
+    let (steps, span, _) = read_steps(&LogText::new("imu.csv", imu), CONSUMER.axes).expect("reads");
+    (rows, steps, span)
 }
 
 /// Assumptions moved from `s`: each key the search takes changed by a factor or a shift.
@@ -102,4 +108,29 @@ fn linear_likelihood_is_the_runs_on_a_simulated_drive() {
 #[test]
 fn linear_likelihood_is_the_runs_on_the_comma_minute() {
     check(&comma(), &CONSUMER, END_FALL / 2.0);
+}
+
+/// A raised flag stops the search: the estimate is `Cancelled` without a full search's work;
+/// the control, the same call with the flag down, gives an estimate.
+#[test]
+fn a_raised_flag_stops_the_noise_search() {
+    use accelcal::calibrate::imu::noise::{ImuKey, estimate_cancellable};
+    use accelcal::progress::Cancel;
+    let (rows, steps, span) = simulated_with_span();
+    let keys = [ImuKey::GnssHorizontalSigma, ImuKey::GnssTimeOffset];
+    let down = Cancel::new();
+    let started = std::time::Instant::now();
+    let found = estimate_cancellable(&rows, &steps, &span, (&CONSUMER, &keys, 0.95), &down);
+    let full = started.elapsed();
+    assert!(matches!(found, Ok(Some(_))));
+    let raised = Cancel::new();
+    raised.cancel();
+    let started = std::time::Instant::now();
+    let stopped = estimate_cancellable(&rows, &steps, &span, (&CONSUMER, &keys, 0.95), &raised);
+    assert!(stopped.is_err());
+    assert!(
+        started.elapsed() < full / 2,
+        "{:?} against {full:?}",
+        started.elapsed()
+    );
 }

@@ -113,18 +113,19 @@ fn calibrate(
     settings: &Settings,
     keys: Option<&[ImuKey]>,
     confidence: f64,
+    cancel: &accelcal::progress::Cancel,
 ) -> PyResult<ImuCalibrationResult> {
     let estimate = match keys {
         None => None,
         Some(keys) => Some(
-            noise::estimate(
+            noise::estimate_cancellable(
                 &held.rows,
                 &held.steps,
                 &held.span,
-                settings,
-                keys,
-                confidence,
+                (settings, keys, confidence),
+                cancel,
             )
+            .map_err(|_| crate::bad_input("interrupted"))?
             .ok_or_else(|| {
                 crate::bad_input(
                     "the likelihood of the drive is not finite at the configured statistics: \
@@ -171,8 +172,8 @@ fn slices<'a, const N: usize>(
 /// `gnss_optional`: the nine optional columns, each given or `None`, NaN where not measured).
 /// `estimate` as `--estimate-noise [--estimate KEYS]`. The columns are read in place to build
 /// the steps and the rows, the GIL released; the filter then runs on a thread of its own that
-/// Ctrl-C leaves behind (`crate::interrupt::leaving_behind`): the filter and the likelihood
-/// poll no flag.
+/// Ctrl-C leaves behind (`crate::interrupt::leaving_behind`); the likelihood's search polls its
+/// flag at every evaluation and ends within one, the filter's runs poll none.
 #[pyfunction]
 #[pyo3(signature = (imu_t, imu_columns, layout, gnss_required, gnss_optional, config_kind, config_value, estimate, confidence))]
 #[allow(clippy::too_many_arguments)]
@@ -222,7 +223,7 @@ pub(crate) fn calibrate_imu_arrays(
             rows,
         })
     })?;
-    crate::interrupt::leaving_behind(py, move |_| {
-        calibrate(&held, &settings, keys.as_deref(), confidence)
+    crate::interrupt::leaving_behind(py, move |cancel| {
+        calibrate(&held, &settings, keys.as_deref(), confidence, cancel)
     })?
 }

@@ -7,7 +7,7 @@
 //!   between stretches) and borrows the caller's data (numpy arrays read in place): the call
 //!   waits for it to stop, a fraction of a second, then raises `KeyboardInterrupt`.
 //! - [`leaving_behind`]: the work owns its data and may not poll the flag everywhere (the
-//!   likelihood's search of `estimate_noise`, the three-axis filter): the call raises
+//!   one-axis likelihood search of `estimate_noise`, the three-axis filter): the call raises
 //!   `KeyboardInterrupt` at once and the work ends in the background, its result dropped. Until
 //!   then it keeps its threads busy; the interpreter is usable meanwhile.
 

@@ -22,6 +22,7 @@ use super::linear::Linearized;
 use super::read::{HeldSteps, ImuSpan, ImuStep};
 use super::run::{filter, shifted};
 use crate::likelihood::{Fit, climb, maximize};
+use crate::progress::{Cancel, Cancelled};
 
 /// Runs of the filter the search linearizes about, at most.
 pub const MAX_RUNS: usize = 12;
@@ -255,6 +256,36 @@ pub fn estimate(
     keys: &[ImuKey],
     confidence: f64,
 ) -> Option<NoiseEstimate> {
+    estimate_cancellable(rows, steps, span, (s, keys, confidence), &Cancel::new())
+        .unwrap_or_default()
+}
+
+/// [`estimate`] that stops when `cancel` is raised: every evaluation of ℓ then returns −∞ at
+/// once, so the search and the intervals end within one evaluation, and the result is
+/// [`Cancelled`].
+///
+/// # Errors
+/// [`Cancelled`] when the flag was raised before the estimate was complete.
+pub fn estimate_cancellable(
+    rows: &[GnssRow],
+    steps: &[ImuStep],
+    span: &ImuSpan,
+    (s, keys, confidence): (&Settings, &[ImuKey], f64),
+    cancel: &Cancel,
+) -> Result<Option<NoiseEstimate>, Cancelled> {
+    let found = search(rows, steps, span, (s, keys, confidence), cancel);
+    cancel.check()?;
+    Ok(found)
+}
+
+/// The search of [`estimate_cancellable`].
+fn search(
+    rows: &[GnssRow],
+    steps: &[ImuStep],
+    span: &ImuSpan,
+    (s, keys, confidence): (&Settings, &[ImuKey], f64),
+    cancel: &Cancel,
+) -> Option<NoiseEstimate> {
     let settings_at = |u: &[f64]| {
         let mut t = *s;
         for (k, x) in keys.iter().zip(u) {
@@ -280,7 +311,12 @@ pub fn estimate(
     let mut at_run = model.log_likelihood(s, fixes);
     let (mut evaluations, mut filter_runs, mut settled) = (0, 1, false);
     'search: while filter_runs < MAX_RUNS {
-        let f = |x: &[f64]| model.log_likelihood(&settings_at(x), fixes);
+        let f = |x: &[f64]| {
+            if cancel.is_cancelled() {
+                return f64::NEG_INFINITY;
+            }
+            model.log_likelihood(&settings_at(x), fixes)
+        };
         let (best, _, n) = climb(&f, (&lo, &hi), &u)?;
         evaluations += n;
         if best.iter().zip(&u).all(|(a, b)| (a - b).abs() <= SETTLED) {
@@ -290,7 +326,7 @@ pub fn estimate(
         // A run at the model's maximum: taken when the likelihood of that run (its model's ℓ
         // at its own statistics, equal to the filter's) beats the last run's; else halfway.
         let mut step: Vec<f64> = best.iter().zip(&u).map(|(a, b)| a - b).collect();
-        while filter_runs < MAX_RUNS {
+        while filter_runs < MAX_RUNS && !cancel.is_cancelled() {
             let candidate: Vec<f64> = u.iter().zip(&step).map(|(a, d)| a + d).collect();
             let t = settings_at(&candidate);
             filter_runs += 1;
@@ -308,10 +344,30 @@ pub fn estimate(
             }
         }
     }
-    let f = |x: &[f64]| model.log_likelihood(&settings_at(x), fixes);
+    let f = |x: &[f64]| {
+        if cancel.is_cancelled() {
+            return f64::NEG_INFINITY;
+        }
+        model.log_likelihood(&settings_at(x), fixes)
+    };
     let fit: Fit = maximize(&f, (&lo, &hi), &u, confidence)?;
-    let estimates = keys
-        .iter()
+    let estimates = key_estimates(keys, &fit, (&lo, &hi));
+    Some(NoiseEstimate {
+        log_likelihood: fit.value,
+        evaluations: evaluations + fit.evaluations,
+        filter_runs,
+        settled,
+        confidence,
+        fixes,
+        keys: estimates,
+        settings: settings_at(&fit.u),
+    })
+}
+
+/// Each key's estimate from the fit, its interval ends open where they reached the box
+/// [lo, hi].
+fn key_estimates(keys: &[ImuKey], fit: &Fit, (lo, hi): (&[f64], &[f64])) -> Vec<KeyEstimate> {
+    keys.iter()
         .enumerate()
         .map(|(j, &k)| {
             let (l, h) = (fit.ends[2 * j].at, fit.ends[2 * j + 1].at);
@@ -325,15 +381,5 @@ pub fn estimate(
                 search_bounds: [k.value(lo[j]), k.value(hi[j])],
             }
         })
-        .collect();
-    Some(NoiseEstimate {
-        log_likelihood: fit.value,
-        evaluations: evaluations + fit.evaluations,
-        filter_runs,
-        settled,
-        confidence,
-        fixes,
-        keys: estimates,
-        settings: settings_at(&fit.u),
-    })
+        .collect()
 }
