@@ -42,6 +42,8 @@ pub mod params;
 pub mod prose;
 pub mod quantities;
 pub mod real_drive;
+pub mod real_drive_3d;
+pub mod real_drive_3d_words;
 pub mod registry;
 pub mod rich;
 pub mod sections;
