@@ -155,9 +155,18 @@ fn the_test_sentences_follow_the_numbers() {
 #[test]
 fn the_noise_sentences_follow_the_numbers() {
     let d = drive();
-    let said = words::noise_findings(d);
+    // Every key determined (both interval ends inside the search's box), then the first one
+    // open above: the first sentence says which.
+    let mut all = d.clone();
+    let est = all.estimated.summary.noise_estimate.as_mut().unwrap();
+    for k in &mut est.keys {
+        k.identifiable = true;
+        k.lower = Some(k.lower.unwrap_or(0.5 * k.value));
+        k.upper = Some(k.upper.unwrap_or(2.0 * k.value));
+    }
+    let said = words::noise_findings(&all);
     assert!(said[0].starts_with("The drive determines"), "{}", said[0]);
-    let mut open = d.clone();
+    let mut open = all.clone();
     let est = open.estimated.summary.noise_estimate.as_mut().unwrap();
     est.keys[0].identifiable = false;
     est.keys[0].upper = None;
@@ -168,8 +177,17 @@ fn the_noise_sentences_follow_the_numbers() {
         "{}",
         said[0]
     );
-    // The same tests in both runs: no whiteness verdict changes.
+    let first = &open.estimated.summary.noise_estimate.as_ref().unwrap().keys[0];
+    assert!(words::key_words(first).contains("only a lower bound"));
+    // The same whiteness verdicts in both runs, then one flipped.
     let mut same = d.clone();
     same.estimated.summary.whiteness = same.plain.summary.whiteness.clone();
     assert!(words::noise_findings(&same)[1].contains("every whiteness verdict as it was"));
+    let w = &mut same.estimated.summary.whiteness[0];
+    w.test.verdict = if w.test.verdict == "pass" {
+        "fail"
+    } else {
+        "pass"
+    };
+    assert!(words::noise_findings(&same)[1].contains("whiteness turns from"));
 }
