@@ -191,3 +191,35 @@ fn the_noise_sentences_follow_the_numbers() {
     };
     assert!(words::noise_findings(&same)[1].contains("whiteness turns from"));
 }
+
+/// The section's view with numbers for exactly its own labels: a bias or yaw the drive does not
+/// determine reads "not determined" (no value), one it determines reads value ± σ.
+#[test]
+fn the_view_prints_no_value_for_what_the_drive_leaves_open() {
+    use accelcal::report::kind::SectionKind;
+    use accelcal::report::labels::Numbers;
+    use accelcal::report::real_drive_3d::{RealDrive3dSection, view};
+    let labels = RealDrive3dSection.labels(0);
+    let numbers = Numbers::from_map(
+        labels
+            .iter()
+            .enumerate()
+            .map(|(i, l)| (*l, i + 1))
+            .collect(),
+    );
+    let d = drive();
+    let v = view(d, &numbers).unwrap();
+    assert_eq!(v.biases.len(), 6);
+    let accel_x = &v.biases[3];
+    assert!(!accel_x.plain_determined && accel_x.plain == "not determined");
+    assert!(accel_x.plain_interval.starts_with('['));
+    assert!(v.biases[0].plain.contains('±') && !v.biases[0].android.is_empty());
+    assert_eq!(v.attitude[2].determined, Some(false));
+    let mut flipped = d.clone();
+    flipped.plain.summary.accel_bias_m_s2.identifiable[0] = true;
+    flipped.plain.summary.attitude_deg.yaw_identifiable = true;
+    let v = view(&flipped, &numbers).unwrap();
+    assert!(v.biases[3].plain.contains('±'), "{}", v.biases[3].plain);
+    assert_eq!(v.attitude[2].determined, Some(true));
+    assert!(v.attitude_html[1].starts_with("The yaw is determined"));
+}
