@@ -177,6 +177,20 @@ fn the_noise_sentences_follow_the_numbers() {
         "{}",
         said[0]
     );
+    // With more than one key, the others are still said to be determined.
+    assert_eq!(
+        said[0].starts_with("The drive determines"),
+        open.estimated
+            .summary
+            .noise_estimate
+            .as_ref()
+            .unwrap()
+            .keys
+            .len()
+            > 1,
+        "{}",
+        said[0]
+    );
     let first = &open.estimated.summary.noise_estimate.as_ref().unwrap().keys[0];
     assert!(words::key_words(first).contains("only a lower bound"));
     // The same whiteness verdicts in both runs, then one flipped.

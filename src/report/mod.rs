@@ -43,6 +43,7 @@ pub mod prose;
 pub mod quantities;
 pub mod real_drive;
 pub mod real_drive_3d;
+mod real_drive_3d_noise;
 pub mod real_drive_3d_words;
 pub mod registry;
 pub mod rich;
