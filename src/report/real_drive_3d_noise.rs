@@ -4,7 +4,7 @@
 //! how far the biases move in their σ's.
 
 use super::calibration_imu_words::listed;
-use crate::calibrate::imu::noise::{ImuKey, KeyEstimate};
+use crate::calibrate::imu::noise::{ImuKey, KeyEstimate, NoiseEstimate};
 use crate::calibrate::imu::summary::Summary;
 use crate::format::{fixed, sig};
 use crate::study::drive3d::RealDrive3d;
@@ -57,6 +57,40 @@ pub fn noise_findings(d: &RealDrive3d) -> Vec<String> {
     let Some(est) = &e.noise_estimate else {
         return Vec::new();
     };
+    let mut out = vec![keys_sentence(est, p)];
+    let moved = if e.nis.verdict == p.nis.verdict {
+        format!("its verdict stays {}", e.nis.verdict)
+    } else {
+        format!(
+            "its verdict turns from {} to {}",
+            p.nis.verdict, e.nis.verdict
+        )
+    };
+    let side = |s: &Summary| {
+        if s.nis.sum < s.nis.lower {
+            "below"
+        } else if s.nis.sum > s.nis.upper {
+            "above"
+        } else {
+            "inside"
+        }
+    };
+    out.push(format!(
+        "With the estimate the NIS sum moves from {} to {} ({} its band [{}, {}]) and {moved}{}.",
+        sig(p.nis.sum, 4),
+        sig(e.nis.sum, 4),
+        side(e),
+        sig(e.nis.lower, 4),
+        sig(e.nis.upper, 4),
+        whiteness_change(p, e)
+    ));
+    out.push(bias_change(p, e));
+    out
+}
+
+/// The keys the drive determines, each with its interval and against the default `p` assumed,
+/// then those it leaves open.
+fn keys_sentence(est: &NoiseEstimate, p: &Summary) -> String {
     let open: Vec<&str> = est
         .keys
         .iter()
@@ -111,35 +145,7 @@ pub fn noise_findings(d: &RealDrive3d) -> Vec<String> {
             listed(&open.iter().map(|k| k.to_string()).collect::<Vec<_>>())
         )
     };
-    let mut out = vec![format!("{determined}{left_open}").trim_end().to_string()];
-    let moved = if e.nis.verdict == p.nis.verdict {
-        format!("its verdict stays {}", e.nis.verdict)
-    } else {
-        format!(
-            "its verdict turns from {} to {}",
-            p.nis.verdict, e.nis.verdict
-        )
-    };
-    let side = |s: &Summary| {
-        if s.nis.sum < s.nis.lower {
-            "below"
-        } else if s.nis.sum > s.nis.upper {
-            "above"
-        } else {
-            "inside"
-        }
-    };
-    out.push(format!(
-        "With the estimate the NIS sum moves from {} to {} ({} its band [{}, {}]) and {moved}{}.",
-        sig(p.nis.sum, 4),
-        sig(e.nis.sum, 4),
-        side(e),
-        sig(e.nis.lower, 4),
-        sig(e.nis.upper, 4),
-        whiteness_change(p, e)
-    ));
-    out.push(bias_change(p, e));
-    out
+    format!("{determined}{left_open}").trim_end().to_string()
 }
 
 /// The largest change of a bias between the two runs, in its σ, and any bias whose
