@@ -158,12 +158,14 @@ pub fn count(n: u64) -> String {
 
 /// A probability as a percentage: 0.01 → "1 %".
 pub fn percent(p: f64) -> String {
-    format!(
-        "{}\u{202F}%",
-        sig(100.0 * p, 3)
-            .trim_end_matches('0')
-            .trim_end_matches('.')
-    )
+    let s = sig(100.0 * p, 3);
+    // Only a fraction's trailing zeros go: 100 stays "100", not "1".
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
+    format!("{s}\u{202F}%")
 }
 
 #[cfg(test)]
@@ -230,5 +232,7 @@ mod tests {
         assert_eq!(count(1_234_567), "1\u{202F}234\u{202F}567");
         assert_eq!(percent(0.01), "1\u{202F}%");
         assert_eq!(percent(0.05), "5\u{202F}%");
+        assert_eq!(percent(1.0), "100\u{202F}%");
+        assert_eq!(percent(0.1), "10\u{202F}%");
     }
 }

@@ -51,6 +51,8 @@ fn default_study() -> &'static Study {
             .unwrap()
             .with_real_drive()
             .unwrap()
+            .with_real_drive_3d()
+            .unwrap()
     })
 }
 

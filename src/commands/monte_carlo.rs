@@ -30,7 +30,8 @@ pub(super) fn run_report(args: &ReportArgs) -> Result<()> {
         .with_drift(&mut bar)?
         .with_ins(&mut bar)?
         .with_noise(study::noise::NOISE_DRIVES, &mut bar)?
-        .with_real_drive()?;
+        .with_real_drive()?
+        .with_real_drive_3d()?;
     let static_noise = accelcal::allan::section::report_coverage()?;
     let command = reproduce_command(args);
     let input = report::ReportInput {

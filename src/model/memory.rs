@@ -48,7 +48,7 @@ impl Work {
         match self {
             Work::Ensemble => (0.0, 24.0, 2048.0),
             Work::Sensitivity => (0.0, 24.0, 6144.0),
-            Work::Report => (128.0 * 1048576.0, 24.0, 13312.0),
+            Work::Report => (144.0 * 1048576.0, 24.0, 13312.0),
             Work::Simulate => (0.0, 640.0, 1024.0),
         }
     }

@@ -93,7 +93,7 @@ pub struct ImuCalibrationPage<'a> {
 }
 
 /// `x ± σ unit`: σ to two significant digits, `x` to the same decimal place.
-fn with_sigma(x: f64, s: f64, unit: &str) -> String {
+pub(super) fn with_sigma(x: f64, s: f64, unit: &str) -> String {
     if !(x.is_finite() && s.is_finite() && s > 0.0) {
         return format!("{} {unit}", sig(x, 4));
     }
@@ -102,7 +102,7 @@ fn with_sigma(x: f64, s: f64, unit: &str) -> String {
 }
 
 /// `[lo, hi] unit` with the digits that tell the ends apart.
-fn interval_text(x: f64, lo: f64, hi: f64, unit: &str) -> String {
+pub(super) fn interval_text(x: f64, lo: f64, hi: f64, unit: &str) -> String {
     let (_, lo, hi) = interval(x, lo, hi, 2);
     format!("[{lo}, {hi}] {unit}")
 }
@@ -204,7 +204,7 @@ fn alignment_rows(s: &Summary) -> Vec<Row> {
 }
 
 /// The NIS test and each component's whiteness.
-fn test_rows(s: &Summary) -> Vec<TestRow> {
+pub(super) fn test_rows(s: &Summary) -> Vec<TestRow> {
     let n = &s.nis;
     let mut rows = vec![TestRow {
         test: format!("NIS over the {} fixes", count(n.fixes as u64)),

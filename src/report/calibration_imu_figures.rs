@@ -56,10 +56,10 @@ pub fn figures(
     let t: Vec<f64> = r.iter().map(|f| f.t_s).collect();
     Ok(vec![
         track(c, &t)?,
-        biases(c, smoothed, &t)?,
+        biases(c, smoothed, &t, ("fig-imu-biases", 2))?,
         attitude(c, smoothed, &t)?,
         innovations(c, &t)?,
-        nis(c, s, &t)?,
+        nis(c, s, &t, ("fig-imu-nis", 5))?,
     ])
 }
 
@@ -94,8 +94,14 @@ fn track(c: &Calibrated, t: &[f64]) -> Result<FigureView, RenderError> {
     )
 }
 
-/// Figure 2: the six biases, filtered and smoothed, ±σ.
-fn biases(c: &Calibrated, sm: &[Smoothed], t: &[f64]) -> Result<FigureView, RenderError> {
+/// Figure 2: the six biases, filtered and smoothed, ±σ; `(id, number)` its element id and
+/// number.
+pub(super) fn biases(
+    c: &Calibrated,
+    sm: &[Smoothed],
+    t: &[f64],
+    (id, number): (&str, usize),
+) -> Result<FigureView, RenderError> {
     let r = &c.records;
     let mut series = Vec::new();
     for i in 0..6 {
@@ -130,8 +136,8 @@ fn biases(c: &Calibrated, sm: &[Smoothed], t: &[f64]) -> Result<FigureView, Rend
         });
     }
     figure(
-        "fig-imu-biases",
-        2,
+        id,
+        number,
         "The six biases",
         "The gyro biases (rad/s, top) and the accelerometer biases (m/s², bottom) in body axes at each fix: the filtered estimate after the fix's update and the smoothed one (Rauch–Tung–Striebel over every fix), each with ±1σ. The axes are fitted after the first second, where the prior's σ has collapsed; a band that stays wide is a bias the drive does not determine.",
         imu_estimates(&series),
@@ -231,8 +237,14 @@ fn innovations(c: &Calibrated, t: &[f64]) -> Result<FigureView, RenderError> {
     )
 }
 
-/// Figure 5: the NIS of every fix against the χ²(mᵢ) band of its own mᵢ.
-fn nis(c: &Calibrated, s: &Summary, t: &[f64]) -> Result<FigureView, RenderError> {
+/// Figure 5: the NIS of every fix against the χ²(mᵢ) band of its own mᵢ; `(id, number)` its
+/// element id and number.
+pub(super) fn nis(
+    c: &Calibrated,
+    s: &Summary,
+    t: &[f64],
+    (id, number): (&str, usize),
+) -> Result<FigureView, RenderError> {
     let n = &s.nis;
     let alpha = n.false_alarm_rate;
     let bands: Vec<(f64, f64)> = c
@@ -252,8 +264,8 @@ fn nis(c: &Calibrated, s: &Summary, t: &[f64]) -> Result<FigureView, RenderError
         n.verdict
     );
     figure(
-        "fig-imu-nis",
-        5,
+        id,
+        number,
         "Normalized innovations squared",
         &format!(
             "The NIS ν^{{T}}S^{{−1}}ν of each fix, χ²(m_{{i}}) for a consistent filter with m_{{i}} the components the fix measured, against the band that holds it with probability 1 − α = {} (α/2 in each tail); {} fixes are outside in vermillion, about {} would be by chance.",

@@ -45,7 +45,7 @@ pub fn nis_words(s: &Summary) -> String {
 }
 
 /// "a", "a and b", "a, b and c".
-fn listed(items: &[String]) -> String {
+pub(super) fn listed(items: &[String]) -> String {
     match items {
         [] => String::new(),
         [one] => one.clone(),
@@ -115,7 +115,7 @@ pub fn findings(s: &Summary) -> Vec<String> {
 
 /// The whiteness tests in words: a correlated GNSS position error, a velocity model that misses
 /// something slow, or white innovations.
-fn whiteness_findings(s: &Summary) -> Vec<String> {
+pub(super) fn whiteness_findings(s: &Summary) -> Vec<String> {
     let failed = |prefix: &str| -> (Vec<String>, f64) {
         let w: Vec<_> = s
             .whiteness

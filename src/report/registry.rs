@@ -9,7 +9,7 @@
 use super::kind::SectionKind;
 #[cfg(doc)]
 use super::kind::SectionView;
-use super::{drift, ins, noise, real_drive, standard, static_noise};
+use super::{drift, ins, noise, real_drive, real_drive_3d, standard, static_noise};
 
 /// The sections of the report, in reading order (subsections of the results after the results).
 pub const SECTIONS: &[&dyn SectionKind] = &[
@@ -26,6 +26,7 @@ pub const SECTIONS: &[&dyn SectionKind] = &[
     &noise::Noise,
     &real_drive::RealDrive,
     &ins::Ins,
+    &real_drive_3d::RealDrive3dSection,
     &standard::Conclusions,
     &standard::Appendix,
 ];

@@ -9,6 +9,7 @@ pub mod analysis;
 pub mod correlated;
 pub mod drift;
 pub mod drive;
+pub mod drive3d;
 pub mod identify;
 pub mod ins;
 pub mod noise;
@@ -101,6 +102,8 @@ pub struct Study {
     pub drift: Option<drift::DriftStudy>,
     /// The real drive's calibrations, when they were run ([`Study::with_real_drive`]).
     pub real_drive: Option<Vec<drive::DriveRun>>,
+    /// The real drive in three axes, when it was calibrated ([`Study::with_real_drive_3d`]).
+    pub real_drive_3d: Option<drive3d::RealDrive3d>,
     /// Noise statistics estimated from simulated drives, when they were run
     /// ([`Study::with_noise`]).
     pub noise: Option<noise::NoiseStudy>,
@@ -153,6 +156,7 @@ impl Study {
             sensitivity: None,
             drift: None,
             real_drive: None,
+            real_drive_3d: None,
             noise: None,
             white_noise: None,
             ins: None,
@@ -202,6 +206,15 @@ impl Study {
     /// [`crate::calibrate::CalibrateError`] only if the shipped files did not calibrate.
     pub fn with_real_drive(mut self) -> Result<Self, crate::calibrate::CalibrateError> {
         self.real_drive = Some(drive::run()?);
+        Ok(self)
+    }
+
+    /// The study with the shipped minute calibrated in three axes ([`drive3d::run`]).
+    ///
+    /// # Errors
+    /// [`drive3d::Drive3dError`] only if the shipped files did not calibrate.
+    pub fn with_real_drive_3d(mut self) -> Result<Self, drive3d::Drive3dError> {
+        self.real_drive_3d = Some(drive3d::run()?);
         Ok(self)
     }
 
