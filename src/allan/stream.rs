@@ -7,7 +7,7 @@
 //! same stretches and blocks over a window of the phase 2·[`EXACT_MAX_M`] + [`STRETCH`] long: the
 //! same bits as [`deviation::overlapping_avars`] on the whole phase. The longer τ of a log with
 //! more than 2·[`EXACT_MAX_M`] samples are summed at the end from the phase written to a
-//! temporary file as it grows ([`spill`](super::spill)), again in the same stretches and blocks:
+//! temporary file as it grows ([`spill`]), again in the same stretches and blocks:
 //! every τ has the whole-series form's bits.
 //!
 //! The phase is the one of [`deviation::phase`] given the log's mean ȳ (found by a first read):

@@ -2,7 +2,7 @@
 //! crate (0.6.3): that crate hands out the same raw records (chunks, connections, messages)
 //! through a memory map, leaving the connections' fields and the messages to decode as here,
 //! and brings bzip2's C library; a flat scan of the records is about as much code as using it.
-//! The file is read from disk record by record, a chunk at a time ([`visit_ros1`]): memory is
+//! The file is read from disk record by record, a chunk at a time (`visit_ros1`): memory is
 //! one chunk's, whatever the bag's length; `rosbag1_stream::Ros1Records` reads it so for
 //! [`super::stream`]. A chunk is plain or compressed as rosbag compresses: lz4 (the LZ4 frame
 //! format, the `lz4` crate) or bz2 (the `bzip2` crate on its pure-Rust `libbz2-rs-sys`).

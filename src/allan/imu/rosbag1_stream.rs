@@ -1,5 +1,5 @@
 //! A ROS 1 bag's chosen `Imu` topic read from disk record by record, a chunk at a time
-//! ([`visit_ros1`]), as [`Record`]s for [`super::stream`]: no bag is held whole.
+//! (`visit_ros1`), as [`Record`]s for [`super::stream`]: no bag is held whole.
 
 use std::cell::Cell;
 use std::collections::BTreeMap;
