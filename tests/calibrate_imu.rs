@@ -3,16 +3,18 @@
 //! control; the same numbers from the same recording in other forms (forward-left-up axes,
 //! increments, gzip, fixes missing); and bad recordings refused with file, line and field.
 
+mod common;
+
+use accelcal::calibrate::imu::Settings;
 use accelcal::calibrate::imu::run::{Calibrated, calibrate};
 use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary};
-use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ins::{Axes, InsConfig};
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Study;
 use accelcal::logs::read::LogText;
+use common::imu::{band, settings_of};
 use rayon::prelude::*;
-use statrs::distribution::{Binomial, DiscreteCDF};
 
 /// The recordings of the coverage study.
 const RECORDINGS: u64 = 100;
@@ -48,30 +50,6 @@ fn recording(study: &Study, index: u64) -> Recording {
         gnss: String::from_utf8(gnss).expect("text"),
         truth: std::array::from_fn(|i| last[10 + i]),
         middle: (mid[0], std::array::from_fn(|i| mid[10 + i])),
-    }
-}
-
-/// The assumptions that match the simulated sensors: the study's own statistics.
-fn settings_of(study: &Study) -> Settings {
-    let imu = &study.filter_imu;
-    let gnss = &study.filter_gnss;
-    let tau = |b: accelcal::ins::sensors::BiasProcess| {
-        let d = b.decay_per_s();
-        (d > 0.0).then(|| 1.0 / d)
-    };
-    Settings {
-        gyro_arw_rad_per_sqrt_s: imu.gyro_arw_rad_per_sqrt_s,
-        accel_vrw_m_s_per_sqrt_s: imu.accel_vrw_m_s_per_sqrt_s,
-        gyro_bias_sigma_rad_s: imu.gyro_bias.initial_sigma(),
-        gyro_bias_random_walk_rad_s_per_sqrt_s: 0.0,
-        gyro_bias_correlation_time_s: tau(imu.gyro_bias),
-        accel_bias_sigma_m_s2: imu.accel_bias.initial_sigma(),
-        accel_bias_random_walk_m_s2_per_sqrt_s: 0.0,
-        accel_bias_correlation_time_s: tau(imu.accel_bias),
-        gnss_position_sigma_m: gnss.position_sigma_m.into(),
-        gnss_velocity_sigma_m_s: gnss.velocity_sigma_m_s.x,
-        gnss_lever_arm_m: gnss.lever_arm_b_m.into(),
-        ..CONSUMER
     }
 }
 
@@ -121,16 +99,6 @@ fn z_scores(s: &Summary, truth: &[f64; 6]) -> [f64; 6] {
     })
 }
 
-/// The band of the count of n trials inside a 95 % interval at rate α (two-sided).
-fn band(n: u64, alpha: f64) -> (u64, u64) {
-    let b = Binomial::new(0.95, n).expect("valid");
-    let lo = (0..=n).find(|&k| b.cdf(k) > alpha / 2.0).expect("some k");
-    let hi = (0..=n)
-        .find(|&k| b.cdf(k) >= 1.0 - alpha / 2.0)
-        .expect("some k");
-    (lo, hi)
-}
-
 /// The six biases recovered against the truth over 100 recordings of the default 10-minute
 /// drive — filtered at the end, and smoothed at the middle — each axis inside the binomial band
 /// of a 95 % interval at α = 1 % split over the twelve; the same recordings with the σ's halved
@@ -156,7 +124,7 @@ fn biases_are_within_their_sigmas_over_many_recordings() {
         runs.iter().all(|r| r.2),
         "a smoothed σ above the filtered one"
     );
-    let (lo, hi) = band(RECORDINGS, FALSE_ALARM / 12.0);
+    let (lo, hi) = band(RECORDINGS, 0.95, FALSE_ALARM / 12.0);
     let names = ["bgx", "bgy", "bgz", "bax", "bay", "baz"];
     for (k, name) in names.iter().enumerate() {
         let smoothed = runs.iter().filter(|r| r.1[k] <= 1.959_964).count() as u64;

@@ -11,15 +11,15 @@
 
 mod common;
 
+use accelcal::calibrate::imu::Settings;
 use accelcal::calibrate::imu::run::calibrate;
 use accelcal::calibrate::imu::summary::{Summary, summary};
-use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ins::InsConfig;
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Study;
 use accelcal::logs::read::LogText;
+use common::imu::{band, settings_of};
 use rayon::prelude::*;
-use statrs::distribution::{Binomial, DiscreteCDF};
 
 /// The recordings of the coverage study (about 1.3 core-seconds each in release: 40 s on 2 idle cores).
 const RECORDINGS: u64 = 60;
@@ -124,30 +124,6 @@ fn jittered(rows: &[[f64; 7]], seed: u64) -> (String, usize) {
     aggregate(rows, || 2 + (splitmix(&mut state) % 3) as usize)
 }
 
-/// The assumptions that match the simulated sensors: the study's own statistics.
-fn settings_of(study: &Study) -> Settings {
-    let imu = &study.filter_imu;
-    let gnss = &study.filter_gnss;
-    let tau = |b: accelcal::ins::sensors::BiasProcess| {
-        let d = b.decay_per_s();
-        (d > 0.0).then(|| 1.0 / d)
-    };
-    Settings {
-        gyro_arw_rad_per_sqrt_s: imu.gyro_arw_rad_per_sqrt_s,
-        accel_vrw_m_s_per_sqrt_s: imu.accel_vrw_m_s_per_sqrt_s,
-        gyro_bias_sigma_rad_s: imu.gyro_bias.initial_sigma(),
-        gyro_bias_random_walk_rad_s_per_sqrt_s: 0.0,
-        gyro_bias_correlation_time_s: tau(imu.gyro_bias),
-        accel_bias_sigma_m_s2: imu.accel_bias.initial_sigma(),
-        accel_bias_random_walk_m_s2_per_sqrt_s: 0.0,
-        accel_bias_correlation_time_s: tau(imu.accel_bias),
-        gnss_position_sigma_m: gnss.position_sigma_m.into(),
-        gnss_velocity_sigma_m_s: gnss.velocity_sigma_m_s.x,
-        gnss_lever_arm_m: gnss.lever_arm_b_m.into(),
-        ..CONSUMER
-    }
-}
-
 fn run(imu: &str, gnss: &str, s: &Settings) -> Summary {
     let (i, g) = (
         LogText::new("imu.csv", imu.as_bytes()),
@@ -170,16 +146,6 @@ fn biases(s: &Summary) -> [(f64, f64); 6] {
 fn z_scores(s: &Summary, truth: &[f64; 6]) -> [f64; 6] {
     let b = biases(s);
     std::array::from_fn(|i| (b[i].0 - truth[i]).abs() / b[i].1)
-}
-
-/// The band of the count of n trials inside an interval of probability p at rate α (two-sided).
-fn band(n: u64, p: f64, alpha: f64) -> (u64, u64) {
-    let b = Binomial::new(p, n).expect("valid");
-    let lo = (0..=n).find(|&k| b.cdf(k) > alpha / 2.0).expect("some k");
-    let hi = (0..=n)
-        .find(|&k| b.cdf(k) >= 1.0 - alpha / 2.0)
-        .expect("some k");
-    (lo, hi)
 }
 
 /// How many fixes of `gnss` fall strictly between two rows of `imu`.
