@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::mcap_stream::{McapEvent, McapRecords, visit_mcap};
-use super::stream::ImuRecords;
+use super::stream::{ImuRecords, Record};
 use super::{Channel, ImuSamples};
 use crate::allan::log::{first_gap, median_step};
 use crate::logs::{LogError, LogProblem};
@@ -39,6 +39,23 @@ pub struct ImuMessage {
     pub angular_velocity: [f64; 3],
     /// linear_acceleration x, y, z, m/s².
     pub linear_acceleration: [f64; 3],
+}
+
+impl ImuMessage {
+    /// The record of this message, the `at`-th of its topic: its stamp in seconds from the
+    /// whole second `sec0` holds (the first message's, which sets it), the accelerometers' values
+    /// then the gyros'.
+    pub fn record(&self, sec0: &std::cell::Cell<Option<i64>>, at: u64) -> Record {
+        let first = sec0.get().unwrap_or(i64::from(self.sec));
+        sec0.set(Some(first));
+        let [ax, ay, az] = self.linear_acceleration;
+        let [gx, gy, gz] = self.angular_velocity;
+        Record {
+            t_s: (i64::from(self.sec) - first) as f64 + f64::from(self.nanosec) * 1e-9,
+            values: [ax, ay, az, gx, gy, gz],
+            at,
+        }
+    }
 }
 
 /// Decodes a `sensor_msgs/msg/Imu` message serialized as CDR (OMG DDS-XTypes 1.3, §7.4.3.5:

@@ -159,16 +159,7 @@ impl ImuRecords for McapRecords {
                 if topic != self.topic {
                     return Ok(());
                 }
-                let sec0 = self.sec0.get().unwrap_or(i64::from(m.sec));
-                self.sec0.set(Some(sec0));
-                let t_s = (i64::from(m.sec) - sec0) as f64 + f64::from(m.nanosec) * 1e-9;
-                let [ax, ay, az] = m.linear_acceleration;
-                let [gx, gy, gz] = m.angular_velocity;
-                visit(&Record {
-                    t_s,
-                    values: [ax, ay, az, gx, gy, gz],
-                    at,
-                })
+                visit(&m.record(&self.sec0, at))
             })?;
         }
         self.read_once.set(true);
