@@ -76,7 +76,7 @@ fn measure(label: &str, repeats: usize, n: u64, mut once: impl FnMut(u64)) -> f6
 /// as `propagation` says; the sum of its NEES before each update and NIS.
 fn realization(study: &Study, track: &Track, index: u64, propagation: Propagation) -> f64 {
     let drive = study.drive();
-    let (mut imu, ekf) = accelcal::ins::ensemble::start(study, track, index);
+    let (mut imu, ekf) = accelcal::ins::ensemble::start::<15>(study, track, index);
     let mut ekf = ekf.with_propagation(propagation);
     let g = &study.filter_gnss;
     let dt = 1.0 / study.imu_rate_hz;
@@ -117,7 +117,7 @@ fn main() {
     if let Some(m) = arg("--profile").and_then(|v| v.parse().ok()) {
         // Only the realizations, for `perf record`.
         for l in 0..m {
-            let r = ensemble::realization(&study, &track, l);
+            let r = ensemble::realization::<15>(&study, &track, l);
             assert!(r.is_ok());
             black_box(&r);
         }
@@ -144,7 +144,7 @@ fn main() {
         repeats,
         n,
         |l| {
-            let r = ensemble::realization(&study, &track, l);
+            let r = ensemble::realization::<15>(&study, &track, l);
             assert!(r.is_ok());
             black_box(&r);
         },
@@ -155,7 +155,7 @@ fn main() {
     println!("speed-up over the dense reference: {:.1}×", fast / dense);
     if let Some(m) = arg("--ensemble").and_then(|v| v.parse().ok()) {
         let t = Instant::now();
-        let outcome = ensemble::run(&study, &track, m);
+        let outcome = ensemble::run::<15>(&study, &track, m);
         // Wall time: the figure the ensemble's user waits for.
         let run_s = t.elapsed().as_secs_f64();
         assert!(outcome.is_ok());

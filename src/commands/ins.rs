@@ -16,6 +16,7 @@ use accelcal::error::ConfigError;
 use accelcal::export;
 use accelcal::ins::blocks;
 use accelcal::ins::ensemble::{self as ins_ensemble, InsSums, Track};
+use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::partial::{self, InsPartialHeader};
 use accelcal::ins::setup::Study;
@@ -103,22 +104,39 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         .into());
     }
     if let (Some(shard), Some(path)) = (&args.shard, &args.partial) {
+        if study.error_states > STATES {
+            return Err(ConfigError::invalid(
+                "filter.error_states",
+                study.error_states,
+                "15 with --shard (a 21-state ensemble runs whole, in one process)",
+            )
+            .into());
+        }
         return run_shard(&config, &study, shard, path, args.model.quiet);
     }
     if let Some(path) = &args.json {
         accelcal::output::check_file(path)?;
     }
+    if study.error_states > STATES {
+        run_whole::<STATES_WITH_SCALE>(args, &config, &study)
+    } else {
+        run_whole::<STATES>(args, &config, &study)
+    }
+}
+
+/// The whole ensemble of `study` with an error state of `N`, in one process, and its JSON.
+fn run_whole<const N: usize>(args: &EnsembleArgs, config: &InsConfig, study: &Study) -> Result<()> {
     let start = std::time::Instant::now();
-    let track = Track::of(&study);
+    let track = Track::of(study);
     let n = study.realizations;
     let mut bar = super::Bar::new(args.model.quiet);
     bar.start("ins", n);
-    let sums = ins_ensemble::sums(&study, &track, n, |done| bar.advance(done))?;
+    let sums = ins_ensemble::sums::<N>(study, &track, n, |done| bar.advance(done))?;
     bar.finish();
     let elapsed_s = start.elapsed().as_secs_f64();
     write_document(
-        &config,
-        &study,
+        config,
+        study,
         &sums,
         elapsed_s,
         args.json.as_deref(),
@@ -128,10 +146,10 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
 
 /// The JSON of the ensemble whose sums are `sums` to `json` (standard output when `None`), and
 /// its checks' lines, labelled `label` (none when `None`), when it goes to a file.
-fn write_document(
+fn write_document<const N: usize>(
     config: &InsConfig,
     study: &Study,
-    sums: &InsSums,
+    sums: &InsSums<N>,
     elapsed_s: f64,
     json: Option<&Path>,
     label: Option<&str>,

@@ -84,9 +84,9 @@ pub struct InsEnsembleFile<'a> {
     pub fixes: Vec<FixRecord>,
 }
 
-fn states(c: &Calibration, alpha: f64) -> Vec<StateRecord> {
+fn states<const N: usize>(c: &Calibration<N>, alpha: f64) -> Vec<StateRecord> {
     let band = binomial_band(c.realizations, 0.95, alpha);
-    VARIABLES
+    VARIABLES[..N]
         .iter()
         .enumerate()
         .map(|(k, v)| StateRecord {
@@ -102,9 +102,9 @@ fn states(c: &Calibration, alpha: f64) -> Vec<StateRecord> {
 }
 
 /// The document of one three-axis ensemble.
-pub fn document<'a>(
+pub fn document<'a, const N: usize>(
     config: &'a InsConfig,
-    outcome: &Outcome,
+    outcome: &Outcome<N>,
     verdicts: &'a Verdicts,
     elapsed_s: f64,
 ) -> InsEnsembleFile<'a> {
@@ -123,7 +123,7 @@ pub fn document<'a>(
             checks: verdicts
                 .checks
                 .iter()
-                .map(|c| CheckRecord::with_names(c, &times, &VARIABLES, &MEASUREMENTS))
+                .map(|c| CheckRecord::with_names(c, &times, &VARIABLES[..N], &MEASUREMENTS))
                 .collect(),
             residual_pairs: ResidualPairs {
                 all_pairs: stats.residual_layout.max_lag().is_none(),

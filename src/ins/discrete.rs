@@ -8,7 +8,12 @@
 //! tested against Van Loan's exact discretization (Van Loan, "Computing integrals involving the
 //! matrix exponential", IEEE TAC 23(3), 1978) over one step.
 
-use super::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, Matrix15, POSITION, STATES, VELOCITY};
+use nalgebra::SVector;
+
+use super::error_state::{
+    ACCEL_BIAS, ACCEL_SCALE, ATTITUDE, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, Square, VELOCITY,
+    has_scale,
+};
 
 /// The white-noise densities that drive the error state, each the same on a sensor's three axes
 /// (so that S = G·Q_c·Gᵀ is diagonal: the rotations C_b^n in G cancel).
@@ -28,8 +33,13 @@ pub struct NoiseDensities {
 impl NoiseDensities {
     /// S = G·Q_c·Gᵀ's diagonal.
     pub fn diagonal(&self) -> [f64; STATES] {
-        let mut s = [0.0; STATES];
-        let mut fill = |first: usize, value: f64| s[first..first + 3].fill(value);
+        self.diagonal_of::<STATES>().into()
+    }
+
+    /// S's diagonal over an error state of `N` (the scale factors, constants, undriven).
+    pub fn diagonal_of<const N: usize>(&self) -> SVector<f64, N> {
+        let mut s = SVector::<f64, N>::zeros();
+        let mut fill = |first: usize, value: f64| s.fixed_rows_mut::<3>(first).fill(value);
         fill(VELOCITY, self.accel_vrw_m_s_per_sqrt_s.powi(2));
         fill(ATTITUDE, self.gyro_arw_rad_per_sqrt_s.powi(2));
         fill(GYRO_BIAS, self.gyro_bias_density);
@@ -39,14 +49,18 @@ impl NoiseDensities {
 }
 
 /// Φ = I + FΔt + (FΔt)²/2.
-pub fn transition(f: &Matrix15, dt: f64) -> Matrix15 {
+pub fn transition<const N: usize>(f: &Square<N>, dt: f64) -> Square<N> {
     let a = f * dt;
-    Matrix15::identity() + a + 0.5 * a * a
+    Square::<N>::identity() + a + 0.5 * a * a
 }
 
 /// Q_d = (Φ·S·Φᵀ + S)·Δt/2 for the diagonal S of `noise`.
-pub fn process_noise(phi: &Matrix15, noise: &NoiseDensities, dt: f64) -> Matrix15 {
-    let s = Matrix15::from_diagonal(&nalgebra::SVector::from(noise.diagonal()));
+pub fn process_noise<const N: usize>(
+    phi: &Square<N>,
+    noise: &NoiseDensities,
+    dt: f64,
+) -> Square<N> {
+    let s = Square::<N>::from_diagonal(&noise.diagonal_of::<N>());
     let q = (phi * s * phi.transpose() + s) * (0.5 * dt);
     // Symmetric to the last bit, as a covariance must be.
     (q + q.transpose()) * 0.5
@@ -56,19 +70,23 @@ pub fn process_noise(phi: &Matrix15, noise: &NoiseDensities, dt: f64) -> Matrix1
 /// exponential to third order, Φ = I + A + A²/2 + A³/6 with A = F·T (Groves §3.2.3, eq. 3.34's
 /// power series). Third order because the longest chain of the error dynamics, δb_g → δψ → δv →
 /// δr, has three links: its leading term, −\[f^n×\]·C·T³/6 from δb_g into δr, is kept.
-pub fn transition_third_order(f: &Matrix15, t: f64) -> Matrix15 {
+pub fn transition_third_order<const N: usize>(f: &Square<N>, t: f64) -> Square<N> {
     let a = f * t;
     let a2 = dynamics_times(&a, &a);
     let a3 = dynamics_times(&a, &a2);
-    Matrix15::identity() + a + a2 * 0.5 + a3 * (1.0 / 6.0)
+    Square::<N>::identity() + a + a2 * 0.5 + a3 * (1.0 / 6.0)
 }
 
 /// Q_d = ∫₀^T e^(Fs)·S·e^(Fᵀs) ds over an interval T, by the power series of Van Loan's integral
 /// (Van Loan 1978, eq. 1.3, expanded): Q_d = Σ_{k=0}^{4} M_k·T^(k+1)/(k+1)! with M₀ = S and
 /// M_k = F·M_(k−1) + M_(k−1)·Fᵀ. Four terms past S carry the angle random walk through
 /// δψ → δv → δr (its T⁵/20 term) and the velocity random walk into δr (T³/3).
-pub fn process_noise_series(f: &Matrix15, noise: &NoiseDensities, t: f64) -> Matrix15 {
-    let mut m = Matrix15::from_diagonal(&nalgebra::SVector::from(noise.diagonal()));
+pub fn process_noise_series<const N: usize>(
+    f: &Square<N>,
+    noise: &NoiseDensities,
+    t: f64,
+) -> Square<N> {
+    let mut m = Square::<N>::from_diagonal(&noise.diagonal_of::<N>());
     let mut factor = t;
     let mut q = m * factor;
     for k in 1..=4 {
@@ -92,11 +110,32 @@ pub const DYNAMICS_BLOCKS: [(usize, &[usize]); 5] = [
     (ACCEL_BIAS, &[ACCEL_BIAS]),
 ];
 
-/// F·X for an F of [`DYNAMICS_BLOCKS`]' pattern: 12 of the 25 blocks, 1 620 multiply-adds
-/// against a dense product's 3 375.
-pub fn dynamics_times(f: &Matrix15, x: &Matrix15) -> Matrix15 {
-    let mut out = Matrix15::zeros();
-    for (row, columns) in DYNAMICS_BLOCKS {
+/// [`DYNAMICS_BLOCKS`] with the scale factors: velocity from the accelerometers' and attitude
+/// from the gyros' (the scale factors' own rows are zero: constants).
+pub const DYNAMICS_BLOCKS_WITH_SCALE: [(usize, &[usize]); 5] = [
+    (POSITION, &[POSITION, VELOCITY]),
+    (
+        VELOCITY,
+        &[POSITION, VELOCITY, ATTITUDE, ACCEL_BIAS, ACCEL_SCALE],
+    ),
+    (
+        ATTITUDE,
+        &[POSITION, VELOCITY, ATTITUDE, GYRO_BIAS, GYRO_SCALE],
+    ),
+    (GYRO_BIAS, &[GYRO_BIAS]),
+    (ACCEL_BIAS, &[ACCEL_BIAS]),
+];
+
+/// F·X for an F of [`DYNAMICS_BLOCKS`]' pattern (or [`DYNAMICS_BLOCKS_WITH_SCALE`]' with 21
+/// states): 12 of the 25 blocks, 1 620 multiply-adds against a dense product's 3 375.
+pub fn dynamics_times<const N: usize>(f: &Square<N>, x: &Square<N>) -> Square<N> {
+    let mut out = Square::<N>::zeros();
+    let blocks: &[(usize, &[usize])] = if has_scale(N) {
+        &DYNAMICS_BLOCKS_WITH_SCALE
+    } else {
+        &DYNAMICS_BLOCKS
+    };
+    for &(row, columns) in blocks {
         let mut rows = out.fixed_rows_mut::<3>(row);
         for &column in columns {
             rows.gemm(
@@ -112,12 +151,12 @@ pub fn dynamics_times(f: &Matrix15, x: &Matrix15) -> Matrix15 {
 
 /// ΦPΦᵀ for a symmetric P and a Φ whose bias rows are diagonal (F's bias blocks are: the
 /// biases' decay), as Φ·(Φ·P)ᵀ: the first nine rows of each product dense, the last six scaled.
-pub fn transition_congruence(phi: &Matrix15, p: &Matrix15) -> Matrix15 {
-    let times = |x: &Matrix15| {
-        let mut out = Matrix15::zeros();
+pub fn transition_congruence<const N: usize>(phi: &Square<N>, p: &Square<N>) -> Square<N> {
+    let times = |x: &Square<N>| {
+        let mut out = Square::<N>::zeros();
         out.fixed_rows_mut::<GYRO_BIAS>(0)
             .gemm(1.0, &phi.fixed_rows::<GYRO_BIAS>(0), x, 0.0);
-        for i in GYRO_BIAS..STATES {
+        for i in GYRO_BIAS..N {
             out.row_mut(i).copy_from(&(x.row(i) * phi[(i, i)]));
         }
         out

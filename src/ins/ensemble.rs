@@ -19,7 +19,9 @@ use crate::ensemble::{EnsembleStats, ResidualLayout};
 
 use super::blocks::{self, CHUNK};
 use super::earth::offset;
-use super::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, POSITION, STATES, VELOCITY};
+use super::error_state::{
+    ACCEL_BIAS, ACCEL_SCALE, ATTITUDE, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, VELOCITY, has_scale,
+};
 use super::filter::{Ekf, FilterError};
 use super::gnss;
 use super::logs::fix;
@@ -29,52 +31,55 @@ use super::setup::Study;
 use super::truth::Truth;
 use crate::ensemble::Partition;
 
+mod memory;
+pub use memory::memory_bytes;
+
 /// The GNSS measurement's rows: position and velocity, NED.
 pub const MEASURED: usize = 6;
 
 /// The normalized sums of the three-axis ensemble.
-pub type Sums = NormalizedSums<STATES, MEASURED>;
+pub type Sums<const N: usize = STATES> = NormalizedSums<N, MEASURED>;
 
 /// One realization's fixes, normalized by its own covariances, and its errors and σ's at the end.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Normalized {
+pub struct Normalized<const N: usize = STATES> {
     /// Every fix, normalized.
-    pub fixes: Vec<NormalizedFix<STATES, MEASURED>>,
+    pub fixes: Vec<NormalizedFix<N, MEASURED>>,
     /// The a posteriori error at the last fix.
-    pub final_error: SVector<f64, STATES>,
+    pub final_error: SVector<f64, N>,
     /// The filter's a posteriori σ at the last fix.
-    pub final_sigma: SVector<f64, STATES>,
+    pub final_sigma: SVector<f64, N>,
 }
 
 /// What the ensemble says of the calibration at the end of the drive, per error state.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Calibration {
+pub struct Calibration<const N: usize = STATES> {
     /// Realizations N.
     pub realizations: u64,
     /// The filter's σ at the last fix, root mean square over the ensemble.
-    pub filter_sigma: [f64; STATES],
+    pub filter_sigma: [f64; N],
     /// The achieved error at the last fix, root mean square over the ensemble.
-    pub achieved_rms: [f64; STATES],
+    pub achieved_rms: [f64; N],
     /// Realizations whose final |error| / σ is within the two-sided 95 % bound 1.96.
-    pub within_95: [u64; STATES],
+    pub within_95: [u64; N],
 }
 
 /// The ensemble's sums: the normalized ones the checks read, and the raw ones at the end.
 #[derive(Clone, Debug, PartialEq)]
-pub struct InsSums {
+pub struct InsSums<const N: usize = STATES> {
     /// The normalized sums.
-    pub normalized: Sums,
+    pub normalized: Sums<N>,
     /// Σ e² at the last fix.
-    pub sq_error: SVector<f64, STATES>,
+    pub sq_error: SVector<f64, N>,
     /// Σ σ² at the last fix.
-    pub variance: SVector<f64, STATES>,
+    pub variance: SVector<f64, N>,
     /// Realizations whose final |e|/σ ≤ 1.96, per state.
-    pub within_95: [u64; STATES],
+    pub within_95: [u64; N],
 }
 
-impl InsSums {
+impl<const N: usize> InsSums<N> {
     /// Adds one realization.
-    pub fn add(&mut self, r: &Normalized) {
+    pub fn add(&mut self, r: &Normalized<N>) {
         self.normalized.add(&r.fixes);
         self.sq_error += r.final_error.component_mul(&r.final_error);
         self.variance += r.final_sigma.component_mul(&r.final_sigma);
@@ -84,7 +89,7 @@ impl InsSums {
     }
 
     /// Adds `other`, the sums of other realizations of the same ensemble.
-    pub fn merge(&mut self, other: &InsSums) {
+    pub fn merge(&mut self, other: &InsSums<N>) {
         self.normalized.merge(&other.normalized);
         self.sq_error += other.sq_error;
         self.variance += other.variance;
@@ -94,7 +99,7 @@ impl InsSums {
     }
 
     /// The statistics the checks read and the calibration, for the ensemble of `study`.
-    pub fn outcome(&self, study: &Study) -> Outcome {
+    pub fn outcome(&self, study: &Study) -> Outcome<N> {
         Outcome {
             stats: self.normalized.stats(constant_states(study)),
             calibration: self.calibration(),
@@ -102,9 +107,9 @@ impl InsSums {
     }
 
     /// The calibration at the end of the drive.
-    pub fn calibration(&self) -> Calibration {
+    pub fn calibration(&self) -> Calibration<N> {
         let n = self.normalized.sums.count;
-        let rms = |v: &SVector<f64, STATES>| std::array::from_fn(|k| (v[k] / n as f64).sqrt());
+        let rms = |v: &SVector<f64, N>| std::array::from_fn(|k| (v[k] / n as f64).sqrt());
         Calibration {
             realizations: n,
             filter_sigma: rms(&self.variance),
@@ -119,11 +124,11 @@ pub const Z95: f64 = 1.959_963_984_540_054;
 
 /// The ensemble's statistics and its calibration figures.
 #[derive(Clone, Debug)]
-pub struct Outcome {
+pub struct Outcome<const N: usize = STATES> {
     /// The statistics of the normalized quantities, for the checks.
-    pub stats: EnsembleStats<STATES, MEASURED>,
+    pub stats: EnsembleStats<N, MEASURED>,
     /// The calibration at the end.
-    pub calibration: Calibration,
+    pub calibration: Calibration<N>,
 }
 
 /// The drive's truth at every IMU step, shared by the realizations.
@@ -148,9 +153,10 @@ impl Track {
     }
 }
 
-/// The error of `ekf` against the true state and biases, in the error state's coordinates.
-pub fn error(ekf: &Ekf, pva: &Pva, imu: &Imu) -> SVector<f64, STATES> {
-    let mut e = SVector::<f64, STATES>::zeros();
+/// The error of `ekf` against the true state, biases (and scale factors), in the error state's
+/// coordinates.
+pub fn error<const N: usize>(ekf: &Ekf<N>, pva: &Pva, imu: &Imu) -> SVector<f64, N> {
+    let mut e = SVector::<f64, N>::zeros();
     e.fixed_rows_mut::<3>(POSITION)
         .copy_from(&gnss::ned_difference_m(&ekf.pva.position, &pva.position));
     e.fixed_rows_mut::<3>(VELOCITY)
@@ -161,6 +167,12 @@ pub fn error(ekf: &Ekf, pva: &Pva, imu: &Imu) -> SVector<f64, STATES> {
         .copy_from(&(ekf.gyro_bias_rad_s - imu.gyro_bias_rad_s));
     e.fixed_rows_mut::<3>(ACCEL_BIAS)
         .copy_from(&(ekf.accel_bias_m_s2 - imu.accel_bias_m_s2));
+    if has_scale(N) {
+        e.fixed_rows_mut::<3>(GYRO_SCALE)
+            .copy_from(&(ekf.gyro_scale - imu.gyro_scale));
+        e.fixed_rows_mut::<3>(ACCEL_SCALE)
+            .copy_from(&(ekf.accel_scale - imu.accel_scale));
+    }
     e
 }
 
@@ -186,15 +198,15 @@ pub enum RealizationError {
 }
 
 /// What one realization's filter saw at one fix, after its update.
-pub struct FixView<'a> {
+pub struct FixView<'a, const N: usize = STATES> {
     /// The fix's time, s.
     pub t_s: f64,
     /// The fix's index.
     pub fix: usize,
     /// The errors before and after the update, the correction, P and S.
-    pub input: FixInput<STATES, MEASURED>,
+    pub input: FixInput<N, MEASURED>,
     /// The filter after the update.
-    pub ekf: &'a Ekf,
+    pub ekf: &'a Ekf<N>,
     /// The true IMU now (its biases).
     pub imu: &'a Imu,
 }
@@ -202,7 +214,7 @@ pub struct FixView<'a> {
 /// Realization `index`'s true IMU (its prior's draws taken from its stream) and its filter,
 /// started from the truth plus a draw of its prior: position, velocity and attitude errors of
 /// the study's initial σ's, the biases' prior from the filter's model.
-pub fn start(study: &Study, track: &Track, index: u64) -> (Imu, Ekf) {
+pub fn start<const N: usize>(study: &Study, track: &Track, index: u64) -> (Imu, Ekf<N>) {
     let mut imu = study.imu(index);
     let s = &study.initial_sigma;
     let dr = imu.normals(&Vector3::new(s[0], s[1], s[2]));
@@ -215,7 +227,7 @@ pub fn start(study: &Study, track: &Track, index: u64) -> (Imu, Ekf) {
     };
     let ekf = Ekf::new(
         start,
-        study.prior(),
+        study.prior_of::<N>(),
         study.filter_noise(),
         study.filter_decay(),
         study.filter_gnss.lever_arm_b_m,
@@ -230,12 +242,12 @@ pub fn start(study: &Study, track: &Track, index: u64) -> (Imu, Ekf) {
 ///
 /// # Errors
 /// [`RealizationError`] when a covariance stops being positive definite, or `on_fix`'s.
-pub fn filter_realization(
+pub fn filter_realization<const N: usize>(
     study: &Study,
     track: &Track,
     index: u64,
-    mut on_fix: impl FnMut(&FixView) -> Result<(), RealizationError>,
-) -> Result<(Ekf, Imu), RealizationError> {
+    mut on_fix: impl FnMut(&FixView<N>) -> Result<(), RealizationError>,
+) -> Result<(Ekf<N>, Imu), RealizationError> {
     let drive = study.drive();
     let (mut imu, mut ekf) = start(study, track, index);
     let g = &study.filter_gnss;
@@ -291,11 +303,11 @@ pub fn filter_realization(
 ///
 /// # Errors
 /// [`RealizationError`] when a covariance stops being positive definite.
-pub fn realization(
+pub fn realization<const N: usize>(
     study: &Study,
     track: &Track,
     index: u64,
-) -> Result<Normalized, RealizationError> {
+) -> Result<Normalized<N>, RealizationError> {
     let mut out = Vec::with_capacity(track.steps.len() / study.imu_steps_per_fix);
     let (ekf, imu) = filter_realization(study, track, index, |v| {
         let bad = RealizationError::Covariance { index, fix: v.fix };
@@ -330,19 +342,8 @@ pub fn layout(fixes: usize, max_lag: Option<usize>) -> ResidualLayout {
     ResidualLayout::with_width(fixes, MEASURED, Some(max_lag.unwrap_or(DEFAULT_MAX_LAG)))
 }
 
-/// The memory an ensemble of `study` holds, bytes: a chunk of realizations' normalized fixes,
-/// and twice the sums per fix and the residual products (a block's and the total).
-pub fn memory_bytes(study: &Study) -> f64 {
-    let fixes = (study.duration_s * study.imu_rate_hz / study.imu_steps_per_fix as f64).floor();
-    let record = std::mem::size_of::<NormalizedFix<STATES, MEASURED>>() as f64;
-    let per_fix = std::mem::size_of::<crate::ensemble::FixSums<STATES>>() as f64
-        + 2.0 * (STATES * STATES * 8) as f64;
-    let products = layout(fixes as usize, study.residual_max_lag).len() as f64 * 8.0;
-    CHUNK as f64 * fixes * record + 2.0 * (fixes * per_fix + products)
-}
-
 /// Empty sums for `study`'s ensemble.
-pub fn empty_sums(study: &Study, track: &Track) -> InsSums {
+pub fn empty_sums<const N: usize>(study: &Study, track: &Track) -> InsSums<N> {
     let times = fix_times_s(study, track);
     let n = times.len();
     let layout = layout(n, study.residual_max_lag);
@@ -350,7 +351,7 @@ pub fn empty_sums(study: &Study, track: &Track) -> InsSums {
         normalized: NormalizedSums::new(times, &layout, [0, n.saturating_sub(1)]),
         sq_error: SVector::zeros(),
         variance: SVector::zeros(),
-        within_95: [0; STATES],
+        within_95: [0; N],
     }
 }
 
@@ -360,13 +361,13 @@ pub fn empty_sums(study: &Study, track: &Track) -> InsSums {
 ///
 /// # Errors
 /// The first realization's [`RealizationError`], in index order.
-pub fn run_blocks(
+pub fn run_blocks<const N: usize>(
     study: &Study,
     track: &Track,
     blocks: &Partition,
     range: Range<u64>,
     mut progress: impl FnMut(u64),
-    mut on_block: impl FnMut(u64, &InsSums),
+    mut on_block: impl FnMut(u64, &InsSums<N>),
 ) -> Result<(), RealizationError> {
     let mut done = 0;
     for b in range {
@@ -375,7 +376,7 @@ pub fn run_blocks(
         let mut first = indices.start;
         while first < indices.end {
             let last = (first + CHUNK).min(indices.end);
-            let chunk: Vec<Result<Normalized, RealizationError>> = (first..last)
+            let chunk: Vec<Result<Normalized<N>, RealizationError>> = (first..last)
                 .into_par_iter()
                 .map(|l| realization(study, track, l))
                 .collect();
@@ -396,12 +397,12 @@ pub fn run_blocks(
 ///
 /// # Errors
 /// The first realization's [`RealizationError`], in index order.
-pub fn sums(
+pub fn sums<const N: usize>(
     study: &Study,
     track: &Track,
     realizations: u64,
     progress: impl FnMut(u64),
-) -> Result<InsSums, RealizationError> {
+) -> Result<InsSums<N>, RealizationError> {
     let blocks = blocks::partition(realizations);
     let mut total = empty_sums(study, track);
     run_blocks(study, track, &blocks, 0..blocks.blocks, progress, |_, s| {
@@ -411,8 +412,8 @@ pub fn sums(
 }
 
 /// Which error states do not move between fixes: a bias whose truth and filter both hold it
-/// constant.
-pub fn constant_states(study: &Study) -> [bool; STATES] {
+/// constant, and the scale factors (constants in both).
+pub fn constant_states<const N: usize>(study: &Study) -> [bool; N] {
     use super::sensors::BiasProcess::Constant;
     let (t, f) = (&study.truth_imu, &study.filter_imu);
     let gyro = matches!(t.gyro_bias, Constant { .. }) && matches!(f.gyro_bias, Constant { .. });
@@ -420,6 +421,7 @@ pub fn constant_states(study: &Study) -> [bool; STATES] {
     std::array::from_fn(|k| {
         (GYRO_BIAS..GYRO_BIAS + 3).contains(&k) && gyro
             || (ACCEL_BIAS..ACCEL_BIAS + 3).contains(&k) && accel
+            || k >= STATES
     })
 }
 
@@ -427,6 +429,10 @@ pub fn constant_states(study: &Study) -> [bool; STATES] {
 ///
 /// # Errors
 /// The first realization's [`RealizationError`], in index order.
-pub fn run(study: &Study, track: &Track, realizations: u64) -> Result<Outcome, RealizationError> {
+pub fn run<const N: usize>(
+    study: &Study,
+    track: &Track,
+    realizations: u64,
+) -> Result<Outcome<N>, RealizationError> {
     Ok(sums(study, track, realizations, |_| {})?.outcome(study))
 }

@@ -1,11 +1,14 @@
-//! The INS error state of 15 and its continuous-time dynamics F(t), linearized about the
-//! navigation solution.
+//! The INS error state of 15, or 21 with the sensors' scale factors, and its continuous-time
+//! dynamics F(t), linearized about the navigation solution.
 //!
 //! Every error is the estimate minus the truth (Groves §14.2): δr^n the position error in NED
 //! metres (δr_N = (R_N + h)δL, δr_E = (R_E + h)cos L·δλ, δr_D = −δh), δv^n the velocity error,
 //! δψ the attitude error with Ĉ_b^n = (I + \[δψ×\])C_b^n (to first order), δb_g and δb_a the gyro
-//! and accelerometer bias errors. The sensors are compensated by the estimated biases, so
-//! ω̂_ib^b − ω_ib^b = −δb_g and f̂^b − f^b = −δb_a (plus their white noise).
+//! and accelerometer bias errors, and in the 21-state form δs_g and δs_a the errors of the six
+//! scale factors (each sensor reads (1 + s)·x + b + noise per axis). The sensors are compensated
+//! by the estimates, x̂ = (x̃ − b̂)/(1 + ŝ) per axis (KF-GINS's `imuCompensate`), so to first order
+//! ω̂_ib^b − ω_ib^b = −δb_g − diag(ω_ib^b)·δs_g and f̂^b − f^b = −δb_a − diag(f^b)·δs_a (plus
+//! their white noise; Groves §14.2.4 with the scale-factor columns of §14.2.6's augmented state).
 //!
 //! F is the exact Jacobian of the NED navigation equations (Groves §5.4: ṗ = (v_N/(R_N + h),
 //! v_E/((R_E + h)cos L), −v_D), v̇^n = C_b^n f^b + g^n − (2ω_ie^n + ω_en^n) × v^n,
@@ -21,6 +24,8 @@ use super::mech::{Pva, skew};
 
 /// The number of error states.
 pub const STATES: usize = 15;
+/// The number of error states with the scale factors.
+pub const STATES_WITH_SCALE: usize = 21;
 /// The first index of δr^n (NED, m).
 pub const POSITION: usize = 0;
 /// The first index of δv^n (NED, m/s).
@@ -32,8 +37,47 @@ pub const GYRO_BIAS: usize = 9;
 /// The first index of δb_a (body axes, m/s²).
 pub const ACCEL_BIAS: usize = 12;
 
+/// The first index of δs_g (body axes, dimensionless), in the 21-state form.
+pub const GYRO_SCALE: usize = 15;
+/// The first index of δs_a (body axes, dimensionless), in the 21-state form.
+pub const ACCEL_SCALE: usize = 18;
+
 /// A square matrix over the error state.
 pub type Matrix15 = SMatrix<f64, STATES, STATES>;
+
+/// A square matrix over an error state of `N` (15 or 21).
+pub type Square<const N: usize> = SMatrix<f64, N, N>;
+
+/// Whether an error state of `N` carries the scale factors.
+pub const fn has_scale(n: usize) -> bool {
+    n > STATES
+}
+
+/// The sensed motion F's entries are linear in (each a mean over the steps of a covariance
+/// interval, or one step's value).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motion {
+    /// C_b^n.
+    pub c: Matrix3<f64>,
+    /// C_b^n·f^b, m/s².
+    pub f_n: Vector3<f64>,
+    /// C_b^n·diag(f^b), m/s²: the accelerometer scale factors' column block.
+    pub c_f: Matrix3<f64>,
+    /// C_b^n·diag(ω_ib^b), rad/s: the gyro scale factors' column block.
+    pub c_w: Matrix3<f64>,
+}
+
+impl Motion {
+    /// The motion of one step at attitude `c` with specific force `f_b` and rate `w_b`.
+    pub fn of(c: &Matrix3<f64>, f_b: &Vector3<f64>, w_b: &Vector3<f64>) -> Self {
+        Motion {
+            c: *c,
+            f_n: c * f_b,
+            c_f: c * Matrix3::from_diagonal(f_b),
+            c_w: c * Matrix3::from_diagonal(w_b),
+        }
+    }
+}
 
 /// How each bias group decays: 1/τ of a Gauss–Markov bias, 0 for a constant or a random walk, in
 /// 1/s.
@@ -129,7 +173,26 @@ pub fn dynamics_rotating(
     decay: &BiasDecay,
     rotation_rad_s: f64,
 ) -> Matrix15 {
-    let c = *c;
+    let motion = Motion {
+        c: *c,
+        f_n: *f_n,
+        c_f: Matrix3::zeros(),
+        c_w: Matrix3::zeros(),
+    };
+    dynamics_of(pva, &motion, decay, rotation_rad_s)
+}
+
+/// F over an error state of `N` (15, or 21 with the scale factors) for the sensed `motion`, on
+/// an Earth turning at `rotation_rad_s`. The scale factors' columns: δv̇ ∋ −C_b^n·diag(f^b)·δs_a,
+/// δψ̇ ∋ −C_b^n·diag(ω_ib^b)·δs_g (the module's compensation, to first order); the scale factors
+/// are constants (their rows zero).
+pub fn dynamics_of<const N: usize>(
+    pva: &Pva,
+    motion: &Motion,
+    decay: &BiasDecay,
+    rotation_rad_s: f64,
+) -> Square<N> {
+    let (c, f_n) = (motion.c, &motion.f_n);
     let p = &pva.position;
     let v = pva.velocity_ned_m_s;
     let (rn0, re0) = earth::radii_m(p.lat_rad);
@@ -158,7 +221,7 @@ pub fn dynamics_rotating(
     let gravity_p = Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, dg_dlat, 0.0, dg_dh);
     let sv = skew(&v);
 
-    let mut f = Matrix15::zeros();
+    let mut f = Square::<N>::zeros();
     let mut set = |row: usize, col: usize, m: Matrix3<f64>| {
         f.fixed_view_mut::<3, 3>(row, col).copy_from(&m);
     };
@@ -188,5 +251,9 @@ pub fn dynamics_rotating(
         ACCEL_BIAS,
         -decay.accel_per_s * Matrix3::identity(),
     );
+    if has_scale(N) {
+        set(VELOCITY, ACCEL_SCALE, -motion.c_f);
+        set(ATTITUDE, GYRO_SCALE, -motion.c_w);
+    }
     f
 }

@@ -1,24 +1,27 @@
 //! The INS/GNSS error-state extended Kalman filter, closed loop: the mechanization carries the
-//! navigation solution, the filter its 15 errors; each fix corrects the solution and the biases
+//! navigation solution, the filter its 15 errors (21 with the sensors' scale factors: `Ekf<21>`);
+//! each fix corrects the solution, the biases (and the scale factors)
 //! and resets the error state to zero (Groves §14.1.1, closed-loop correction; the arrangement of
 //! KF-GINS's `GIEngine`).
 //!
 //! The update is the Joseph form P⁺ = (I − KH)P(I − KH)ᵀ + KRKᵀ with the gain from a Cholesky
 //! factor of the innovation covariance S = HPHᵀ + R (no explicit inverse).
 
-use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, SVector, Vector3};
 use thiserror::Error;
 
 use super::discrete::{self, NoiseDensities};
 use super::error_state::{
-    self, ACCEL_BIAS, ATTITUDE, BiasDecay, GYRO_BIAS, Matrix15, POSITION, STATES, VELOCITY,
+    self, ACCEL_SCALE, BiasDecay, GYRO_SCALE, Motion, STATES, Square, has_scale,
 };
 use super::gnss::{self, Fix};
 use super::mech::{self, Increment, Pva};
 
+mod correct;
 mod measured;
 mod parts;
 
+pub use correct::apply_correction;
 pub use parts::{LinearView, NOISE_GROUPS};
 
 /// A filter step that cannot go on.
@@ -38,7 +41,7 @@ pub enum FilterError {
 /// What one fix's update saw: the innovation, its covariance and the normalized squared
 /// innovation (NIS).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Innovation {
+pub struct Innovation<const N: usize = STATES> {
     /// The fix's time, s.
     pub t_s: f64,
     /// The innovation ν (position NED m, then velocity NED m/s where measured).
@@ -48,7 +51,7 @@ pub struct Innovation {
     /// νᵀS⁻¹ν.
     pub nis: f64,
     /// The estimated errors K·ν the update took out of the solution.
-    pub correction: SVector<f64, STATES>,
+    pub correction: SVector<f64, N>,
 }
 
 /// How the filter carries its covariance from one IMU step to the next.
@@ -91,24 +94,33 @@ struct Pending {
     c_sum: Matrix3<f64>,
     /// Σ C_b^n f^b (m/s²).
     f_n_sum: Vector3<f64>,
+    /// Σ C_b^n diag(f^b) (m/s²), for the accelerometer scale factors.
+    c_f_sum: Matrix3<f64>,
+    /// Σ C_b^n diag(ω_ib^b) (rad/s), for the gyro scale factors.
+    c_w_sum: Matrix3<f64>,
     /// The solution at the interval's middle step, for F's position and velocity blocks.
     middle: Pva,
 }
 
-/// The filter: the navigation solution, the bias estimates, and the covariance of their errors.
+/// The filter: the navigation solution, the bias estimates (and the scale factors' with `N` =
+/// 21), and the covariance of their errors.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Ekf {
+pub struct Ekf<const N: usize = STATES> {
     /// The navigation solution at the last step.
     pub pva: Pva,
     /// The gyro bias estimate, rad/s.
     pub gyro_bias_rad_s: Vector3<f64>,
     /// The accelerometer bias estimate, m/s².
     pub accel_bias_m_s2: Vector3<f64>,
+    /// The gyro scale factor estimates (dimensionless; zero and held without the scale states).
+    pub gyro_scale: Vector3<f64>,
+    /// The accelerometer scale factor estimates (dimensionless), likewise.
+    pub accel_scale: Vector3<f64>,
     /// The error state's covariance P: current after each update and after the step that ends a
     /// covariance interval. With [`Propagation::Interval`] the intervals divide the time between
     /// the last two fixes, so with evenly spaced fixes P is current at each; [`Ekf::flush`]
     /// brings it up to date anywhere.
-    pub covariance: Matrix15,
+    pub covariance: Square<N>,
     /// The noise densities the filter assumes.
     pub noise: NoiseDensities,
     /// The biases' decay rates the filter assumes.
@@ -130,18 +142,18 @@ pub struct Ekf {
     before: Option<Increment>,
     /// Φ from the last update to the last covariance propagation, when tracked (a smoother
     /// needs it; [`Ekf::with_transition`]).
-    transition: Option<Matrix15>,
+    transition: Option<Square<N>>,
     /// Q_d from the last update split by noise group, each at unit density, when tracked (a
     /// likelihood linearized about the run needs it; [`Ekf::with_noise_parts`]).
-    noise_parts: Option<Box<[Matrix15; NOISE_GROUPS]>>,
+    noise_parts: Option<Box<[Square<N>; NOISE_GROUPS]>>,
 }
 
-impl Ekf {
+impl<const N: usize> Ekf<N> {
     /// A filter starting at `pva` with zero bias estimates and covariance `p0`, propagating its
     /// covariance every [`DEFAULT_COVARIANCE_INTERVAL_S`].
     pub fn new(
         pva: Pva,
-        p0: Matrix15,
+        p0: Square<N>,
         noise: NoiseDensities,
         decay: BiasDecay,
         lever_arm_b_m: Vector3<f64>,
@@ -150,6 +162,8 @@ impl Ekf {
             pva,
             gyro_bias_rad_s: Vector3::zeros(),
             accel_bias_m_s2: Vector3::zeros(),
+            gyro_scale: Vector3::zeros(),
+            accel_scale: Vector3::zeros(),
             covariance: p0,
             noise,
             decay,
@@ -171,14 +185,14 @@ impl Ekf {
     #[must_use]
     pub fn with_transition(mut self) -> Self {
         self.flush();
-        self.transition = Some(Matrix15::identity());
+        self.transition = Some(Square::<N>::identity());
         self
     }
 
     /// Φ from the last update (or the start) to the last covariance propagation, restarted at
     /// the identity; `None` unless tracked.
-    pub fn take_transition(&mut self) -> Option<Matrix15> {
-        self.transition.replace(Matrix15::identity())
+    pub fn take_transition(&mut self) -> Option<Square<N>> {
+        self.transition.replace(Square::<N>::identity())
     }
 
     /// The same filter propagating its covariance as `propagation` says.
@@ -198,11 +212,22 @@ impl Ekf {
         self
     }
 
-    /// The increments `raw` compensated by the bias estimates.
+    /// The increments `raw` compensated by the bias estimates, and with the scale states by
+    /// the scale factor estimates: x̂ = (x̃ − b̂Δt)/(1 + ŝ) per axis (KF-GINS's `imuCompensate`).
     fn compensate(&self, raw: &Increment) -> Increment {
+        let dtheta_rad = raw.dtheta_rad - self.gyro_bias_rad_s * raw.dt_s;
+        let dvel_m_s = raw.dvel_m_s - self.accel_bias_m_s2 * raw.dt_s;
+        if !has_scale(N) {
+            return Increment {
+                dtheta_rad,
+                dvel_m_s,
+                dt_s: raw.dt_s,
+            };
+        }
+        let one = Vector3::repeat(1.0);
         Increment {
-            dtheta_rad: raw.dtheta_rad - self.gyro_bias_rad_s * raw.dt_s,
-            dvel_m_s: raw.dvel_m_s - self.accel_bias_m_s2 * raw.dt_s,
+            dtheta_rad: dtheta_rad.component_div(&(one + self.gyro_scale)),
+            dvel_m_s: dvel_m_s.component_div(&(one + self.accel_scale)),
             dt_s: raw.dt_s,
         }
     }
@@ -215,13 +240,13 @@ impl Ekf {
         let now = self.compensate(raw);
         let before = self.before.unwrap_or(now);
         let f_b = now.dvel_m_s / now.dt_s;
+        let w_b = now.dtheta_rad / now.dt_s;
         match self.propagation {
             Propagation::Dense => {
                 let c = *self.pva.attitude.to_rotation_matrix().matrix();
-                let big_f = error_state::dynamics_rotating(
+                let big_f = error_state::dynamics_of::<N>(
                     &self.pva,
-                    &c,
-                    &(c * f_b),
+                    &Motion::of(&c, &f_b, &w_b),
                     &self.decay,
                     self.earth_rotation_rad_s,
                 );
@@ -233,7 +258,9 @@ impl Ekf {
                 }
                 self.propagate_parts_dense(&phi, now.dt_s);
             }
-            Propagation::Interval { interval_s } => self.gather(&f_b, now.dt_s, interval_s),
+            Propagation::Interval { interval_s } => {
+                self.gather(&f_b, &w_b, now.dt_s, interval_s);
+            }
         }
         self.pva = mech::step_rotating(&self.pva, &before, &now, self.earth_rotation_rad_s);
         self.gyro_bias_rad_s *= (-self.decay.gyro_per_s * now.dt_s).exp();
@@ -245,8 +272,9 @@ impl Ekf {
         }
     }
 
-    /// The step from the solution now with specific force `f_b` over `dt` added to the interval.
-    fn gather(&mut self, f_b: &Vector3<f64>, dt: f64, interval_s: f64) {
+    /// The step from the solution now with specific force `f_b` and rate `w_b` over `dt` added
+    /// to the interval.
+    fn gather(&mut self, f_b: &Vector3<f64>, w_b: &Vector3<f64>, dt: f64, interval_s: f64) {
         let c = *self.pva.attitude.to_rotation_matrix().matrix();
         let period = self.fix_period_steps;
         // Intervals of the nominal length, or of the fix period when that is shorter; one step
@@ -274,6 +302,8 @@ impl Ekf {
             t_s: 0.0,
             c_sum: Matrix3::zeros(),
             f_n_sum: Vector3::zeros(),
+            c_f_sum: Matrix3::zeros(),
+            c_w_sum: Matrix3::zeros(),
             middle: self.pva,
         });
         if pending.steps == pending.target / 2 {
@@ -283,6 +313,10 @@ impl Ekf {
         pending.t_s += dt;
         pending.c_sum += c;
         pending.f_n_sum += c * f_b;
+        if has_scale(N) {
+            pending.c_f_sum += c * Matrix3::from_diagonal(f_b);
+            pending.c_w_sum += c * Matrix3::from_diagonal(w_b);
+        }
     }
 
     /// P brought up to the last step: the pending interval's ΦPΦᵀ + Q_d with F at its steps'
@@ -292,10 +326,15 @@ impl Ekf {
             return;
         };
         let n = p.steps as f64;
-        let big_f = error_state::dynamics_rotating(
+        let motion = Motion {
+            c: p.c_sum / n,
+            f_n: p.f_n_sum / n,
+            c_f: p.c_f_sum / n,
+            c_w: p.c_w_sum / n,
+        };
+        let big_f = error_state::dynamics_of::<N>(
             &p.middle,
-            &(p.c_sum / n),
-            &(p.f_n_sum / n),
+            &motion,
             &self.decay,
             self.earth_rotation_rad_s,
         );
@@ -313,7 +352,7 @@ impl Ekf {
     ///
     /// # Errors
     /// [`FilterError::Innovation`] when S is not positive definite.
-    pub fn update(&mut self, fix: &Fix) -> Result<Innovation, FilterError> {
+    pub fn update(&mut self, fix: &Fix) -> Result<Innovation<N>, FilterError> {
         self.flush();
         self.fix_period_steps = Some(self.steps_since_update);
         self.steps_since_update = 0;
@@ -321,7 +360,7 @@ impl Ekf {
             .before
             .map_or(Vector3::zeros(), |b| b.dtheta_rad / b.dt_s);
         let (position, velocity) = gnss::antenna(&self.pva, &self.lever_arm_b_m, &omega);
-        let h6 = gnss::observation(&self.pva, &self.lever_arm_b_m, &omega);
+        let h6 = gnss::observation_of::<N>(&self.pva, &self.lever_arm_b_m, &omega);
         let z_r = gnss::ned_difference_m(&position, &fix.position);
         let r_r = fix.position_sigma_m.component_mul(&fix.position_sigma_m);
         let (dx, nu, s) = if let Some(v) = fix.velocity_ned_m_s {
@@ -352,11 +391,11 @@ impl Ekf {
     #[allow(clippy::type_complexity)]
     fn joseph<const R: usize>(
         &mut self,
-        h: &SMatrix<f64, R, STATES>,
+        h: &SMatrix<f64, R, N>,
         z: &SVector<f64, R>,
         r: &SVector<f64, R>,
         t_s: f64,
-    ) -> Result<(SVector<f64, STATES>, (DVector<f64>, f64), DMatrix<f64>), FilterError> {
+    ) -> Result<(SVector<f64, N>, (DVector<f64>, f64), DMatrix<f64>), FilterError> {
         let p = &self.covariance;
         let hp = h * p;
         let s = hp * h.transpose() + SMatrix::<f64, R, R>::from_diagonal(r);
@@ -365,7 +404,7 @@ impl Ekf {
         let k = chol.solve(&hp).transpose();
         let nis = z.dot(&chol.solve(z));
         let dx = k * z;
-        let i_kh = Matrix15::identity() - k * h;
+        let i_kh = Square::<N>::identity() - k * h;
         let kr = k * SMatrix::<f64, R, R>::from_diagonal(r);
         let p_new = i_kh * p * i_kh.transpose() + kr * k.transpose();
         self.covariance = (p_new + p_new.transpose()) * 0.5;
@@ -375,35 +414,16 @@ impl Ekf {
     }
 
     /// The closed-loop correction by the estimated errors `dx` ([`apply_correction`]).
-    fn correct(&mut self, dx: &SMatrix<f64, STATES, 1>) {
+    fn correct(&mut self, dx: &SVector<f64, N>) {
         apply_correction(
             &mut self.pva,
             &mut self.gyro_bias_rad_s,
             &mut self.accel_bias_m_s2,
-            dx,
+            &dx.fixed_rows::<STATES>(0).into_owned(),
         );
+        if has_scale(N) {
+            self.gyro_scale -= dx.fixed_rows::<3>(GYRO_SCALE);
+            self.accel_scale -= dx.fixed_rows::<3>(ACCEL_SCALE);
+        }
     }
-}
-
-/// The closed-loop correction by the estimated errors `dx` (estimate minus truth): each part of
-/// the solution and the biases has its error taken out (a smoother applies its own corrections
-/// to a filtered solution the same way).
-pub fn apply_correction(
-    pva: &mut Pva,
-    gyro_bias_rad_s: &mut Vector3<f64>,
-    accel_bias_m_s2: &mut Vector3<f64>,
-    dx: &SMatrix<f64, STATES, 1>,
-) {
-    let p = &mut pva.position;
-    let (rn, re) = super::earth::radii_m(p.lat_rad);
-    let dr = dx.fixed_rows::<3>(POSITION);
-    p.lat_rad -= dr[0] / (rn + p.height_m);
-    p.lon_rad -= dr[1] / ((re + p.height_m) * p.lat_rad.cos());
-    p.height_m += dr[2];
-    pva.velocity_ned_m_s -= dx.fixed_rows::<3>(VELOCITY);
-    // Ĉ = exp([δψ×])C, so C = exp(−[δψ×])Ĉ.
-    let psi = dx.fixed_rows::<3>(ATTITUDE).into_owned();
-    pva.attitude = UnitQuaternion::from_scaled_axis(-psi) * pva.attitude;
-    *gyro_bias_rad_s -= dx.fixed_rows::<3>(GYRO_BIAS);
-    *accel_bias_m_s2 -= dx.fixed_rows::<3>(ACCEL_BIAS);
 }

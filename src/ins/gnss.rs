@@ -9,12 +9,14 @@
 //! - position: z_r = δr − \[(Cl)×\]δψ − w_r;
 //! - velocity: z_v = δv − \[(C(ω_ib × l))×\]δψ + \[ω_in×\]\[(Cl)×\]δψ + C\[l×\]δb_g − w_v,
 //!
-//! where δω_ib^b = −δb_g because the gyros are compensated by the estimated bias.
+//! where δω_ib^b = −δb_g because the gyros are compensated by the estimated bias (and
+//! −δb_g − diag(ω_ib^b)δs_g with the scale factors: the velocity row then has C\[l×\]diag(ω_ib^b)
+//! in δs_g's columns).
 
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use super::earth::{self, Geodetic};
-use super::error_state::{ATTITUDE, GYRO_BIAS, POSITION, STATES, VELOCITY};
+use super::error_state::{ATTITUDE, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, VELOCITY, has_scale};
 use super::mech::{Pva, skew};
 
 /// One GNSS fix: the antenna's position and, when measured, its velocity.
@@ -65,11 +67,21 @@ pub fn observation(
     lever_b_m: &Vector3<f64>,
     omega_ib_b: &Vector3<f64>,
 ) -> SMatrix<f64, 6, STATES> {
+    observation_of(pva, lever_b_m, omega_ib_b)
+}
+
+/// [`observation`] over an error state of `N`: with the scale factors, the antenna velocity's
+/// lever-arm term C_b^n(ω̂_ib^b × l^b) moves with δs_g as with δb_g, times diag(ω_ib^b).
+pub fn observation_of<const N: usize>(
+    pva: &Pva,
+    lever_b_m: &Vector3<f64>,
+    omega_ib_b: &Vector3<f64>,
+) -> SMatrix<f64, 6, N> {
     let c = *pva.attitude.to_rotation_matrix().matrix();
     let arm_n = c * lever_b_m;
     let w_in = earth::earth_rate_ned(pva.position.lat_rad)
         + earth::transport_rate_ned(&pva.position, &pva.velocity_ned_m_s);
-    let mut h = SMatrix::<f64, 6, STATES>::zeros();
+    let mut h = SMatrix::<f64, 6, N>::zeros();
     let mut set = |row: usize, col: usize, m: Matrix3<f64>| {
         h.fixed_view_mut::<3, 3>(row, col).copy_from(&m);
     };
@@ -82,5 +94,12 @@ pub fn observation(
         -skew(&(c * omega_ib_b.cross(lever_b_m))) + skew(&w_in) * skew(&arm_n),
     );
     set(3, GYRO_BIAS, c * skew(lever_b_m));
+    if has_scale(N) {
+        set(
+            3,
+            GYRO_SCALE,
+            c * skew(lever_b_m) * Matrix3::from_diagonal(omega_ib_b),
+        );
+    }
     h
 }

@@ -4,7 +4,7 @@
 use crate::state::Variable;
 
 use super::ensemble::MEASURED;
-use super::error_state::STATES;
+use super::error_state::STATES_WITH_SCALE;
 
 const fn v(
     key: &'static str,
@@ -20,8 +20,9 @@ const fn v(
     }
 }
 
-/// The 15 error states: δr, δv (NED), δψ, δb_g, δb_a (body axes).
-pub const VARIABLES: [Variable; STATES] = [
+/// The error states: δr, δv (NED), δψ, δb_g, δb_a (body axes), then in the 21-state form δs_g,
+/// δs_a (the first 15 are the 15-state form's).
+pub const VARIABLES: [Variable; STATES_WITH_SCALE] = [
     v("position_n", "north position error", "δr_N", "m"),
     v("position_e", "east position error", "δr_E", "m"),
     v("position_d", "down position error", "δr_D", "m"),
@@ -51,6 +52,27 @@ pub const VARIABLES: [Variable; STATES] = [
         "accelerometer bias error, z",
         "δb_az",
         "m/s²",
+    ),
+    v("gyro_scale_x", "gyro scale factor error, x", "δs_gx", "1"),
+    v("gyro_scale_y", "gyro scale factor error, y", "δs_gy", "1"),
+    v("gyro_scale_z", "gyro scale factor error, z", "δs_gz", "1"),
+    v(
+        "accel_scale_x",
+        "accelerometer scale factor error, x",
+        "δs_ax",
+        "1",
+    ),
+    v(
+        "accel_scale_y",
+        "accelerometer scale factor error, y",
+        "δs_ay",
+        "1",
+    ),
+    v(
+        "accel_scale_z",
+        "accelerometer scale factor error, z",
+        "δs_az",
+        "1",
     ),
 ];
 

@@ -5,7 +5,11 @@
 //! Each gyro and accelerometer bias is a first-order Gauss–Markov process (or a constant, or a
 //! random walk) discretized exactly per step, b_{k+1} = e^(−Δt/τ)·b_k + η with
 //! η ~ N(0, σ²(1 − e^(−2Δt/τ))); the white noise adds N(0, ARW²·Δt) to each Δθ and
-//! N(0, VRW²·Δt) to each Δv (angle and velocity random walk: Groves §4.4.3).
+//! N(0, VRW²·Δt) to each Δv (angle and velocity random walk: Groves §4.4.3). Each axis also has
+//! a scale factor s, a constant drawn once from N(0, σ_s²): the sensor reads (1 + s)·x + b·Δt +
+//! noise of the true increment x (Groves §4.4.2, the scale-factor error; cross-coupling left
+//! out). The scale factors come from a stream of their own, so a study without them draws the
+//! same numbers as before they existed.
 
 use nalgebra::Vector3;
 
@@ -14,6 +18,9 @@ use crate::random::{Stream, splitmix64};
 
 /// Key of the random streams of three-axis realizations.
 const STREAM_KEY: u64 = 0x696e_735f_7265_616c;
+
+/// Key of the scale factors' streams.
+const SCALE_KEY: u64 = 0x696e_735f_7363_616c;
 
 /// How one sensor triad's bias moves.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -95,6 +102,10 @@ pub struct ImuModel {
     pub gyro_bias: BiasProcess,
     /// The accelerometer biases' process (m/s²).
     pub accel_bias: BiasProcess,
+    /// The gyro scale factors' σ (dimensionless).
+    pub gyro_scale_sigma: f64,
+    /// The accelerometer scale factors' σ (dimensionless).
+    pub accel_scale_sigma: f64,
 }
 
 /// What one step of a given length draws with: the white noises' σ's and the biases' (φ, σ_η),
@@ -135,6 +146,10 @@ pub struct Imu {
     pub gyro_bias_rad_s: Vector3<f64>,
     /// The accelerometer biases now, m/s².
     pub accel_bias_m_s2: Vector3<f64>,
+    /// The gyro scale factors (dimensionless).
+    pub gyro_scale: Vector3<f64>,
+    /// The accelerometer scale factors (dimensionless).
+    pub accel_scale: Vector3<f64>,
 }
 
 impl Imu {
@@ -146,12 +161,18 @@ impl Imu {
         let mut draw = |sigma: f64| Vector3::from_fn(|_, _| sigma * stream.normal());
         let gyro_bias_rad_s = draw(model.gyro_bias.initial_sigma());
         let accel_bias_m_s2 = draw(model.accel_bias.initial_sigma());
+        let mut scale = Stream::new(splitmix64(seed ^ SCALE_KEY), index);
+        let mut draw = |sigma: f64| Vector3::from_fn(|_, _| sigma * scale.normal());
+        let gyro_scale = draw(model.gyro_scale_sigma);
+        let accel_scale = draw(model.accel_scale_sigma);
         Imu {
             model,
             stream,
             scales: None,
             gyro_bias_rad_s,
             accel_bias_m_s2,
+            gyro_scale,
+            accel_scale,
         }
     }
 
@@ -165,10 +186,13 @@ impl Imu {
         let s = &mut self.stream;
         let (arw, vrw) = (k.angle_sigma, k.velocity_sigma);
         let dtheta = truth.dtheta_rad
+            + truth.dtheta_rad.component_mul(&self.gyro_scale)
             + self.gyro_bias_rad_s * dt
             + Vector3::from_fn(|_, _| arw * s.normal());
-        let dvel =
-            truth.dvel_m_s + self.accel_bias_m_s2 * dt + Vector3::from_fn(|_, _| vrw * s.normal());
+        let dvel = truth.dvel_m_s
+            + truth.dvel_m_s.component_mul(&self.accel_scale)
+            + self.accel_bias_m_s2 * dt
+            + Vector3::from_fn(|_, _| vrw * s.normal());
         let (phi_g, eta_g) = k.gyro_bias;
         let (phi_a, eta_a) = k.accel_bias;
         self.gyro_bias_rad_s =

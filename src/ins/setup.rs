@@ -6,7 +6,9 @@ use nalgebra::Vector3;
 use super::discrete::NoiseDensities;
 use super::drive::Drive;
 use super::earth::Geodetic;
-use super::error_state::{ACCEL_BIAS, BiasDecay, GYRO_BIAS, Matrix15};
+use super::error_state::{
+    ACCEL_BIAS, ACCEL_SCALE, BiasDecay, GYRO_BIAS, GYRO_SCALE, Matrix15, Square, has_scale,
+};
 use super::sensors::{BiasProcess, Imu, ImuModel};
 use crate::config::BiasModelKind;
 use crate::config::ins::{GnssConfig, ImuConfig, InsConfig};
@@ -55,6 +57,8 @@ pub struct Study {
     /// The Earth's rotation rate the filter's mechanization uses, rad/s: the true one, or 0 in
     /// the negative control of a filter that leaves it out.
     pub filter_earth_rotation_rad_s: f64,
+    /// The filter's error states: 15, or 21 with the scale factors.
+    pub error_states: usize,
 }
 
 /// A sensor triad's bias process from its configured model.
@@ -85,6 +89,8 @@ fn imu_model(c: &ImuConfig) -> ImuModel {
             c.accel_bias_correlation_time_s,
             c.accel_bias_random_walk_m_s2_per_sqrt_s,
         ),
+        gyro_scale_sigma: c.gyro_scale_factor_sigma_ppm * 1e-6,
+        accel_scale_sigma: c.accel_scale_factor_sigma_ppm * 1e-6,
     }
 }
 
@@ -126,6 +132,7 @@ impl Study {
             false_alarm_rate: c.checks.false_alarm_rate,
             residual_max_lag: c.checks.residual_max_lag.map(|l| l as usize),
             filter_earth_rotation_rad_s: super::earth::ROTATION_RATE_RAD_S,
+            error_states: c.filter.error_states.unwrap_or(15) as usize,
         })
     }
 
@@ -160,7 +167,12 @@ impl Study {
 
     /// The filter's prior covariance P(0): the navigation σ's and each bias's initial σ.
     pub fn prior(&self) -> Matrix15 {
-        let mut p = Matrix15::zeros();
+        self.prior_of::<{ super::error_state::STATES }>()
+    }
+
+    /// P(0) over an error state of `N`: with the scale factors, each one's σ besides.
+    pub fn prior_of<const N: usize>(&self) -> Square<N> {
+        let mut p = Square::<N>::zeros();
         for (i, s) in self.initial_sigma.iter().enumerate() {
             p[(i, i)] = s * s;
         }
@@ -171,6 +183,16 @@ impl Study {
         for i in 0..3 {
             p[(GYRO_BIAS + i, GYRO_BIAS + i)] = g * g;
             p[(ACCEL_BIAS + i, ACCEL_BIAS + i)] = a * a;
+        }
+        if has_scale(N) {
+            let (g, a) = (
+                self.filter_imu.gyro_scale_sigma,
+                self.filter_imu.accel_scale_sigma,
+            );
+            for i in 0..3 {
+                p[(GYRO_SCALE + i, GYRO_SCALE + i)] = g * g;
+                p[(ACCEL_SCALE + i, ACCEL_SCALE + i)] = a * a;
+            }
         }
         p
     }

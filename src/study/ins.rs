@@ -5,7 +5,7 @@
 use crate::checks::{Budget, Verdicts, evaluate};
 use crate::config::ins::InsConfig;
 use crate::ins::ensemble::{self, Calibration, RealizationError, Track, filter_realization};
-use crate::ins::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS};
+use crate::ins::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, STATES};
 use crate::ins::gnss::ned_difference_m;
 use crate::ins::setup::Study;
 use crate::progress::Progress;
@@ -82,7 +82,7 @@ fn judged(
 /// Realization 0 of `study`, every fix.
 fn trace(study: &Study, track: &Track) -> Result<Trace, RealizationError> {
     let mut t = Trace::default();
-    filter_realization(study, track, 0, |v| {
+    filter_realization::<STATES>(study, track, 0, |v| {
         let p = &v.ekf.covariance;
         let sigma = |k: usize| p[(k, k)].sqrt();
         let (g, a) = (v.ekf.gyro_bias_rad_s, v.ekf.accel_bias_m_s2);

@@ -104,6 +104,10 @@ pub struct ImuConfig {
     pub accel_bias_correlation_time_s: f64,
     /// A random-walk accelerometer bias's K, m/s² per √s.
     pub accel_bias_random_walk_m_s2_per_sqrt_s: f64,
+    /// The gyro scale factors' σ (each axis a constant drawn once), ppm.
+    pub gyro_scale_factor_sigma_ppm: f64,
+    /// The accelerometer scale factors' σ, ppm.
+    pub accel_scale_factor_sigma_ppm: f64,
 }
 
 impl Default for ImuConfig {
@@ -122,6 +126,8 @@ impl Default for ImuConfig {
             accel_bias_sigma_m_s2: 2.451_662_5e-3,
             accel_bias_correlation_time_s: 3600.0,
             accel_bias_random_walk_m_s2_per_sqrt_s: 0.0,
+            gyro_scale_factor_sigma_ppm: 0.0,
+            accel_scale_factor_sigma_ppm: 0.0,
         }
     }
 }
@@ -191,9 +197,13 @@ pub struct InsFilterConfig {
     pub accel_bias_sigma_m_s2: Option<f64>,
     pub accel_bias_correlation_time_s: Option<f64>,
     pub accel_bias_random_walk_m_s2_per_sqrt_s: Option<f64>,
+    pub gyro_scale_factor_sigma_ppm: Option<f64>,
+    pub accel_scale_factor_sigma_ppm: Option<f64>,
     pub gnss_lever_arm_m: Option<[f64; 3]>,
     pub gnss_position_sigma_m: Option<[f64; 3]>,
     pub gnss_velocity_sigma_m_s: Option<f64>,
+    /// The filter's error states: 15, or 21 with the six scale factors.
+    pub error_states: Option<u32>,
 }
 
 /// The Monte Carlo ensemble.
@@ -293,6 +303,8 @@ impl InsConfig {
                 accel_bias_sigma_m_s2,
                 accel_bias_correlation_time_s,
                 accel_bias_random_walk_m_s2_per_sqrt_s,
+                gyro_scale_factor_sigma_ppm,
+                accel_scale_factor_sigma_ppm,
             }
         );
         let gnss = over_truth!(

@@ -82,6 +82,12 @@ impl InsConfig {
         let assumed = self.assumed();
         imu_fields(true, &assumed.imu)?;
         gnss_fields(true, &assumed.gnss)?;
+        self.error_states(&assumed.imu)?;
+        self.checks()
+    }
+
+    /// The ensemble's size, the checks' false-alarm rate and the whiteness check's lag.
+    fn checks(&self) -> Result<(), ConfigError> {
         if self.ensemble.realizations < 2 {
             return Err(ConfigError::invalid(
                 "ensemble.realizations",
@@ -89,11 +95,6 @@ impl InsConfig {
                 "at least 2",
             ));
         }
-        self.checks()
-    }
-
-    /// The checks' false-alarm rate and the whiteness check's lag.
-    fn checks(&self) -> Result<(), ConfigError> {
         crate::config::validate_false_alarm_rate(self.checks.false_alarm_rate)?;
         if self.checks.residual_max_lag == Some(0) {
             return Err(ConfigError::invalid(
@@ -103,6 +104,40 @@ impl InsConfig {
             ));
         }
         Ok(())
+    }
+
+    /// The filter's error states: 15, or 21 with a prior σ for each scale factor group.
+    fn error_states(&self, assumed: &ImuConfig) -> Result<(), ConfigError> {
+        match self.filter.error_states {
+            None | Some(15) => Ok(()),
+            Some(21) => {
+                for (field, sigma) in [
+                    (
+                        "filter.gyro_scale_factor_sigma_ppm",
+                        assumed.gyro_scale_factor_sigma_ppm,
+                    ),
+                    (
+                        "filter.accel_scale_factor_sigma_ppm",
+                        assumed.accel_scale_factor_sigma_ppm,
+                    ),
+                ] {
+                    if sigma <= 0.0 {
+                        return Err(ConfigError::invalid(
+                            field,
+                            show(sigma),
+                            "a prior σ above 0 ppm when filter.error_states = 21 (set it in \
+                             [imu] or [filter])",
+                        ));
+                    }
+                }
+                Ok(())
+            }
+            Some(n) => Err(ConfigError::invalid(
+                "filter.error_states",
+                n,
+                "15, or 21 with the six scale factors",
+            )),
+        }
     }
 
     /// The IMU's rate in whole hertz, the GNSS rate dividing it.
@@ -207,6 +242,20 @@ fn imu_fields(filter: bool, m: &ImuConfig) -> Result<(), ConfigError> {
         0.0,
         10.0,
         "m/s² per √s",
+    )?;
+    within(
+        field!(filter, "imu", "gyro_scale_factor_sigma_ppm"),
+        m.gyro_scale_factor_sigma_ppm,
+        0.0,
+        1e5,
+        "ppm",
+    )?;
+    within(
+        field!(filter, "imu", "accel_scale_factor_sigma_ppm"),
+        m.accel_scale_factor_sigma_ppm,
+        0.0,
+        1e5,
+        "ppm",
     )?;
     if m.gyro_bias_model == BiasModelKind::GaussMarkov {
         within(

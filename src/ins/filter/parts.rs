@@ -13,7 +13,7 @@ use nalgebra::{Matrix3, SMatrix, Vector3};
 use super::Ekf;
 use crate::ins::discrete::{self, NoiseDensities};
 use crate::ins::earth;
-use crate::ins::error_state::{Matrix15, STATES};
+use crate::ins::error_state::{STATES, Square};
 use crate::ins::gnss;
 
 /// The noise groups whose densities Q_d is linear in: the accelerometers' VRW², the gyros'
@@ -47,9 +47,9 @@ impl NoiseDensities {
 
 /// The filter's view of a fix before its update, for a likelihood linearized about the run.
 #[derive(Clone, Debug, PartialEq)]
-pub struct LinearView {
+pub struct LinearView<const N: usize = STATES> {
     /// H of the antenna's position (3) and velocity (3) at the solution.
-    pub observation: SMatrix<f64, 6, STATES>,
+    pub observation: SMatrix<f64, 6, N>,
     /// The antenna's velocity, NED, m/s: the rate of its predicted position.
     pub antenna_velocity_ned_m_s: Vector3<f64>,
     /// C_b^n at the fix.
@@ -59,28 +59,31 @@ pub struct LinearView {
     pub field_acceleration_ned_m_s2: Vector3<f64>,
     /// The accelerometer bias estimate before the update, m/s².
     pub accel_bias_m_s2: Vector3<f64>,
+    /// The accelerometer scale factor estimates before the update (zero without the scale
+    /// states).
+    pub accel_scale: Vector3<f64>,
 }
 
-impl Ekf {
+impl<const N: usize> Ekf<N> {
     /// The same filter keeping Q_d from each update to the next split by noise group
     /// ([`Ekf::take_noise_parts`]).
     #[must_use]
     pub fn with_noise_parts(mut self) -> Self {
         self.flush();
-        self.noise_parts = Some(Box::new([Matrix15::zeros(); NOISE_GROUPS]));
+        self.noise_parts = Some(Box::new([Square::<N>::zeros(); NOISE_GROUPS]));
         self
     }
 
     /// Q_d of each noise group at unit density from the last update (or the start) to the last
     /// covariance propagation, restarted at zero; `None` unless tracked.
-    pub fn take_noise_parts(&mut self) -> Option<[Matrix15; NOISE_GROUPS]> {
+    pub fn take_noise_parts(&mut self) -> Option<[Square<N>; NOISE_GROUPS]> {
         self.noise_parts
             .as_mut()
-            .map(|p| std::mem::replace(&mut **p, [Matrix15::zeros(); NOISE_GROUPS]))
+            .map(|p| std::mem::replace(&mut **p, [Square::<N>::zeros(); NOISE_GROUPS]))
     }
 
     /// Each tracked part carried through one dense step Φ over `dt`.
-    pub(super) fn propagate_parts_dense(&mut self, phi: &Matrix15, dt: f64) {
+    pub(super) fn propagate_parts_dense(&mut self, phi: &Square<N>, dt: f64) {
         if let Some(parts) = self.noise_parts.as_mut() {
             for (g, q) in parts.iter_mut().enumerate() {
                 *q = phi * *q * phi.transpose()
@@ -90,7 +93,7 @@ impl Ekf {
     }
 
     /// Each tracked part carried through one interval's Φ (dynamics `f`, length `t`).
-    pub(super) fn propagate_parts_interval(&mut self, phi: &Matrix15, f: &Matrix15, t: f64) {
+    pub(super) fn propagate_parts_interval(&mut self, phi: &Square<N>, f: &Square<N>, t: f64) {
         if let Some(parts) = self.noise_parts.as_mut() {
             for (g, q) in parts.iter_mut().enumerate() {
                 *q = discrete::transition_congruence(phi, q)
@@ -101,11 +104,11 @@ impl Ekf {
 
     /// H and what the predicted measurement's motion needs at the fix now (the last step's
     /// compensated rate for the lever arm's terms).
-    pub fn linear_view(&self) -> LinearView {
+    pub fn linear_view(&self) -> LinearView<N> {
         let omega = self
             .before
             .map_or(Vector3::zeros(), |b| b.dtheta_rad / b.dt_s);
-        let observation = gnss::observation(&self.pva, &self.lever_arm_b_m, &omega);
+        let observation = gnss::observation_of::<N>(&self.pva, &self.lever_arm_b_m, &omega);
         let (_, velocity) = gnss::antenna(&self.pva, &self.lever_arm_b_m, &omega);
         let p = &self.pva.position;
         let v = self.pva.velocity_ned_m_s;
@@ -118,6 +121,7 @@ impl Ekf {
             c_bn: *self.pva.attitude.to_rotation_matrix().matrix(),
             field_acceleration_ned_m_s2: earth::gravity_ned(p) - (2.0 * w_ie + w_en).cross(&v),
             accel_bias_m_s2: self.accel_bias_m_s2,
+            accel_scale: self.accel_scale,
         }
     }
 }

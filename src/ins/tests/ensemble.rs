@@ -1,10 +1,12 @@
 //! The ensemble over the drive: its statistics do not depend on the thread count, a consistent
 //! filter passes the check catalogue (each realization normalized by its own covariance), and a
-//! filter without the lever arm does not.
+//! filter without the lever arm does not; with scale factors in the sensors, the 21-state filter
+//! passes and the 15-state one does not.
 
 use crate::checks::{Budget, Verdict, Verdicts, evaluate};
 use crate::config::ins::InsConfig;
 use crate::ins::ensemble::{Track, run};
+use crate::ins::error_state::{STATES, STATES_WITH_SCALE};
 use crate::ins::setup::Study;
 
 /// A study of the drive's first `duration_s` seconds.
@@ -17,7 +19,12 @@ fn study(duration_s: f64, edit: impl FnOnce(&mut InsConfig)) -> Study {
 
 /// The verdicts on `n` realizations of `s`, at the study's family-wise 1 %.
 fn verdicts(s: &Study, n: u64) -> Verdicts {
-    let stats = run(s, &Track::of(s), n).unwrap().stats;
+    verdicts_of::<STATES>(s, n)
+}
+
+/// [`verdicts`] of a filter of `N` error states.
+fn verdicts_of<const N: usize>(s: &Study, n: u64) -> Verdicts {
+    let stats = run::<N>(s, &Track::of(s), n).unwrap().stats;
     let v = evaluate(&stats, &Budget::study(s.false_alarm_rate));
     for c in &v.checks {
         eprintln!(
@@ -43,7 +50,7 @@ fn the_same_statistics_on_one_and_two_threads() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| run(&s, &track, 20).unwrap().stats)
+            .install(|| run::<STATES>(&s, &track, 20).unwrap().stats)
     };
     // Debug text compares every number to the last bit and NaN (an estimate that never moves)
     // with NaN.
@@ -88,4 +95,41 @@ fn a_filter_that_leaves_the_earth_rate_out_fails() {
         failed.contains(&"NEES"),
         "the Earth's rate went unseen: {failed:?}"
     );
+}
+
+#[test]
+fn with_scale_factors_the_21_state_filter_passes_and_the_15_state_one_fails() {
+    // 1 000 ppm on every axis: 0.01 m/s² on gravity's axis, 0.03 °/s in a 30 °/s turn.
+    let scaled = |c: &mut InsConfig| {
+        c.imu.gyro_scale_factor_sigma_ppm = 1000.0;
+        c.imu.accel_scale_factor_sigma_ppm = 1000.0;
+    };
+    let n = 64;
+    let s = study(600.0, |c| {
+        scaled(c);
+        c.filter.error_states = Some(21);
+    });
+    assert_eq!(s.error_states, STATES_WITH_SCALE);
+    let v = verdicts_of::<STATES_WITH_SCALE>(&s, n);
+    let failed: Vec<_> = v.failed().map(|c| c.definition.title).collect();
+    assert!(failed.is_empty(), "the 21-state filter failed {failed:?}");
+    // The control: the same sensors, a filter that does not know their scale factors.
+    let s = study(120.0, scaled);
+    let v = verdicts(&s, n);
+    let failed: Vec<_> = v.failed().map(|c| c.definition.title).collect();
+    assert!(
+        failed.contains(&"NEES"),
+        "unmodelled scale factors went unseen: {failed:?}"
+    );
+}
+
+#[test]
+fn a_21_state_filter_needs_a_prior_for_its_scale_factors() {
+    let mut c = InsConfig::default();
+    c.filter.error_states = Some(21);
+    let e = Study::from_config(&c).unwrap_err().to_string();
+    assert!(e.contains("filter.gyro_scale_factor_sigma_ppm"), "{e}");
+    c.filter.error_states = Some(18);
+    let e = Study::from_config(&c).unwrap_err().to_string();
+    assert!(e.contains("filter.error_states"), "{e}");
 }

@@ -6,3 +6,4 @@ mod error_state;
 mod logs;
 mod mechanization;
 mod propagation;
+mod scale;

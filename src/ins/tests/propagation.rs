@@ -15,7 +15,7 @@ fn covariances(
     propagation: Propagation,
 ) -> Vec<Matrix15> {
     let drive = study.drive();
-    let (mut imu, ekf) = crate::ins::ensemble::start(study, track, index);
+    let (mut imu, ekf) = crate::ins::ensemble::start::<15>(study, track, index);
     let mut ekf = ekf.with_propagation(propagation);
     let g = &study.filter_gnss;
     let dt = 1.0 / study.imu_rate_hz;
