@@ -115,6 +115,12 @@ fn calibrate(
     confidence: f64,
     cancel: &accelcal::progress::Cancel,
 ) -> PyResult<ImuCalibrationResult> {
+    if settings.error_states > accelcal::ins::error_state::STATES {
+        return Err(crate::bad_input(
+            "filter.error_states = 21: the scale factors are estimated by the command line \
+             (accelcal calibrate --imu … --gnss … --config FILE); from Python, 15",
+        ));
+    }
     let estimate = match keys {
         None => None,
         Some(keys) => Some(

@@ -11,12 +11,15 @@ use accelcal::calibrate::imu::config::settings_of;
 use accelcal::calibrate::imu::gnss::read_gnss;
 use accelcal::calibrate::imu::noise::{self, ImuKey};
 use accelcal::calibrate::imu::read::read_steps;
-use accelcal::calibrate::imu::run::{Calibrated, ImuCalibrateError, calibrate, calibrate_held};
+use accelcal::calibrate::imu::run::{
+    Calibrated, ImuCalibrateError, calibrate, calibrate_held, calibrate_of,
+};
 use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary, write_estimates};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ConfigText;
 use accelcal::error::ConfigError;
+use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
 use accelcal::logs::read::{LogFile, LogSource};
 use accelcal::output::{StagedFiles, check_directory};
 
@@ -52,6 +55,21 @@ pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
         eprintln!("checking the logs, aligning and running the filter…");
     }
     let (imu_log, gnss_log) = (LogFile::new(imu), LogFile::new(gnss));
+    if settings.error_states > STATES {
+        if args.estimate_noise {
+            return Err(ConfigError::invalid(
+                "filter.error_states",
+                settings.error_states,
+                "15 with --estimate-noise (the noise search runs the 15-state filter: estimate \
+                 the statistics first, then calibrate the scale factors with them in --config)",
+            )
+            .into());
+        }
+        let c =
+            calibrate_of::<STATES_WITH_SCALE>(&imu_log, &gnss_log, &settings).map_err(anyhow_of)?;
+        let s = summary(&c, &settings, &imu.display().to_string());
+        return write_outputs(args, (imu, gnss), &c, &s);
+    }
     let (c, s) = if args.estimate_noise {
         with_noise(args, &imu_log, &gnss_log, &settings)?
     } else {
@@ -59,24 +77,35 @@ pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
         let s = summary(&c, &settings, &imu.display().to_string());
         (c, s)
     };
+    write_outputs(args, (imu, gnss), &c, &s)
+}
+
+/// `estimates.csv`, `summary.json` and `index.html` of the calibration `c` summarized as `s`,
+/// written together into `--out`, and the result's lines.
+fn write_outputs<const N: usize>(
+    args: &CalibrateArgs,
+    (imu, gnss): (&Path, &Path),
+    c: &Calibrated<N>,
+    s: &Summary,
+) -> Result<()> {
     let mut staged = StagedFiles::create(&args.out, &FILES)?;
     let into = |name: &str| format!("cannot write {}", args.out.join(name).display());
     let smoothed = smooth(&c.records);
-    write_estimates(&c, &smoothed, staged.writer(ESTIMATES_FILE))
+    write_estimates(c, &smoothed, staged.writer(ESTIMATES_FILE))
         .with_context(|| into(ESTIMATES_FILE))?;
-    let json = serde_json::to_string_pretty(&s).expect("the summary serializes") + "\n";
+    let json = serde_json::to_string_pretty(s).expect("the summary serializes") + "\n";
     staged
         .writer(SUMMARY_FILE)
         .write_all(json.as_bytes())
         .with_context(|| into(SUMMARY_FILE))?;
     let page =
-        accelcal::report::calibration_imu::render(&c, &s, &smoothed, &command(args, imu, gnss))?;
+        accelcal::report::calibration_imu::render(c, s, &smoothed, &command(args, imu, gnss))?;
     staged
         .writer(PAGE_FILE)
         .write_all(page.as_bytes())
         .with_context(|| into(PAGE_FILE))?;
     staged.commit()?;
-    print_result(&s)
+    print_result(s)
 }
 
 /// The keys `--estimate` names for the three-axis path, or its default ones.

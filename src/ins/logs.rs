@@ -7,7 +7,8 @@
 //! - `gnss.csv`: `t_s,lat_deg,lon_deg,height_m,vn_m_s,ve_m_s,vd_m_s`, the antenna's fix.
 //! - `truth.csv`: `t_s,lat_deg,lon_deg,height_m,vn_m_s,ve_m_s,vd_m_s,roll_deg,pitch_deg,yaw_deg`
 //!   of the IMU, and the six biases `bgx_rad_s,bgy_rad_s,bgz_rad_s,bax_m_s2,bay_m_s2,baz_m_s2`
-//!   over the step ending at `t_s`, at every IMU time.
+//!   over the step ending at `t_s`, at every IMU time; when the IMU has scale factors, the six
+//!   of them besides, `sgx_ppm,sgy_ppm,sgz_ppm,sax_ppm,say_ppm,saz_ppm` (constants).
 //!
 //! Numbers are written as the shortest decimals that read back to the same `f64` (a negative
 //! zero as 0).
@@ -31,6 +32,8 @@ pub const GNSS_HEADER: &str = "t_s,lat_deg,lon_deg,height_m,vn_m_s,ve_m_s,vd_m_s
 /// The truth's header.
 pub const TRUTH_HEADER: &str = "t_s,lat_deg,lon_deg,height_m,vn_m_s,ve_m_s,vd_m_s,roll_deg,pitch_deg,\
                                 yaw_deg,bgx_rad_s,bgy_rad_s,bgz_rad_s,bax_m_s2,bay_m_s2,baz_m_s2";
+/// The truth's columns of the scale factors, when the IMU has them.
+pub const TRUTH_SCALE_COLUMNS: &str = ",sgx_ppm,sgy_ppm,sgz_ppm,sax_ppm,say_ppm,saz_ppm";
 
 /// What a written realization holds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,7 +76,10 @@ pub fn write_realization(
 ) -> io::Result<Written> {
     writeln!(imu_out, "{IMU_HEADER}")?;
     writeln!(gnss_out, "{GNSS_HEADER}")?;
-    writeln!(truth_out, "{TRUTH_HEADER}")?;
+    let m = &study.truth_imu;
+    let scaled = m.gyro_scale_sigma > 0.0 || m.accel_scale_sigma > 0.0;
+    let scale_columns = if scaled { TRUTH_SCALE_COLUMNS } else { "" };
+    writeln!(truth_out, "{TRUTH_HEADER}{scale_columns}")?;
     let drive = study.drive();
     let dt = 1.0 / study.imu_rate_hz;
     let truth = Truth::new(&drive, study.start, dt).until(study.duration_s);
@@ -88,27 +94,32 @@ pub fn write_realization(
         row(imu_out, t, &[a.x, a.y, a.z, w.x, w.y, w.z])?;
         let (roll, pitch, yaw) = super::euler_of(&pva.attitude);
         let (p, v) = (&pva.position, pva.velocity_ned_m_s);
-        row(
-            truth_out,
-            t,
-            &[
-                p.lat_rad.to_degrees(),
-                p.lon_rad.to_degrees(),
-                p.height_m,
-                v.x,
-                v.y,
-                v.z,
-                roll.to_degrees(),
-                pitch.to_degrees(),
-                yaw.to_degrees(),
-                bg.x,
-                bg.y,
-                bg.z,
-                ba.x,
-                ba.y,
-                ba.z,
-            ],
-        )?;
+        let mut values = vec![
+            p.lat_rad.to_degrees(),
+            p.lon_rad.to_degrees(),
+            p.height_m,
+            v.x,
+            v.y,
+            v.z,
+            roll.to_degrees(),
+            pitch.to_degrees(),
+            yaw.to_degrees(),
+            bg.x,
+            bg.y,
+            bg.z,
+            ba.x,
+            ba.y,
+            ba.z,
+        ];
+        if scaled {
+            values.extend(
+                imu.gyro_scale
+                    .iter()
+                    .chain(&imu.accel_scale)
+                    .map(|x| x * 1e6),
+            );
+        }
+        row(truth_out, t, &values)?;
         samples += 1;
         if (k + 1) % study.imu_steps_per_fix == 0 {
             let f = fix(study, &drive, &mut imu, t, &pva);

@@ -246,10 +246,10 @@ pub(super) fn test_rows(s: &Summary) -> Vec<TestRow> {
 ///
 /// # Errors
 /// [`RenderError::Figure`] when a figure cannot be drawn.
-pub fn view(
-    c: &Calibrated,
+pub fn view<const N: usize>(
+    c: &Calibrated<N>,
     s: &Summary,
-    smoothed: &[Smoothed],
+    smoothed: &[Smoothed<N>],
     command: &str,
 ) -> Result<ImuCalibrationView, RenderError> {
     let end = c.records.last().map_or(c.start_s, |r| r.t_s);
@@ -261,6 +261,15 @@ pub fn view(
         "accel-bias",
         "m/s²",
     ));
+    if let (Some(g), Some(a)) = (&s.gyro_scale_factor_ppm, &s.accel_scale_factor_ppm) {
+        biases.extend(triad_rows(g, "gyro scale factor", "gyro-scale", "ppm"));
+        biases.extend(triad_rows(
+            a,
+            "accelerometer scale factor",
+            "accel-scale",
+            "ppm",
+        ));
+    }
     Ok(ImuCalibrationView {
         version: env!("CARGO_PKG_VERSION").to_string(),
         subtitle: format!(
@@ -290,10 +299,10 @@ pub fn view(
 ///
 /// # Errors
 /// [`RenderError`] when a figure cannot be drawn or the template cannot be filled.
-pub fn render(
-    c: &Calibrated,
+pub fn render<const N: usize>(
+    c: &Calibrated<N>,
     s: &Summary,
-    smoothed: &[Smoothed],
+    smoothed: &[Smoothed<N>],
     command: &str,
 ) -> Result<String, RenderError> {
     let v = view(c, s, smoothed, command)?;

@@ -62,6 +62,9 @@ pub fn rows(a: &Settings, estimated: &[&str]) -> Vec<AssumptionRow> {
         heading_offset_sigma_deg: _,
         false_alarm_rate: _,
         gnss_time_offset_s: _,
+        error_states: _,
+        gyro_scale_factor_sigma_ppm: _,
+        accel_scale_factor_sigma_ppm: _,
     } = *a;
     let d = CONSUMER;
     let unit = |unit: &'static str| move |x: f64| format!("{} {unit}", value(x));
@@ -95,6 +98,9 @@ pub fn rows(a: &Settings, estimated: &[&str]) -> Vec<AssumptionRow> {
         alignment_window_s: "the alignment's window" => unit("s"),
         heading_offset_sigma_deg: "σ of the IMU's heading about the course" => unit("°"),
         false_alarm_rate: "each test's false-alarm rate α" => value,
+        error_states: "the filter's error states (21: the scale factors estimated too)" => |n: usize| n.to_string(),
+        gyro_scale_factor_sigma_ppm: "gyro scale factors' prior σ (with 21 states)" => unit("ppm"),
+        accel_scale_factor_sigma_ppm: "accelerometer scale factors' prior σ (with 21 states)" => unit("ppm"),
     )
 }
 

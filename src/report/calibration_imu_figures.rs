@@ -47,10 +47,10 @@ pub fn unwrapped_deg(yaw: &[f64]) -> Vec<f64> {
 ///
 /// # Errors
 /// [`RenderError::Figure`] when a figure cannot be drawn.
-pub fn figures(
-    c: &Calibrated,
+pub fn figures<const N: usize>(
+    c: &Calibrated<N>,
     s: &Summary,
-    smoothed: &[Smoothed],
+    smoothed: &[Smoothed<N>],
 ) -> Result<Vec<FigureView>, RenderError> {
     let r = &c.records;
     let t: Vec<f64> = r.iter().map(|f| f.t_s).collect();
@@ -65,7 +65,7 @@ pub fn figures(
 
 /// Figure 1: north and east from the first fix (the local radii of curvature at its latitude,
 /// Groves (2013) eqs. 2.105–2.106: Δn = (R_N + h)·ΔL, Δe = (R_E + h)·cos L·Δλ) and the height.
-fn track(c: &Calibrated, t: &[f64]) -> Result<FigureView, RenderError> {
+fn track<const N: usize>(c: &Calibrated<N>, t: &[f64]) -> Result<FigureView, RenderError> {
     let first = c.records.first().map(|f| f.pva.position);
     let (mut north, mut east, mut height) = (Vec::new(), Vec::new(), Vec::new());
     if let Some(p0) = first {
@@ -96,9 +96,9 @@ fn track(c: &Calibrated, t: &[f64]) -> Result<FigureView, RenderError> {
 
 /// Figure 2: the six biases, filtered and smoothed, ±σ; `(id, number)` its element id and
 /// number.
-pub(super) fn biases(
-    c: &Calibrated,
-    sm: &[Smoothed],
+pub(super) fn biases<const N: usize>(
+    c: &Calibrated<N>,
+    sm: &[Smoothed<N>],
     t: &[f64],
     (id, number): (&str, usize),
 ) -> Result<FigureView, RenderError> {
@@ -110,7 +110,7 @@ pub(super) fn biases(
         let pick = |g: &nalgebra::Vector3<f64>, a: &nalgebra::Vector3<f64>| {
             if gyro { g[k] } else { a[k] }
         };
-        let sigma = |p: &crate::ins::error_state::Matrix15| {
+        let sigma = |p: &crate::ins::error_state::Square<N>| {
             let (sg, sa) = bias_sigmas(p);
             if gyro { sg[k] } else { sa[k] }
         };
@@ -145,7 +145,11 @@ pub(super) fn biases(
 }
 
 /// Figure 3: roll, pitch and yaw, filtered and smoothed, ±σ.
-fn attitude(c: &Calibrated, sm: &[Smoothed], t: &[f64]) -> Result<FigureView, RenderError> {
+fn attitude<const N: usize>(
+    c: &Calibrated<N>,
+    sm: &[Smoothed<N>],
+    t: &[f64],
+) -> Result<FigureView, RenderError> {
     let deg = |(r, p, y): (f64, f64, f64)| [r, p, y].map(f64::to_degrees);
     let filtered: Vec<[f64; 3]> = c
         .records
@@ -198,7 +202,7 @@ fn attitude(c: &Calibrated, sm: &[Smoothed], t: &[f64]) -> Result<FigureView, Re
 }
 
 /// Figure 4: the innovation of each measured component within ±√S.
-fn innovations(c: &Calibrated, t: &[f64]) -> Result<FigureView, RenderError> {
+fn innovations<const N: usize>(c: &Calibrated<N>, t: &[f64]) -> Result<FigureView, RenderError> {
     let r = &c.records;
     let measured: Vec<usize> = (0..6)
         .filter(|&i| r.iter().any(|f| f.innovation[i].is_finite()))
@@ -239,8 +243,8 @@ fn innovations(c: &Calibrated, t: &[f64]) -> Result<FigureView, RenderError> {
 
 /// Figure 5: the NIS of every fix against the χ²(mᵢ) band of its own mᵢ; `(id, number)` its
 /// element id and number.
-pub(super) fn nis(
-    c: &Calibrated,
+pub(super) fn nis<const N: usize>(
+    c: &Calibrated<N>,
     s: &Summary,
     t: &[f64],
     (id, number): (&str, usize),

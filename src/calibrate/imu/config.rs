@@ -34,6 +34,9 @@ struct Statistics {
     gnss_position_sigma_m: Option<[f64; 3]>,
     gnss_velocity_sigma_m_s: Option<f64>,
     gnss_time_offset_s: Option<f64>,
+    gyro_scale_factor_sigma_ppm: Option<f64>,
+    accel_scale_factor_sigma_ppm: Option<f64>,
+    error_states: Option<u32>,
 }
 
 #[derive(Clone, Debug, Default, Deserialize)]
@@ -97,12 +100,8 @@ fn bias(
     }
 }
 
-/// The settings of the configuration `text`: [`CONSUMER`] with every key the file sets.
-///
-/// # Errors
-/// [`ConfigError::Parse`] for a file that is not TOML or has an unknown key or a value of the
-/// wrong type; [`ConfigError::Invalid`] naming the key, its line and its accepted range.
-pub fn settings_of(text: &ConfigText) -> Result<Settings, ConfigError> {
+/// The file `text` parsed, of the three-axis model.
+fn parse(text: &ConfigText) -> Result<File, ConfigError> {
     let t = &text.text;
     let file: File = toml::from_str(t).map_err(|e| {
         let span = e.span();
@@ -117,6 +116,17 @@ pub fn settings_of(text: &ConfigText) -> Result<Settings, ConfigError> {
         let e = ConfigError::invalid("model", m, "\"ins\": the three-axis keys");
         return Err(text.locate(e));
     }
+    Ok(file)
+}
+
+/// The settings of the configuration `text`: [`CONSUMER`] with every key the file sets.
+///
+/// # Errors
+/// [`ConfigError::Parse`] for a file that is not TOML or has an unknown key or a value of the
+/// wrong type; [`ConfigError::Invalid`] naming the key, its line and its accepted range.
+pub fn settings_of(text: &ConfigText) -> Result<Settings, ConfigError> {
+    let t = &text.text;
+    let file = parse(text)?;
     let pick = |f: fn(&Statistics) -> Option<f64>| f(&file.filter).or(f(&file.imu));
     let c = CONSUMER;
     let (g_sigma, g_k, g_tau) = bias(
@@ -176,6 +186,14 @@ pub fn settings_of(text: &ConfigText) -> Result<Settings, ConfigError> {
             .heading_offset_sigma_deg
             .unwrap_or(c.heading_offset_sigma_deg),
         false_alarm_rate: file.checks.false_alarm_rate.unwrap_or(c.false_alarm_rate),
+        error_states: file
+            .filter
+            .error_states
+            .map_or(c.error_states, |n| n as usize),
+        gyro_scale_factor_sigma_ppm: pick(|s| s.gyro_scale_factor_sigma_ppm)
+            .unwrap_or(c.gyro_scale_factor_sigma_ppm),
+        accel_scale_factor_sigma_ppm: pick(|s| s.accel_scale_factor_sigma_ppm)
+            .unwrap_or(c.accel_scale_factor_sigma_ppm),
     };
     validate(&s).map_err(|e| text.locate(in_section(e, t)))?;
     Ok(s)
@@ -216,6 +234,13 @@ fn in_section(e: ConfigError, text: &str) -> ConfigError {
 pub fn validate(s: &Settings) -> Result<(), ConfigError> {
     let [pn, pe, pd] = s.gnss_position_sigma_m;
     let [lx, ly, lz] = s.gnss_lever_arm_m;
+    // A scale factor's prior σ matters with 21 states only (0, the study's ideal scale, is
+    // accepted with 15).
+    let (scale_lo, scale_words) = if s.error_states > 15 {
+        (1.0, "in [1, 10⁵] ppm with error_states = 21")
+    } else {
+        (0.0, "in [0, 10⁵] ppm")
+    };
     // One row per key: the key, its value, its range and the range in words.
     #[rustfmt::skip]
     let mut checks: Vec<Check> = vec![
@@ -235,7 +260,17 @@ pub fn validate(s: &Settings) -> Result<(), ConfigError> {
         ("heading_offset_sigma_deg", s.heading_offset_sigma_deg, 0.01, 30.0, "in [0.01, 30]° (a larger offset breaks the filter's linearization)"),
         ("false_alarm_rate", s.false_alarm_rate, 1e-6, 0.5, "in [1e-6, 0.5]"),
         ("gnss_time_offset_s", s.gnss_time_offset_s, -MAX_TIME_OFFSET_S, MAX_TIME_OFFSET_S, "in [−0.5, 0.5] s"),
+        ("gyro_scale_factor_sigma_ppm", s.gyro_scale_factor_sigma_ppm, scale_lo, 1e5, scale_words),
+        ("accel_scale_factor_sigma_ppm", s.accel_scale_factor_sigma_ppm, scale_lo, 1e5, scale_words),
+        ("error_states", s.error_states as f64, 15.0, 21.0, "15, or 21 with the six scale factors"),
     ];
+    if s.error_states != 15 && s.error_states != 21 {
+        return Err(ConfigError::invalid(
+            "error_states",
+            s.error_states,
+            "15, or 21 with the six scale factors",
+        ));
+    }
     for (field, tau) in [
         (
             "gyro_bias_correlation_time_s",

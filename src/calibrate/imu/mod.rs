@@ -19,6 +19,7 @@ pub mod linear;
 pub mod noise;
 pub mod read;
 pub mod run;
+pub mod scale;
 pub mod smoother;
 mod step;
 pub mod summary;
@@ -41,6 +42,8 @@ use crate::config::ins::Axes;
 /// - GNSS: 2 m horizontal and 4 m vertical σ per fix, 0.1 m/s per velocity component, the
 ///   antenna at the IMU; a missing vertical velocity is taken as 0 with σ 0.5 m/s at the start.
 /// - Heading: the IMU's forward axis along the course within 2° (σ).
+/// - Scale factors (estimated only with `error_states = 21`): σ 1 % per axis (10 000 ppm:
+///   phone-class datasheets give a sensitivity tolerance of ±1–3 %).
 pub const CONSUMER: Settings = Settings {
     axes: Axes::Frd,
     gyro_arw_rad_per_sqrt_s: 1e-3,
@@ -60,6 +63,9 @@ pub const CONSUMER: Settings = Settings {
     alignment_window_s: 2.0,
     heading_offset_sigma_deg: 2.0,
     false_alarm_rate: 0.01,
+    error_states: 15,
+    gyro_scale_factor_sigma_ppm: 10_000.0,
+    accel_scale_factor_sigma_ppm: 10_000.0,
 };
 
 /// What a calibration assumes: the IMU's axes and statistics, the receiver's, the alignment's
@@ -103,6 +109,12 @@ pub struct Settings {
     pub heading_offset_sigma_deg: f64,
     /// The false-alarm rate of each test.
     pub false_alarm_rate: f64,
+    /// The filter's error states: 15, or 21 with the six scale factors.
+    pub error_states: usize,
+    /// The gyro scale factors' prior σ, ppm (with 21 states).
+    pub gyro_scale_factor_sigma_ppm: f64,
+    /// The accelerometer scale factors' prior σ, ppm (with 21 states).
+    pub accel_scale_factor_sigma_ppm: f64,
 }
 
 impl Settings {

@@ -21,6 +21,7 @@ use super::gnss::GnssRow;
 use super::linear::Linearized;
 use super::read::{HeldSteps, ImuSpan, ImuStep};
 use super::run::{filter, shifted};
+use crate::ins::error_state::STATES;
 use crate::likelihood::{Fit, climb, maximize};
 use crate::progress::{Cancel, Cancelled};
 
@@ -224,7 +225,7 @@ pub struct NoiseEstimate {
 /// first `fixes` fixes after the alignment's; −∞ when the filter cannot run or updates fewer.
 pub fn log_likelihood(rows: &[GnssRow], steps: &[ImuStep], s: &Settings, fixes: usize) -> f64 {
     let rows = shifted(rows, s.gnss_time_offset_s);
-    let Ok(run) = filter(&rows, &mut HeldSteps::new(steps), s, "") else {
+    let Ok(run) = filter::<STATES>(&rows, &mut HeldSteps::new(steps), s, "") else {
         return f64::NEG_INFINITY;
     };
     if run.records.len() < fixes {

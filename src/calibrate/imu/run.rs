@@ -11,6 +11,7 @@ use super::gnss::{GnssRow, read_gnss};
 use super::read::{HeldSteps, ImuLayout, ImuReader, ImuSpan, ImuStep, StepSource};
 pub use super::step::{FixRecord, bias_sigmas, euler_sigmas};
 use super::step::{Running, part, start, update, velocity_sigmas};
+use crate::ins::error_state::STATES;
 use crate::ins::filter::{Ekf, FilterError, LinearView};
 use crate::logs::read::LogSource;
 use crate::logs::{LogError, LogProblem};
@@ -36,7 +37,7 @@ pub enum ImuCalibrateError {
 
 /// A calibrated recording.
 #[derive(Clone, Debug)]
-pub struct Calibrated {
+pub struct Calibrated<const N: usize = STATES> {
     /// The GNSS log's file, as named.
     pub gnss_file: String,
     /// The IMU log's span and steps.
@@ -52,29 +53,29 @@ pub struct Calibrated {
     /// The filter's start time, s.
     pub start_s: f64,
     /// One record per fix after the start.
-    pub records: Vec<FixRecord>,
+    pub records: Vec<FixRecord<N>>,
     /// Fixes whose vertical velocity was missing (the component left out).
     pub missing_velocity: [usize; 3],
 }
 
 /// The filter run over the steps: its records and where it ended.
-pub struct Filtered {
+pub struct Filtered<const N: usize = STATES> {
     /// The alignment's fixes.
     pub plan: Plan,
     /// The alignment.
     pub alignment: Alignment,
     /// One record per fix updated.
-    pub records: Vec<FixRecord>,
+    pub records: Vec<FixRecord<N>>,
     /// Fixes without each velocity component.
     pub missing: [usize; 3],
     /// The filter after the last step.
-    pub ekf: Ekf,
+    pub ekf: Ekf<N>,
     /// The first fix not yet updated.
     pub next: usize,
     /// The mean specific force over the alignment's window, body axes, m/s².
     pub mean_f_b: Vector3<f64>,
     /// The filter's view at its start, when tracked ([`filter_tracked`]).
-    pub start_view: Option<LinearView>,
+    pub start_view: Option<LinearView<N>>,
 }
 
 /// The alignment's error sources at the heading's fix `rh` under the assumptions `s`.
@@ -103,12 +104,12 @@ pub fn shifted(rows: &[GnssRow], offset_s: f64) -> Vec<GnssRow> {
 /// # Errors
 /// A log's problem; [`ImuCalibrateError::Alignment`] when no fix is fast enough for the
 /// heading or the log ends before it; [`ImuCalibrateError::Filter`].
-pub fn filter(
+pub fn filter<const N: usize>(
     rows: &[GnssRow],
     source: &mut dyn StepSource,
     s: &Settings,
     gnss_name: &str,
-) -> Result<Filtered, ImuCalibrateError> {
+) -> Result<Filtered<N>, ImuCalibrateError> {
     run_filter(rows, source, s, gnss_name, false)
 }
 
@@ -117,23 +118,23 @@ pub fn filter(
 ///
 /// # Errors
 /// As [`filter`].
-pub fn filter_tracked(
+pub fn filter_tracked<const N: usize>(
     rows: &[GnssRow],
     source: &mut dyn StepSource,
     s: &Settings,
     gnss_name: &str,
-) -> Result<Filtered, ImuCalibrateError> {
+) -> Result<Filtered<N>, ImuCalibrateError> {
     run_filter(rows, source, s, gnss_name, true)
 }
 
 /// [`filter`], tracking what a linearized likelihood needs when `tracked`.
-fn run_filter(
+fn run_filter<const N: usize>(
     rows: &[GnssRow],
     source: &mut dyn StepSource,
     s: &Settings,
     gnss_name: &str,
     tracked: bool,
-) -> Result<Filtered, ImuCalibrateError> {
+) -> Result<Filtered<N>, ImuCalibrateError> {
     let mut first = source.next_step()?;
     let imu_first_s = source.first_s().unwrap_or(f64::INFINITY);
     let settings = AlignSettings {
@@ -146,7 +147,7 @@ fn run_filter(
     let mut sum_dv = Vector3::zeros();
     let mut mean_f_b = Vector3::zeros();
     let mut start_view = None;
-    let mut started: Option<(Ekf, Alignment)> = None;
+    let mut started: Option<(Ekf<N>, Alignment)> = None;
     let mut next = plan.start + 1;
     let mut records = Vec::with_capacity(rows.len() - next);
     let mut missing = [0; 3];
@@ -211,6 +212,18 @@ pub fn calibrate(
     gnss: &dyn LogSource,
     s: &Settings,
 ) -> Result<Calibrated, ImuCalibrateError> {
+    calibrate_of::<STATES>(imu, gnss, s)
+}
+
+/// [`calibrate`] with a filter of `N` error states (21: the scale factors too).
+///
+/// # Errors
+/// As [`calibrate`].
+pub fn calibrate_of<const N: usize>(
+    imu: &dyn LogSource,
+    gnss: &dyn LogSource,
+    s: &Settings,
+) -> Result<Calibrated<N>, ImuCalibrateError> {
     let rows = shifted(&read_gnss(gnss)?, s.gnss_time_offset_s);
     let mut reader = ImuReader::open(imu, s.axes)?;
     let layout = reader.layout();
@@ -224,12 +237,12 @@ pub fn calibrate(
 ///
 /// # Errors
 /// As [`calibrate`].
-pub fn calibrate_held(
+pub fn calibrate_held<const N: usize>(
     rows: &[GnssRow],
     (steps, span, layout): (&[ImuStep], ImuSpan, ImuLayout),
     s: &Settings,
     gnss: &str,
-) -> Result<Calibrated, ImuCalibrateError> {
+) -> Result<Calibrated<N>, ImuCalibrateError> {
     let rows = shifted(rows, s.gnss_time_offset_s);
     let run = filter(&rows, &mut HeldSteps::new(steps), s, gnss);
     assemble(&rows, run?, (span, layout), s, gnss)
@@ -237,13 +250,13 @@ pub fn calibrate_held(
 
 /// The calibration from a filter's run over the whole log: every fix checked against the
 /// log's span, the last fixes updated.
-fn assemble(
+fn assemble<const N: usize>(
     rows: &[GnssRow],
-    mut run: Filtered,
+    mut run: Filtered<N>,
     (span, layout): (ImuSpan, ImuLayout),
     s: &Settings,
     gnss: &str,
-) -> Result<Calibrated, ImuCalibrateError> {
+) -> Result<Calibrated<N>, ImuCalibrateError> {
     check_span(rows, &span, gnss, s.gnss_time_offset_s)?;
     // A time offset can carry the last fixes past the log's end: those are left out.
     let tolerance = 0.5 * span.median_step_s;
@@ -263,9 +276,9 @@ fn assemble(
 }
 
 /// The fixes within half a step after the last sample, updated where the log ends.
-fn finish(
+fn finish<const N: usize>(
     fixes: usize,
-    run: &mut Filtered,
+    run: &mut Filtered<N>,
     s: &Settings,
     rows: &[GnssRow],
 ) -> Result<(), FilterError> {

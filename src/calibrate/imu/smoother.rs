@@ -18,32 +18,36 @@
 use nalgebra::{SVector, Vector3};
 
 use super::run::FixRecord;
-use crate::ins::error_state::{Matrix15, STATES};
+use crate::ins::error_state::{ACCEL_SCALE, GYRO_SCALE, STATES, Square, has_scale};
 use crate::ins::filter::apply_correction;
 use crate::ins::mech::Pva;
 
 /// The smoothed solution at one fix.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Smoothed {
+pub struct Smoothed<const N: usize = STATES> {
     /// Position, velocity and attitude.
     pub pva: Pva,
     /// The gyro biases, rad/s.
     pub gyro_bias_rad_s: Vector3<f64>,
     /// The accelerometer biases, m/s².
     pub accel_bias_m_s2: Vector3<f64>,
+    /// The gyro scale factors (zero without the scale states).
+    pub gyro_scale: Vector3<f64>,
+    /// The accelerometer scale factors (zero without the scale states).
+    pub accel_scale: Vector3<f64>,
     /// The covariance of its errors.
-    pub covariance: Matrix15,
+    pub covariance: Square<N>,
 }
 
 /// The smoothed solution at every fix of `records`, in their order.
-pub fn smooth(records: &[FixRecord]) -> Vec<Smoothed> {
+pub fn smooth<const N: usize>(records: &[FixRecord<N>]) -> Vec<Smoothed<N>> {
     let n = records.len();
     let mut out = Vec::with_capacity(n);
     let Some(last) = records.last() else {
         return out;
     };
     // ê⁻ and P^s of the fix after the current one.
-    let mut e_prior: SVector<f64, STATES> = last.correction;
+    let mut e_prior: SVector<f64, N> = last.correction;
     let mut p_next = last.covariance;
     out.push(smoothed(last, &SVector::zeros(), last.covariance));
     for k in (0..n - 1).rev() {
@@ -52,7 +56,7 @@ pub fn smooth(records: &[FixRecord]) -> Vec<Smoothed> {
         let phi_p = next.transition * r.covariance;
         let c_t = match next.prior_covariance.cholesky() {
             Some(ch) => ch.solve(&phi_p),
-            None => Matrix15::zeros(),
+            None => Square::<N>::zeros(),
         };
         let c = c_t.transpose();
         let e_post = c * e_prior;
@@ -67,13 +71,29 @@ pub fn smooth(records: &[FixRecord]) -> Vec<Smoothed> {
 }
 
 /// The filtered solution of `r` with the smoothed errors `e` taken out.
-fn smoothed(r: &FixRecord, e: &SVector<f64, STATES>, covariance: Matrix15) -> Smoothed {
+fn smoothed<const N: usize>(
+    r: &FixRecord<N>,
+    e: &SVector<f64, N>,
+    covariance: Square<N>,
+) -> Smoothed<N> {
     let (mut pva, mut g, mut a) = (r.pva, r.gyro_bias_rad_s, r.accel_bias_m_s2);
-    apply_correction(&mut pva, &mut g, &mut a, e);
+    apply_correction(
+        &mut pva,
+        &mut g,
+        &mut a,
+        &e.fixed_rows::<STATES>(0).into_owned(),
+    );
+    let (mut sg, mut sa) = (r.gyro_scale, r.accel_scale);
+    if has_scale(N) {
+        sg -= e.fixed_rows::<3>(GYRO_SCALE);
+        sa -= e.fixed_rows::<3>(ACCEL_SCALE);
+    }
     Smoothed {
         pva,
         gyro_bias_rad_s: g,
         accel_bias_m_s2: a,
+        gyro_scale: sg,
+        accel_scale: sa,
         covariance,
     }
 }

@@ -8,7 +8,8 @@ use super::align::{self, Alignment};
 use super::gnss::GnssRow;
 use crate::ins::discrete::NoiseDensities;
 use crate::ins::error_state::{
-    ACCEL_BIAS, ATTITUDE, BiasDecay, GYRO_BIAS, Matrix15, POSITION, STATES,
+    ACCEL_BIAS, ACCEL_SCALE, ATTITUDE, BiasDecay, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, Square,
+    has_scale,
 };
 use crate::ins::filter::{Ekf, FilterError, LinearView, NOISE_GROUPS};
 use crate::ins::gnss::Fix;
@@ -16,7 +17,7 @@ use crate::ins::mech::{Increment, Pva};
 
 /// One fix's filtered estimates.
 #[derive(Clone, Debug, PartialEq)]
-pub struct FixRecord {
+pub struct FixRecord<const N: usize = STATES> {
     /// The fix's line in the GNSS log.
     pub line: u64,
     /// Its time, s.
@@ -27,14 +28,18 @@ pub struct FixRecord {
     pub gyro_bias_rad_s: Vector3<f64>,
     /// The accelerometer bias estimate, m/s².
     pub accel_bias_m_s2: Vector3<f64>,
+    /// The gyro scale factor estimates (zero without the scale states).
+    pub gyro_scale: Vector3<f64>,
+    /// The accelerometer scale factor estimates (zero without the scale states).
+    pub accel_scale: Vector3<f64>,
     /// The covariance after the update.
-    pub covariance: Matrix15,
+    pub covariance: Square<N>,
     /// The covariance before it.
-    pub prior_covariance: Matrix15,
+    pub prior_covariance: Square<N>,
     /// Φ from the previous fix's update (or the start) to this fix.
-    pub transition: Matrix15,
+    pub transition: Square<N>,
     /// The errors the update took out of the solution.
-    pub correction: SVector<f64, STATES>,
+    pub correction: SVector<f64, N>,
     /// The innovation: position NED (m), velocity NED (m/s); NaN where not measured.
     pub innovation: [f64; 6],
     /// √S of each component; NaN where not measured.
@@ -47,16 +52,16 @@ pub struct FixRecord {
     pub rows: usize,
     /// What a likelihood linearized about this run needs of the fix; `None` unless the run
     /// tracked it ([`crate::calibrate::imu::run::filter_tracked`]).
-    pub linear: Option<Box<LinearRecord>>,
+    pub linear: Option<Box<LinearRecord<N>>>,
 }
 
 /// One fix's part of a likelihood linearized about the filter's run.
 #[derive(Clone, Debug, PartialEq)]
-pub struct LinearRecord {
+pub struct LinearRecord<const N: usize = STATES> {
     /// Q_d from the previous fix (or the start) split by noise group at unit density.
-    pub noise_parts: [Matrix15; NOISE_GROUPS],
+    pub noise_parts: [Square<N>; NOISE_GROUPS],
     /// H and the predicted measurement's rate before the update.
-    pub view: LinearView,
+    pub view: LinearView<N>,
 }
 
 /// The increments of `inc` over the part of its step from `lo` to `hi` (its end `end`).
@@ -121,13 +126,24 @@ pub(super) fn fix_of(row: &GnssRow, s: &Settings) -> (Fix, [bool; 3]) {
 }
 
 /// The prior covariance at fix `h` from the alignment `a`: the alignment's errors, the fix's
-/// position σ's and the gyro biases' prior.
-pub(super) fn initial_covariance(h: &GnssRow, a: &Alignment, s: &Settings) -> Matrix15 {
+/// position σ's and the gyro biases' prior (and the scale factors' with 21 states).
+pub(super) fn initial_covariance<const N: usize>(
+    h: &GnssRow,
+    a: &Alignment,
+    s: &Settings,
+) -> Square<N> {
     let (fix, _) = fix_of(h, s);
-    let mut p0 = a.covariance;
+    let mut p0 = Square::<N>::zeros();
+    p0.fixed_view_mut::<STATES, STATES>(0, 0)
+        .copy_from(&a.covariance);
     for i in 0..3 {
         p0[(POSITION + i, POSITION + i)] = fix.position_sigma_m[i].powi(2);
         p0[(GYRO_BIAS + i, GYRO_BIAS + i)] = s.gyro_bias_sigma_rad_s.powi(2);
+        if has_scale(N) {
+            p0[(GYRO_SCALE + i, GYRO_SCALE + i)] = (s.gyro_scale_factor_sigma_ppm * 1e-6).powi(2);
+            p0[(ACCEL_SCALE + i, ACCEL_SCALE + i)] =
+                (s.accel_scale_factor_sigma_ppm * 1e-6).powi(2);
+        }
     }
     p0
 }
@@ -135,7 +151,12 @@ pub(super) fn initial_covariance(h: &GnssRow, a: &Alignment, s: &Settings) -> Ma
 /// The filter at fix `h` from the alignment `a`: the IMU carried from the antenna's fix, the
 /// prior covariance of position, alignment and gyro biases; tracking Q_d by noise group when
 /// `tracked`.
-pub(super) fn start(h: &GnssRow, a: &Alignment, s: &Settings, tracked: bool) -> Ekf {
+pub(super) fn start<const N: usize>(
+    h: &GnssRow,
+    a: &Alignment,
+    s: &Settings,
+    tracked: bool,
+) -> Ekf<N> {
     let [roll, pitch, yaw] = a.euler_rad;
     let attitude = crate::ins::attitude_from_euler(roll, pitch, yaw);
     let c: Matrix3<f64> = *attitude.to_rotation_matrix().matrix();
@@ -158,15 +179,15 @@ pub(super) fn start(h: &GnssRow, a: &Alignment, s: &Settings, tracked: bool) -> 
 }
 
 /// The running filter and where it is among the fixes.
-pub(super) struct Running<'a> {
-    pub(super) ekf: &'a mut Ekf,
+pub(super) struct Running<'a, const N: usize> {
+    pub(super) ekf: &'a mut Ekf<N>,
     pub(super) rows: &'a [GnssRow],
     pub(super) next: &'a mut usize,
-    pub(super) records: &'a mut Vec<FixRecord>,
+    pub(super) records: &'a mut Vec<FixRecord<N>>,
     pub(super) missing: &'a mut [usize; 3],
 }
 
-impl Running<'_> {
+impl<const N: usize> Running<'_, N> {
     /// The IMU step `inc` ending at `t1` from `from` on: propagated up to each fix it holds,
     /// updated there, then to its end.
     pub(super) fn step(
@@ -203,19 +224,19 @@ pub(super) fn velocity_sigmas(r: &GnssRow, s: &Settings) -> Vector3<f64> {
 }
 
 /// The update by the fix of `row`, recorded.
-pub(super) fn update(
-    f: &mut Ekf,
+pub(super) fn update<const N: usize>(
+    f: &mut Ekf<N>,
     row: &GnssRow,
     s: &Settings,
     missing: &mut [usize; 3],
-) -> Result<FixRecord, FilterError> {
+) -> Result<FixRecord<N>, FilterError> {
     let (fix, measured) = fix_of(row, s);
     for (m, &k) in missing.iter_mut().zip(&measured) {
         *m += usize::from(!k);
     }
     f.flush();
     let prior_covariance = f.covariance;
-    let transition = f.take_transition().unwrap_or_else(Matrix15::identity);
+    let transition = f.take_transition().unwrap_or_else(Square::<N>::identity);
     let linear = f.take_noise_parts().map(|noise_parts| {
         Box::new(LinearRecord {
             noise_parts,
@@ -235,6 +256,8 @@ pub(super) fn update(
         pva: f.pva,
         gyro_bias_rad_s: f.gyro_bias_rad_s,
         accel_bias_m_s2: f.accel_bias_m_s2,
+        gyro_scale: f.gyro_scale,
+        accel_scale: f.accel_scale,
         covariance: f.covariance,
         prior_covariance,
         transition,
@@ -255,7 +278,7 @@ pub(super) fn update(
 /// The σ's of roll, pitch and yaw (rad) from the attitude error's covariance at `pva`: the
 /// Euler angles' first-order response to a small rotation about north, east and down, found
 /// by central differences.
-pub fn euler_sigmas(pva: &Pva, p: &Matrix15) -> [f64; 3] {
+pub fn euler_sigmas<const N: usize>(pva: &Pva, p: &Square<N>) -> [f64; 3] {
     let h = 1e-7;
     let mut j = Matrix3::zeros();
     for axis in 0..3 {
@@ -276,10 +299,21 @@ pub fn euler_sigmas(pva: &Pva, p: &Matrix15) -> [f64; 3] {
     [0, 1, 2].map(|i| cov[(i, i)].max(0.0).sqrt())
 }
 
-/// The σ of each accelerometer and gyro bias in `p`.
-pub fn bias_sigmas(p: &Matrix15) -> ([f64; 3], [f64; 3]) {
+/// The σ of each gyro and accelerometer bias in `p`.
+pub fn bias_sigmas<const N: usize>(p: &Square<N>) -> ([f64; 3], [f64; 3]) {
     (
         [0, 1, 2].map(|i| p[(GYRO_BIAS + i, GYRO_BIAS + i)].max(0.0).sqrt()),
         [0, 1, 2].map(|i| p[(ACCEL_BIAS + i, ACCEL_BIAS + i)].max(0.0).sqrt()),
+    )
+}
+
+/// The σ of each gyro and accelerometer scale factor in `p` (NaN without the scale states).
+pub fn scale_sigmas<const N: usize>(p: &Square<N>) -> ([f64; 3], [f64; 3]) {
+    if !has_scale(N) {
+        return ([f64::NAN; 3], [f64::NAN; 3]);
+    }
+    (
+        [0, 1, 2].map(|i| p[(GYRO_SCALE + i, GYRO_SCALE + i)].max(0.0).sqrt()),
+        [0, 1, 2].map(|i| p[(ACCEL_SCALE + i, ACCEL_SCALE + i)].max(0.0).sqrt()),
     )
 }

@@ -119,6 +119,12 @@ pub struct Summary {
     pub gyro_bias_rad_s: Triad,
     /// The accelerometer biases at the end, m/s².
     pub accel_bias_m_s2: Triad,
+    /// The gyro scale factors at the end, ppm, when estimated (`error_states` = 21).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gyro_scale_factor_ppm: Option<Triad>,
+    /// The accelerometer scale factors at the end, ppm, when estimated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accel_scale_factor_ppm: Option<Triad>,
     /// The attitude at the end.
     pub attitude_deg: Attitude,
     /// The NIS test over the fixes.
@@ -147,7 +153,7 @@ pub const COMPONENTS: [&str; 6] = [
     "velocity_down",
 ];
 
-fn triad(value: [f64; 3], sigma: [f64; 3], prior: [f64; 3]) -> Triad {
+pub(super) fn triad(value: [f64; 3], sigma: [f64; 3], prior: [f64; 3]) -> Triad {
     let z = crate::stats::normal_bound(1.0 - CONFIDENCE);
     Triad {
         value,
@@ -167,7 +173,7 @@ fn prior_sigma(sigma0: f64, k: f64, tau: Option<f64>, t: f64) -> f64 {
 }
 
 /// The summary of `c` calibrated with `s`, the IMU log named `imu_file`.
-pub fn summary(c: &Calibrated, s: &Settings, imu_file: &str) -> Summary {
+pub fn summary<const N: usize>(c: &Calibrated<N>, s: &Settings, imu_file: &str) -> Summary {
     let last = c.records.last();
     let elapsed = last.map_or(0.0, |r| r.t_s - c.start_s);
     let (gyro, accel, attitude) = match last {
@@ -186,6 +192,7 @@ pub fn summary(c: &Calibrated, s: &Settings, imu_file: &str) -> Summary {
             },
         ),
     };
+    let (gyro_scale, accel_scale) = super::scale::end_triads(last, s).unzip();
     let (nis, whiteness, rejected_by) = tests(c, s);
     let alignment = alignment_record(c);
     let mut warnings = Vec::new();
@@ -199,6 +206,10 @@ pub fn summary(c: &Calibrated, s: &Settings, imu_file: &str) -> Summary {
             c.alignment.covariance[(8, 8)].sqrt().to_degrees()
         ));
     }
+    warnings.extend(super::scale::warnings(
+        gyro_scale.as_ref(),
+        accel_scale.as_ref(),
+    ));
     if c.missing_velocity[2] > 0 {
         warnings.push(format!(
             "{} of {} fixes have no vertical velocity: only their position and horizontal \
@@ -218,6 +229,8 @@ pub fn summary(c: &Calibrated, s: &Settings, imu_file: &str) -> Summary {
         alignment,
         gyro_bias_rad_s: gyro,
         accel_bias_m_s2: accel,
+        gyro_scale_factor_ppm: gyro_scale,
+        accel_scale_factor_ppm: accel_scale,
         attitude_deg: attitude,
         intervals_conditional: !rejected_by.is_empty(),
         nis,
@@ -230,7 +243,10 @@ pub fn summary(c: &Calibrated, s: &Settings, imu_file: &str) -> Summary {
 }
 
 /// The NIS test, each component's whiteness, and the tests that reject the model.
-fn tests(c: &Calibrated, s: &Settings) -> (NisTest, Vec<ComponentWhiteness>, Vec<String>) {
+fn tests<const N: usize>(
+    c: &Calibrated<N>,
+    s: &Settings,
+) -> (NisTest, Vec<ComponentWhiteness>, Vec<String>) {
     let nis: Vec<f64> = c.records.iter().map(|r| r.nis).collect();
     let rows: Vec<usize> = c.records.iter().map(|r| r.rows).collect();
     let nis = nis_test_rows(&nis, &rows, s.false_alarm_rate);
@@ -262,7 +278,7 @@ fn tests(c: &Calibrated, s: &Settings) -> (NisTest, Vec<ComponentWhiteness>, Vec
 }
 
 /// The alignment as the summary tells it.
-fn alignment_record(c: &Calibrated) -> AlignmentRecord {
+fn alignment_record<const N: usize>(c: &Calibrated<N>) -> AlignmentRecord {
     let a = &c.alignment;
     let deg = f64::to_degrees;
     let p = &a.covariance;
@@ -282,7 +298,12 @@ fn alignment_record(c: &Calibrated) -> AlignmentRecord {
 }
 
 /// The biases and the attitude of the last record `r`.
-fn end_estimates(r: &FixRecord, c: &Calibrated, s: &Settings, t: f64) -> (Triad, Triad, Attitude) {
+fn end_estimates<const N: usize>(
+    r: &FixRecord<N>,
+    c: &Calibrated<N>,
+    s: &Settings,
+    t: f64,
+) -> (Triad, Triad, Attitude) {
     let (sg, sa) = bias_sigmas(&r.covariance);
     let pg = prior_sigma(
         s.gyro_bias_sigma_rad_s,
@@ -335,12 +356,12 @@ smoothed_sigma_bax_m_s2,smoothed_sigma_bay_m_s2,smoothed_sigma_baz_m_s2";
 ///
 /// # Errors
 /// The writer's.
-pub fn write_estimates(
-    c: &Calibrated,
-    smoothed: &[Smoothed],
+pub fn write_estimates<const N: usize>(
+    c: &Calibrated<N>,
+    smoothed: &[Smoothed<N>],
     out: &mut impl Write,
 ) -> io::Result<()> {
-    writeln!(out, "{ESTIMATES_HEADER}")?;
+    writeln!(out, "{ESTIMATES_HEADER}{}", super::scale::header::<N>())?;
     for (r, sm) in c.records.iter().zip(smoothed) {
         let p = &r.pva.position;
         let v = r.pva.velocity_ned_m_s;
@@ -379,6 +400,7 @@ pub fn write_estimates(
         let (sg, sa) = bias_sigmas(&sm.covariance);
         row.extend(sg);
         row.extend(sa);
+        super::scale::extend_row(&mut row, sm);
         let mut line = String::new();
         crate::logs::write::push_row(&mut line, &row);
         out.write_all(line.as_bytes())?;
