@@ -9,6 +9,7 @@ use accelcal::calibrate::imu::noise::log_likelihood;
 use accelcal::calibrate::imu::read::{ImuSpan, ImuStep, read_steps};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ins::InsConfig;
+use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Study;
 use accelcal::logs::read::LogText;
@@ -74,7 +75,16 @@ const END_FALL: f64 = 1.92;
 /// within `tolerance` at each move of [`moves`], each of which moves the rerun's ℓ by more than
 /// `tolerance` (the control: a model that ignored the statistics would fail).
 fn check((rows, steps): &(Vec<GnssRow>, Vec<ImuStep>), s: &Settings, tolerance: f64) {
-    let model = Linearized::new(rows, steps, s).expect("runs");
+    if s.error_states > STATES {
+        check_of::<STATES_WITH_SCALE>((rows, steps), s, tolerance);
+    } else {
+        check_of::<STATES>((rows, steps), s, tolerance);
+    }
+}
+
+/// [`check`] with the filter of `N` error states.
+fn check_of<const N: usize>((rows, steps): (&[GnssRow], &[ImuStep]), s: &Settings, tolerance: f64) {
+    let model = Linearized::<N>::new(rows, steps, s).expect("runs");
     let fixes = model.len() - 2;
     let exact = log_likelihood(rows, steps, s, fixes);
     let linear = model.log_likelihood(s, fixes);
@@ -102,6 +112,16 @@ fn check((rows, steps): &(Vec<GnssRow>, Vec<ImuStep>), s: &Settings, tolerance: 
 #[test]
 fn linear_likelihood_is_the_runs_on_a_simulated_drive() {
     check(&simulated(), &CONSUMER, END_FALL / 8.0);
+}
+
+/// The same with the six scale factors as states (21): the linearized model carries them.
+#[test]
+fn linear_likelihood_is_the_runs_with_the_scale_factors() {
+    let s = Settings {
+        error_states: STATES_WITH_SCALE,
+        ..CONSUMER
+    };
+    check(&simulated(), &s, END_FALL / 8.0);
 }
 
 /// On the comma2k19 minute (a vibrating phone, smoothed fixes) within half an end's fall.

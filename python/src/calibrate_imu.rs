@@ -17,6 +17,7 @@ use accelcal::calibrate::imu::smoother::{Smoothed, smooth};
 use accelcal::calibrate::imu::summary::{Summary, summary, write_estimates};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::error::ConfigError;
+use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
 
 use crate::config::Source;
 
@@ -28,10 +29,18 @@ const GNSS_NAME: &str = "gnss";
 /// (plain numbers: any Python thread may use it).
 #[pyclass(frozen, module = "accelcal._accelcal")]
 pub(crate) struct ImuCalibrationResult {
-    calibrated: Calibrated,
+    run: Run,
     summary: Summary,
-    smoothed: Vec<Smoothed>,
     estimates_csv: String,
+}
+
+/// The filter's records and their smoothing, with 15 error states or 21 (the scale factors).
+enum Run {
+    Biases(Calibrated, Vec<Smoothed>),
+    Scales(
+        Calibrated<STATES_WITH_SCALE>,
+        Vec<Smoothed<STATES_WITH_SCALE>>,
+    ),
 }
 
 #[pymethods]
@@ -50,12 +59,11 @@ impl ImuCalibrationResult {
 
     /// The page `index.html`, with `command` as the line that reproduces it.
     fn html(&self, command: &str) -> PyResult<String> {
-        accelcal::report::calibration_imu::render(
-            &self.calibrated,
-            &self.summary,
-            &self.smoothed,
-            command,
-        )
+        use accelcal::report::calibration_imu::render;
+        match &self.run {
+            Run::Biases(c, sm) => render(c, &self.summary, sm, command),
+            Run::Scales(c, sm) => render(c, &self.summary, sm, command),
+        }
         .map_err(crate::bad_input)
     }
 }
@@ -115,12 +123,6 @@ fn calibrate(
     confidence: f64,
     cancel: &accelcal::progress::Cancel,
 ) -> PyResult<ImuCalibrationResult> {
-    if settings.error_states > accelcal::ins::error_state::STATES {
-        return Err(crate::bad_input(
-            "filter.error_states = 21: the scale factors are estimated by the command line \
-             (accelcal calibrate --imu … --gnss … --config FILE); from Python, 15",
-        ));
-    }
     let estimate = match keys {
         None => None,
         Some(keys) => Some(
@@ -141,24 +143,40 @@ fn calibrate(
         ),
     };
     let settings = estimate.as_ref().map_or(settings, |e| &e.settings);
-    let calibrated = calibrate_held(
+    let (run, mut summary, estimates) = if settings.error_states > STATES {
+        let (c, s, sm, e) = finished::<STATES_WITH_SCALE>(held, settings)?;
+        (Run::Scales(c, sm), s, e)
+    } else {
+        let (c, s, sm, e) = finished::<STATES>(held, settings)?;
+        (Run::Biases(c, sm), s, e)
+    };
+    summary.noise_estimate = estimate;
+    Ok(ImuCalibrationResult {
+        run,
+        summary,
+        estimates_csv: String::from_utf8(estimates).map_err(crate::bad_input)?,
+    })
+}
+
+/// The held logs calibrated by a filter of `N` error states: the records, the summary, the
+/// smoothing and `estimates.csv`'s bytes.
+#[allow(clippy::type_complexity)]
+fn finished<const N: usize>(
+    held: &Held,
+    settings: &Settings,
+) -> PyResult<(Calibrated<N>, Summary, Vec<Smoothed<N>>, Vec<u8>)> {
+    let calibrated = calibrate_held::<N>(
         &held.rows,
         (&held.steps, held.span, held.layout),
         settings,
         GNSS_NAME,
     )
     .map_err(crate::bad_input)?;
-    let mut summary = summary(&calibrated, settings, IMU_NAME);
-    summary.noise_estimate = estimate;
+    let summary = summary(&calibrated, settings, IMU_NAME);
     let smoothed = smooth(&calibrated.records);
     let mut estimates = Vec::new();
     write_estimates(&calibrated, &smoothed, &mut estimates).map_err(crate::bad_input)?;
-    Ok(ImuCalibrationResult {
-        calibrated,
-        summary,
-        smoothed,
-        estimates_csv: String::from_utf8(estimates).map_err(crate::bad_input)?,
-    })
+    Ok((calibrated, summary, smoothed, estimates))
 }
 
 /// The slices of `arrays` (float64 and contiguous: the Python layer converts once).

@@ -244,3 +244,26 @@ def test_the_result_is_usable_from_another_thread():
     worker.start()
     worker.join()
     assert pages and pages[0] == r.html()
+
+
+@pytest.mark.parametrize("estimate", [None, ["gnss_velocity_sigma_m_s"]])
+def test_scale_factors_equal_the_command(cli, tmp_path, estimate):
+    """``[filter] error_states = 21``: the six scale factors in summary.json and estimates.csv,
+    the command's bit for bit; the shipped minute (no turns) leaves them undetermined."""
+    imu, gnss = COMMA_3D / "imu.csv", COMMA_3D / "gnss.csv"
+    config = tmp_path / "scale.toml"
+    config.write_text("[filter]\nerror_states = 21\n")
+    out = tmp_path / "out"
+    args = ["calibrate", "--imu", imu, "--gnss", gnss, "--config", config, "--out", out, "--quiet"]
+    if estimate:
+        args += ["--estimate-noise", "--estimate", ",".join(estimate)]
+    cli(*args)
+    r = accelcal.calibrate(imu=table(imu), gnss=table(gnss), config=config, estimate_noise=estimate)
+    assert_equals_the_command(r, out, imu, gnss)
+    for key in ("gyro_scale_factor_ppm", "accel_scale_factor_ppm"):
+        assert r.summary[key]["identifiable"] == [False, False, False]
+    assert "smoothed_sgz_ppm" in r.estimates
+    assert "gyro scale factor, z" in r.html()
+    # Control: the 15-state calibration has no scale factors.
+    plain = accelcal.calibrate(imu=table(imu), gnss=table(gnss))
+    assert "gyro_scale_factor_ppm" not in plain.summary

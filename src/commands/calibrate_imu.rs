@@ -11,9 +11,7 @@ use accelcal::calibrate::imu::config::settings_of;
 use accelcal::calibrate::imu::gnss::read_gnss;
 use accelcal::calibrate::imu::noise::{self, ImuKey};
 use accelcal::calibrate::imu::read::read_steps;
-use accelcal::calibrate::imu::run::{
-    Calibrated, ImuCalibrateError, calibrate, calibrate_held, calibrate_of,
-};
+use accelcal::calibrate::imu::run::{Calibrated, ImuCalibrateError, calibrate_held, calibrate_of};
 use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary, write_estimates};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
@@ -54,27 +52,25 @@ pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
     if !args.quiet && std::io::stderr().is_terminal() {
         eprintln!("checking the logs, aligning and running the filter…");
     }
-    let (imu_log, gnss_log) = (LogFile::new(imu), LogFile::new(gnss));
     if settings.error_states > STATES {
-        if args.estimate_noise {
-            return Err(ConfigError::invalid(
-                "filter.error_states",
-                settings.error_states,
-                "15 with --estimate-noise (the noise search runs the 15-state filter: estimate \
-                 the statistics first, then calibrate the scale factors with them in --config)",
-            )
-            .into());
-        }
-        let c =
-            calibrate_of::<STATES_WITH_SCALE>(&imu_log, &gnss_log, &settings).map_err(anyhow_of)?;
-        let s = summary(&c, &settings, &imu.display().to_string());
-        return write_outputs(args, (imu, gnss), &c, &s);
-    }
-    let (c, s) = if args.estimate_noise {
-        with_noise(args, &imu_log, &gnss_log, &settings)?
+        run_with::<STATES_WITH_SCALE>(args, (imu, gnss), &settings)
     } else {
-        let c = calibrate(&imu_log, &gnss_log, &settings).map_err(anyhow_of)?;
-        let s = summary(&c, &settings, &imu.display().to_string());
+        run_with::<STATES>(args, (imu, gnss), &settings)
+    }
+}
+
+/// The calibration with a filter of `N` error states, its outputs written.
+fn run_with<const N: usize>(
+    args: &CalibrateArgs,
+    (imu, gnss): (&Path, &Path),
+    settings: &Settings,
+) -> Result<()> {
+    let (imu_log, gnss_log) = (LogFile::new(imu), LogFile::new(gnss));
+    let (c, s) = if args.estimate_noise {
+        with_noise::<N>(args, &imu_log, &gnss_log, settings)?
+    } else {
+        let c = calibrate_of::<N>(&imu_log, &gnss_log, settings).map_err(anyhow_of)?;
+        let s = summary(&c, settings, &imu.display().to_string());
         (c, s)
     };
     write_outputs(args, (imu, gnss), &c, &s)
@@ -128,12 +124,12 @@ fn imu_keys(args: &CalibrateArgs) -> Result<Vec<ImuKey>> {
 }
 
 /// `--estimate-noise`: the logs held, the keys estimated, the recording calibrated with them.
-fn with_noise(
+fn with_noise<const N: usize>(
     args: &CalibrateArgs,
     imu: &LogFile,
     gnss: &LogFile,
     settings: &Settings,
-) -> Result<(Calibrated, Summary)> {
+) -> Result<(Calibrated<N>, Summary)> {
     let keys = imu_keys(args)?;
     let rows = read_gnss(gnss)?;
     let (steps, span, layout) = read_steps(imu, settings.axes)?;

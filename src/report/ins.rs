@@ -283,7 +283,7 @@ fn record(s: &InsStudy) -> InsRecord {
     InsRecord {
         realizations: s.realizations,
         filters,
-        final_sigma: VARIABLES
+        final_sigma: VARIABLES[..s.calibration.filter_sigma.len()]
             .iter()
             .enumerate()
             .map(|(k, v)| {

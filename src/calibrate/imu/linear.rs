@@ -14,8 +14,9 @@
 //! receiver's time offset δ moves each fix by ε = δ − δ_run along the run's solution: the
 //! predicted velocity by Δv = C·(∫f dt − b̂_a·ε) + (γ − (2Ω_ie + Ω_en)×v)·ε with the specific
 //! force integrated over the IMU steps between the two times (shared in proportion, as the run
-//! cuts a step at a fix), the position by v·ε + Δv·ε/2. Each evaluation costs O(fixes) 15×15
-//! products instead of a run over every IMU step.
+//! cuts a step at a fix; divided by 1 + ŝ_a per axis with the scale factors), the position by
+//! v·ε + Δv·ε/2. Each evaluation costs O(fixes) 15×15 products (21×21 with the scale factors)
+//! instead of a run over every IMU step.
 
 use nalgebra::{SMatrix, SVector, Vector3};
 
@@ -26,32 +27,32 @@ use super::read::{HeldSteps, ImuStep};
 use super::run::{ImuCalibrateError, alignment_sources, filter_tracked, shifted};
 use super::step::{fix_of, initial_covariance, noise};
 use crate::ins::discrete::transition_congruence;
-use crate::ins::error_state::{ATTITUDE, Matrix15, STATES};
+use crate::ins::error_state::{ATTITUDE, STATES, Square};
 use crate::ins::filter::{LinearView, NOISE_GROUPS};
 
 /// One fix of the linearized model.
 #[derive(Clone, Debug)]
-struct LinearFix {
+struct LinearFix<const N: usize> {
     /// The fix as the run read it (its σ's where the log has them, what it measures; its time
     /// moved by the run's offset).
     row: GnssRow,
     /// The first IMU step that ends at or after the fix.
     step: usize,
     /// Φ from the previous fix (or the start).
-    transition: Matrix15,
+    transition: Square<N>,
     /// Q_d from the previous fix by noise group at unit density.
-    noise_parts: [Matrix15; NOISE_GROUPS],
+    noise_parts: [Square<N>; NOISE_GROUPS],
     /// H and the motion at the run's solution.
-    view: LinearView,
+    view: LinearView<N>,
     /// The run's innovation (NaN where not measured).
     innovation: [f64; 6],
     /// The errors the run's update took out of its solution.
-    correction: SVector<f64, STATES>,
+    correction: SVector<f64, N>,
 }
 
 /// The likelihood of a drive linearized about one run of the filter.
 #[derive(Clone, Debug)]
-pub struct Linearized<'a> {
+pub struct Linearized<'a, const N: usize = STATES> {
     /// The IMU steps.
     steps: &'a [ImuStep],
     /// The assumptions of the run.
@@ -63,14 +64,14 @@ pub struct Linearized<'a> {
     /// The mean specific force over the alignment's window.
     mean_f_b: Vector3<f64>,
     /// One per fix after the start.
-    fixes: Vec<LinearFix>,
+    fixes: Vec<LinearFix<N>>,
     /// The filter's view at its start and the first IMU step ending at or after it.
-    start_view: (LinearView, usize),
+    start_view: (LinearView<N>, usize),
     /// The first IMU step ending at or after the alignment's first fix.
     first_step: usize,
 }
 
-impl<'a> Linearized<'a> {
+impl<'a, const N: usize> Linearized<'a, N> {
     /// The model about the run of the filter over `steps` and the fixes `rows` (as read) with
     /// the assumptions `s`.
     ///
@@ -82,7 +83,7 @@ impl<'a> Linearized<'a> {
         s: &Settings,
     ) -> Result<Self, ImuCalibrateError> {
         let rows = shifted(rows, s.gnss_time_offset_s);
-        let run = filter_tracked(&rows, &mut HeldSteps::new(steps), s, "")?;
+        let run = filter_tracked::<N>(&rows, &mut HeldSteps::new(steps), s, "")?;
         let start = run.plan.start;
         let fixes = run
             .records
@@ -160,13 +161,13 @@ impl<'a> Linearized<'a> {
             self.mean_f_b + (end - begin) / window
         };
         let a = align::align(first, heading, &mean_f_b, &alignment_sources(heading, t));
-        let mut p = initial_covariance(heading, &a, t);
+        let mut p = initial_covariance::<N>(heading, &a, t);
         let d = noise(t).0.groups();
         let ln_2pi = (2.0 * std::f64::consts::PI).ln();
         // A later start leaves the run's solution ahead of the filter's by the motion, and its
         // attitude off the other alignment's by the rotation between them.
         let moved = motion(self.steps, (view, *step, heading.t_s), shift);
-        let mut m = SVector::<f64, STATES>::zeros();
+        let mut m = SVector::<f64, N>::zeros();
         m.fixed_rows_mut::<6>(0).copy_from_slice(&moved);
         if shift != 0.0 {
             let [roll, pitch, yaw] = a.euler_rad;
@@ -175,7 +176,7 @@ impl<'a> Linearized<'a> {
             m.fixed_rows_mut::<3>(ATTITUDE)
                 .copy_from(&(run * c.inverse()).scaled_axis());
         }
-        let mut applied = SVector::<f64, STATES>::zeros();
+        let mut applied = SVector::<f64, N>::zeros();
         let mut sum = 0.0;
         for (index, fx) in self.fixes[..fixes].iter().enumerate() {
             m = fx.transition * (m - applied);
@@ -225,12 +226,17 @@ impl<'a> Linearized<'a> {
 /// How far the predicted measurement at a fix moves when the fix is `shift` s later, from the
 /// filter's `view` there, the first IMU step ending at or after it, and its time: the antenna's
 /// position (NED, m) and velocity (m/s).
-fn motion(steps: &[ImuStep], (v, step, t): (&LinearView, usize, f64), shift: f64) -> [f64; 6] {
+fn motion<const N: usize>(
+    steps: &[ImuStep],
+    (v, step, t): (&LinearView<N>, usize, f64),
+    shift: f64,
+) -> [f64; 6] {
     if shift == 0.0 {
         return [0.0; 6];
     }
     let f = specific_force_integral(steps, step, t, t + shift);
-    let dv = v.c_bn * (f - v.accel_bias_m_s2 * shift) + v.field_acceleration_ned_m_s2 * shift;
+    let compensated = (f - v.accel_bias_m_s2 * shift).component_div(&v.accel_scale.add_scalar(1.0));
+    let dv = v.c_bn * compensated + v.field_acceleration_ned_m_s2 * shift;
     let dp = v.antenna_velocity_ned_m_s * shift + dv * (0.5 * shift);
     [dp.x, dp.y, dp.z, dv.x, dv.y, dv.z]
 }
@@ -267,9 +273,9 @@ fn specific_force_integral(steps: &[ImuStep], step: usize, from: f64, to: f64) -
 }
 
 /// P ← (P + Pᵀ)/2 in place.
-fn symmetrize(p: &mut Matrix15) {
-    for i in 0..STATES {
-        for j in i + 1..STATES {
+fn symmetrize<const N: usize>(p: &mut Square<N>) {
+    for i in 0..N {
+        for j in i + 1..N {
             let v = 0.5 * (p[(i, j)] + p[(j, i)]);
             p[(i, j)] = v;
             p[(j, i)] = v;

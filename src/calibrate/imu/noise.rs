@@ -21,7 +21,7 @@ use super::gnss::GnssRow;
 use super::linear::Linearized;
 use super::read::{HeldSteps, ImuSpan, ImuStep};
 use super::run::{filter, shifted};
-use crate::ins::error_state::STATES;
+use crate::ins::error_state::{STATES, STATES_WITH_SCALE};
 use crate::likelihood::{Fit, climb, maximize};
 use crate::progress::{Cancel, Cancelled};
 
@@ -224,8 +224,22 @@ pub struct NoiseEstimate {
 /// The log-likelihood of the GNSS innovations of the filter with assumptions `s` over the
 /// first `fixes` fixes after the alignment's; −∞ when the filter cannot run or updates fewer.
 pub fn log_likelihood(rows: &[GnssRow], steps: &[ImuStep], s: &Settings, fixes: usize) -> f64 {
+    if s.error_states > STATES {
+        log_likelihood_of::<STATES_WITH_SCALE>(rows, steps, s, fixes)
+    } else {
+        log_likelihood_of::<STATES>(rows, steps, s, fixes)
+    }
+}
+
+/// [`log_likelihood`] of a filter of `N` error states.
+fn log_likelihood_of<const N: usize>(
+    rows: &[GnssRow],
+    steps: &[ImuStep],
+    s: &Settings,
+    fixes: usize,
+) -> f64 {
     let rows = shifted(rows, s.gnss_time_offset_s);
-    let Ok(run) = filter::<STATES>(&rows, &mut HeldSteps::new(steps), s, "") else {
+    let Ok(run) = filter::<N>(&rows, &mut HeldSteps::new(steps), s, "") else {
         return f64::NEG_INFINITY;
     };
     if run.records.len() < fixes {
@@ -279,8 +293,23 @@ pub fn estimate_cancellable(
     Ok(found)
 }
 
-/// The search of [`estimate_cancellable`].
+/// The search of [`estimate_cancellable`], on the filter of the error states `s` names.
 fn search(
+    rows: &[GnssRow],
+    steps: &[ImuStep],
+    span: &ImuSpan,
+    request: (&Settings, &[ImuKey], f64),
+    cancel: &Cancel,
+) -> Option<NoiseEstimate> {
+    if request.0.error_states > STATES {
+        search_of::<STATES_WITH_SCALE>(rows, steps, span, request, cancel)
+    } else {
+        search_of::<STATES>(rows, steps, span, request, cancel)
+    }
+}
+
+/// [`search`] on a filter of `N` error states.
+fn search_of<const N: usize>(
     rows: &[GnssRow],
     steps: &[ImuStep],
     span: &ImuSpan,
@@ -307,7 +336,7 @@ fn search(
             }
         })
         .collect();
-    let mut model = Linearized::new(rows, steps, s).ok()?;
+    let mut model = Linearized::<N>::new(rows, steps, s).ok()?;
     let fixes = fixes_in_reach(rows, span, model.start);
     let mut at_run = model.log_likelihood(s, fixes);
     let (mut evaluations, mut filter_runs, mut settled) = (0, 1, false);
@@ -331,7 +360,7 @@ fn search(
             let candidate: Vec<f64> = u.iter().zip(&step).map(|(a, d)| a + d).collect();
             let t = settings_at(&candidate);
             filter_runs += 1;
-            if let Ok(next) = Linearized::new(rows, steps, &t) {
+            if let Ok(next) = Linearized::<N>::new(rows, steps, &t) {
                 let value = next.log_likelihood(&t, fixes);
                 if value > at_run {
                     (model, u, at_run) = (next, candidate, value);
