@@ -193,3 +193,29 @@ fn damaged_missing_and_foreign_partials_are_refused() {
         2,
     ));
 }
+
+#[test]
+fn shards_of_a_21_state_ensemble_merge_to_the_text_of_one_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let config = format!(
+        "{CONFIG}[imu]\ngyro_scale_factor_sigma_ppm = 1000.0\naccel_scale_factor_sigma_ppm = \
+         1000.0\n[filter]\nerror_states = 21\n"
+    );
+    std::fs::write(d.join("c.toml"), config).unwrap();
+    ok(&run(d, &ins(&["--json", "whole.json"]), 2));
+    let whole = text_without_timing(&d.join("whole.json"));
+    // The scale factors are in the final states.
+    assert!(whole.contains("\"accel_scale_z\""), "{whole}");
+    let files: Vec<String> = (1..=2).map(|k| shard(d, k, 2, k)).collect();
+    ok(&merge(d, &files, "merged.json"));
+    assert_eq!(text_without_timing(&d.join("merged.json")), whole);
+    // Control: a 15-state shard of the same drive is of another ensemble.
+    std::fs::write(d.join("c.toml"), CONFIG).unwrap();
+    let other = shard(d, 2, 2, 2);
+    std::fs::rename(d.join(&other), d.join("other.bin")).unwrap();
+    refused(
+        &merge(d, &[files[0].clone(), "other.bin".to_string()], "x.json"),
+        &["other.bin", "another ensemble"],
+    );
+}

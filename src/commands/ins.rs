@@ -18,7 +18,7 @@ use accelcal::ins::blocks;
 use accelcal::ins::ensemble::{self as ins_ensemble, InsSums, Track};
 use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
 use accelcal::ins::logs::write_realization;
-use accelcal::ins::partial::{self, InsPartialHeader};
+use accelcal::ins::partial::{self, InsPartialHeader, MergedSums};
 use accelcal::ins::setup::Study;
 use accelcal::output::{AtomicFile, ScratchFile, StagedFiles, check_directory};
 use accelcal::study::Progress;
@@ -104,15 +104,11 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         .into());
     }
     if let (Some(shard), Some(path)) = (&args.shard, &args.partial) {
-        if study.error_states > STATES {
-            return Err(ConfigError::invalid(
-                "filter.error_states",
-                study.error_states,
-                "15 with --shard (a 21-state ensemble runs whole, in one process)",
-            )
-            .into());
-        }
-        return run_shard(&config, &study, shard, path, args.model.quiet);
+        return if study.error_states > STATES {
+            run_shard::<STATES_WITH_SCALE>(&config, &study, shard, path, args.model.quiet)
+        } else {
+            run_shard::<STATES>(&config, &study, shard, path, args.model.quiet)
+        };
     }
     if let Some(path) = &args.json {
         accelcal::output::check_file(path)?;
@@ -175,7 +171,7 @@ fn write_document<const N: usize>(
 
 /// `ensemble --model ins --shard K/M --partial FILE`: the blocks of shard K of M, their sums
 /// written to `path` (see docs/CLUSTER.md).
-fn run_shard(
+fn run_shard<const N: usize>(
     config: &InsConfig,
     study: &Study,
     shard: &str,
@@ -201,7 +197,7 @@ fn run_shard(
     let mut bar = super::Bar::new(quiet);
     bar.start(&format!("ins shard {k}/{m}"), realizations);
     let mut written = Ok(());
-    ins_ensemble::run_blocks(
+    ins_ensemble::run_blocks::<N>(
         study,
         &track,
         &blocks,
@@ -214,7 +210,7 @@ fn run_shard(
         },
     )?;
     bar.finish();
-    let empty = ins_ensemble::empty_sums(study, &track);
+    let empty = ins_ensemble::empty_sums::<N>(study, &track);
     let elapsed_s = start.elapsed().as_secs_f64();
     let header = InsPartialHeader::new(config, &empty, shard, range.clone(), elapsed_s);
     written
@@ -271,14 +267,17 @@ pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
     }
     let merged = partial::merge(super::shards::open_partials(&args.files)?)?;
     let label = format!("three axes (merged from {} shards)", args.files.len());
-    write_document(
+    let label = (!args.quiet).then_some(label.as_str());
+    let (c, s, t, json) = (
         &merged.config,
         &merged.study,
-        &merged.sums,
         merged.elapsed_s,
         args.json.as_deref(),
-        (!args.quiet).then_some(label.as_str()),
-    )
+    );
+    match &merged.sums {
+        MergedSums::Biases(sums) => write_document(c, s, sums, t, json, label),
+        MergedSums::Scales(sums) => write_document(c, s, sums, t, json, label),
+    }
 }
 
 /// `simulate --model ins`: one realization's IMU and GNSS logs and its truth.

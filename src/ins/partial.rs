@@ -7,7 +7,8 @@
 //! and realization count, as little-endian 64-bit floats: per fix, the normalized sums
 //! ([`FixSums::FLOATS`]) and Σ R a priori and a posteriori (column-major); the kept residual
 //! products; the single residual pair's products (column-major); Σ e², Σ σ² and the within-95 %
-//! counts at the last fix.
+//! counts at the last fix; each over the configuration's error state (15, or 21 with the scale
+//! factors).
 
 use std::io::{BufRead, Read};
 
@@ -16,7 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use super::blocks;
 use super::ensemble::{InsSums, MEASURED, Track, empty_sums};
-use super::error_state::STATES;
+use super::error_state::{STATES, STATES_WITH_SCALE};
 use super::setup::Study;
 use crate::config::ins::InsConfig;
 use crate::ensemble::Partition;
@@ -53,15 +54,23 @@ pub struct InsPartialHeader {
     pub elapsed_s: f64,
 }
 
-/// Floats of one fix's sums in a block: the normalized sums and Σ R of both stages.
-const FIX_LEN: usize = FixSums::<STATES>::FLOATS + 2 * STATES * STATES;
+/// Floats of one fix's sums in a block over an error state of `N`: the normalized sums and Σ R
+/// of both stages.
+const fn fix_len<const N: usize>() -> usize {
+    FixSums::<N>::FLOATS + 2 * N * N
+}
+
+/// The error states of the filter `config` configures.
+fn states_of(config: &InsConfig) -> usize {
+    config.filter.error_states.map_or(STATES, |n| n as usize)
+}
 
 impl InsPartialHeader {
     /// The header of shard `shard` (its `blocks`) of the ensemble configured by `config`,
     /// whose sums have the fixes and residual lag of `sums`, its realizations run in `elapsed_s`.
-    pub fn new(
+    pub fn new<const N: usize>(
         config: &InsConfig,
-        sums: &InsSums,
+        sums: &InsSums<N>,
         shard: Shard,
         blocks: std::ops::Range<u64>,
         elapsed_s: f64,
@@ -83,12 +92,17 @@ impl InsPartialHeader {
     pub fn block_bytes(&self) -> usize {
         let products =
             crate::ensemble::ResidualLayout::with_width(self.fixes, MEASURED, self.max_lag).len();
-        16 + 8 * (self.fixes * FIX_LEN + products + MEASURED * MEASURED + 3 * STATES)
+        let (fix, n) = if states_of(&self.config) > STATES {
+            (fix_len::<STATES_WITH_SCALE>(), STATES_WITH_SCALE)
+        } else {
+            (fix_len::<STATES>(), STATES)
+        };
+        16 + 8 * (self.fixes * fix + products + MEASURED * MEASURED + 3 * n)
     }
 }
 
 /// Block `index`'s bytes without their digest: index, realization count, sums.
-pub fn encode_block(index: u64, sums: &InsSums) -> Vec<u8> {
+pub fn encode_block<const N: usize>(index: u64, sums: &InsSums<N>) -> Vec<u8> {
     let acc = &sums.normalized.sums;
     let mut floats = Vec::new();
     for (f, r) in acc.fixes.iter().zip(&sums.normalized.correlation) {
@@ -126,29 +140,29 @@ pub fn write_partial(
 
 /// The sums of a block of `count` realizations from its `floats`, in [`encode_block`]'s order,
 /// into `sums` (the ensemble's empty sums).
-fn decode_block(mut sums: InsSums, count: u64, floats: &[f64]) -> InsSums {
+fn decode_block<const N: usize>(mut sums: InsSums<N>, count: u64, floats: &[f64]) -> InsSums<N> {
     let mut rest = floats;
     let mut take = |len: usize| {
         let (head, tail) = rest.split_at(len);
         rest = tail;
         head
     };
-    let stage = StageSums::<STATES>::FLOATS;
+    let stage = StageSums::<N>::FLOATS;
     let n = &mut sums.normalized;
     n.sums.count = count;
     for (f, r) in n.sums.fixes.iter_mut().zip(&mut n.correlation) {
         f.prior = StageSums::from_floats(take(stage));
         f.post = StageSums::from_floats(take(stage));
         f.nis = take(1)[0];
-        r[0] = SMatrix::from_column_slice(take(STATES * STATES));
-        r[1] = SMatrix::from_column_slice(take(STATES * STATES));
+        r[0] = SMatrix::from_column_slice(take(N * N));
+        r[1] = SMatrix::from_column_slice(take(N * N));
     }
     let products = n.sums.residual_products.len();
     n.sums.residual_products.copy_from_slice(take(products));
     n.sums.pair_products = SMatrix::from_column_slice(take(MEASURED * MEASURED));
-    sums.sq_error = SVector::from_column_slice(take(STATES));
-    sums.variance = SVector::from_column_slice(take(STATES));
-    for (w, x) in sums.within_95.iter_mut().zip(take(STATES)) {
+    sums.sq_error = SVector::from_column_slice(take(N));
+    sums.variance = SVector::from_column_slice(take(N));
+    for (w, x) in sums.within_95.iter_mut().zip(take(N)) {
         *w = *x as u64;
     }
     sums
@@ -161,9 +175,17 @@ pub struct InsMerged {
     /// The study it configures.
     pub study: Study,
     /// The sums of the whole ensemble, folded in block order.
-    pub sums: InsSums,
+    pub sums: MergedSums,
     /// The shards' run times added up, s.
     pub elapsed_s: f64,
+}
+
+/// The merged sums, over the error state the configuration names.
+pub enum MergedSums {
+    /// 15 states.
+    Biases(InsSums),
+    /// 21 states: the scale factors too.
+    Scales(InsSums<STATES_WITH_SCALE>),
 }
 
 /// A three-axis partial file whose header is read.
@@ -220,12 +242,36 @@ pub fn merge<R: BufRead>(files: Vec<(String, R)>) -> Result<InsMerged, PartialEr
             format!("the configuration in its header is not valid: {e}"),
         )
     })?;
-    let track = Track::of(&study);
-    let empty = empty_sums(&study, &track);
+    let (sums, elapsed_s) = if study.error_states > STATES {
+        let (sums, t) = fold::<R, STATES_WITH_SCALE>(opened, &study, &first, &first_name)?;
+        (MergedSums::Scales(sums), t)
+    } else {
+        let (sums, t) = fold::<R, STATES>(opened, &study, &first, &first_name)?;
+        (MergedSums::Biases(sums), t)
+    };
+    Ok(InsMerged {
+        config: first.config,
+        study,
+        sums,
+        elapsed_s,
+    })
+}
+
+/// The shards `opened`, checked against the first's header `first` (of `first_name`), folded
+/// in block order into the sums of `study`'s ensemble over `N` error states; the shards' run
+/// times added up.
+fn fold<R: BufRead, const N: usize>(
+    mut opened: Vec<Opened<R>>,
+    study: &Study,
+    first: &InsPartialHeader,
+    first_name: &str,
+) -> Result<(InsSums<N>, f64), PartialError> {
+    let track = Track::of(study);
+    let empty = empty_sums::<N>(study, &track);
     let made = InsPartialHeader::new(&first.config, &empty, Shard::WHOLE, 0..0, 0.0);
     if (made.fixes, made.max_lag) != (first.fixes, first.max_lag) {
         return Err(mismatch(
-            &first_name,
+            first_name,
             format!(
                 "its header is inconsistent: its configuration makes {} fixes and residual lag \
                  {:?}, the header says {} and {:?}",
@@ -235,7 +281,7 @@ pub fn merge<R: BufRead>(files: Vec<(String, R)>) -> Result<InsMerged, PartialEr
     }
     let blocks = blocks::partition(study.realizations);
     for o in &opened {
-        if let Some(why) = differs(&o.header, &first, &first_name, &blocks) {
+        if let Some(why) = differs(&o.header, first, first_name, &blocks) {
             return Err(mismatch(&o.name, why));
         }
     }
@@ -250,12 +296,7 @@ pub fn merge<R: BufRead>(files: Vec<(String, R)>) -> Result<InsMerged, PartialEr
     for o in opened {
         elapsed_s += fold_shard(o, &blocks, &empty, &mut sums)?;
     }
-    Ok(InsMerged {
-        config: first.config,
-        study,
-        sums,
-        elapsed_s,
-    })
+    Ok((sums, elapsed_s))
 }
 
 /// Why the shard `h` is not of the ensemble of `first` (the header of `first_name`), cut as
@@ -307,11 +348,11 @@ fn differs(
 
 /// Adds the blocks of the shard `o` to `sums`, in block order, checking that they are the blocks
 /// of its shard of `blocks`, each with its realizations; its run time.
-fn fold_shard<R: BufRead>(
+fn fold_shard<R: BufRead, const N: usize>(
     o: Opened<R>,
     blocks: &Partition,
-    empty: &InsSums,
-    sums: &mut InsSums,
+    empty: &InsSums<N>,
+    sums: &mut InsSums<N>,
 ) -> Result<f64, PartialError> {
     let Opened {
         name,
