@@ -15,7 +15,7 @@ use crate::format::{count, fixed, sig};
 use crate::ins::names::{MEASUREMENTS, VARIABLES};
 use crate::plot::{self, TraceSeries};
 use crate::stats::binomial_band;
-use crate::study::ins::{Control, InsStudy};
+use crate::study::ins::{Control, InsStudy, SCALE_PPM};
 
 const TRACK: Figure = Figure::Named("ins-track");
 const TRACE: Figure = Figure::Named("ins-trace");
@@ -141,11 +141,30 @@ fn findings(s: &InsStudy) -> String {
             since(first_failure(&s.verdicts, &s.times_s))
         )
     });
+    out.push(' ');
+    out.push_str(&scaled_sentence(&s.scaled));
     for c in &s.controls {
         out.push(' ');
         out.push_str(&control_sentence(c));
     }
     out
+}
+
+/// What the 21-state filter on sensors with scale factors shows.
+fn scaled_sentence(c: &Control) -> String {
+    let f = failed(&c.verdicts);
+    let ppm = count(SCALE_PPM as u64);
+    if f.is_empty() {
+        format!(
+            "On sensors whose six scale factors have σ {ppm} ppm, the filter that carries them as six more states (21) passes every check too."
+        )
+    } else {
+        format!(
+            "On sensors whose six scale factors have σ {ppm} ppm, the filter that carries them as six more states (21) fails {}{}.",
+            f.join(", "),
+            since(first_failure(&c.verdicts, &c.times_s))
+        )
+    }
 }
 
 fn control_sentence(c: &Control) -> String {
@@ -233,7 +252,10 @@ pub fn view(s: &InsStudy, numbers: &Numbers) -> Result<InsView, RenderError> {
             within: format!("{} [{}, {}]", c.within_95[k], band.0, band.1),
         })
         .collect();
-    let mut rows = vec![row("the truth's statistics", &s.verdicts, &s.times_s)];
+    let mut rows = vec![
+        row("the truth's statistics", &s.verdicts, &s.times_s),
+        row(s.scaled.what, &s.scaled.verdicts, &s.scaled.times_s),
+    ];
     rows.extend(
         s.controls
             .iter()
@@ -274,7 +296,10 @@ fn record(s: &InsStudy) -> InsRecord {
             .map(|c| (c.id.name(), c.verdict.name()))
             .collect()
     };
-    let mut filters = vec![("the truth's statistics".to_string(), verdicts(&s.verdicts))];
+    let mut filters = vec![
+        ("the truth's statistics".to_string(), verdicts(&s.verdicts)),
+        (s.scaled.what.to_string(), verdicts(&s.scaled.verdicts)),
+    ];
     filters.extend(
         s.controls
             .iter()

@@ -5,7 +5,7 @@
 use crate::checks::{Budget, Verdicts, evaluate};
 use crate::config::ins::InsConfig;
 use crate::ins::ensemble::{self, Calibration, RealizationError, Track, filter_realization};
-use crate::ins::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, STATES};
+use crate::ins::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, STATES, STATES_WITH_SCALE};
 use crate::ins::gnss::ned_difference_m;
 use crate::ins::setup::Study;
 use crate::progress::Progress;
@@ -59,11 +59,25 @@ pub struct InsStudy {
     pub times_s: Vec<f64>,
     /// The calibration at the end of the drive.
     pub calibration: Calibration,
+    /// The filter of 21 states on sensors with [`SCALE_PPM`] scale factors.
+    pub scaled: Control,
     /// The negative controls.
     pub controls: Vec<Control>,
 }
 
-/// The verdicts and calibration of `realizations` realizations of `study`.
+/// The scale factors' σ of the sensors the 21-state filter and the control that leaves them out
+/// run on, ppm.
+pub const SCALE_PPM: f64 = 1000.0;
+
+/// `s` with sensors whose scale factors have σ [`SCALE_PPM`] (the filter assuming the same prior).
+fn with_scale_factors(s: &mut Study) {
+    for imu in [&mut s.truth_imu, &mut s.filter_imu] {
+        imu.gyro_scale_sigma = SCALE_PPM * 1e-6;
+        imu.accel_scale_sigma = SCALE_PPM * 1e-6;
+    }
+}
+
+/// The verdicts and calibration of `realizations` realizations of `study`'s 15-state filter.
 fn judged(
     study: &Study,
     track: &Track,
@@ -71,8 +85,19 @@ fn judged(
     progress: &mut dyn Progress,
     label: &str,
 ) -> Result<(Verdicts, Calibration, Vec<f64>), RealizationError> {
+    judged_of::<STATES>(study, track, realizations, progress, label)
+}
+
+/// [`judged`] with a filter of `N` error states.
+fn judged_of<const N: usize>(
+    study: &Study,
+    track: &Track,
+    realizations: u64,
+    progress: &mut dyn Progress,
+    label: &str,
+) -> Result<(Verdicts, Calibration<N>, Vec<f64>), RealizationError> {
     progress.start(label, realizations);
-    let sums = ensemble::sums(study, track, realizations, |done| progress.advance(done))?;
+    let sums = ensemble::sums::<N>(study, track, realizations, |done| progress.advance(done))?;
     progress.finish();
     let outcome = sums.outcome(study);
     let verdicts = evaluate(&outcome.stats, &Budget::study(study.false_alarm_rate));
@@ -130,7 +155,7 @@ fn track_every_second(study: &Study, track: &Track) -> Vec<[f64; 4]> {
 pub type ControlEdit = (&'static str, fn(&mut Study));
 
 /// The negative controls: each edit of the default study and what it makes wrong.
-pub const CONTROLS: [ControlEdit; 4] = [
+pub const CONTROLS: [ControlEdit; 5] = [
     ("assumes half the gyros' angle random walk", |s| {
         s.filter_imu.gyro_arw_rad_per_sqrt_s /= 2.0;
     }),
@@ -146,6 +171,10 @@ pub const CONTROLS: [ControlEdit; 4] = [
     ("starts with a 30° heading σ", |s| {
         s.initial_sigma[8] = 30f64.to_radians();
     }),
+    (
+        "leaves out the sensors' scale factors of 1 000 ppm (15 states)",
+        with_scale_factors,
+    ),
 ];
 
 /// Runs the three-axis study of `config` with `realizations` per ensemble.
@@ -161,6 +190,15 @@ pub fn run(
     let track = Track::of(&study);
     let (verdicts, calibration, times_s) =
         judged(&study, &track, realizations, progress, "3-axis")?;
+    let mut s = study.clone();
+    with_scale_factors(&mut s);
+    let (v, _, t) =
+        judged_of::<STATES_WITH_SCALE>(&s, &track, realizations, progress, "21 states")?;
+    let scaled = Control {
+        what: "estimates the sensors' scale factors of 1 000 ppm (21 states)",
+        verdicts: v,
+        times_s: t,
+    };
     let mut controls = Vec::new();
     for (what, edit) in CONTROLS {
         let mut s = study.clone();
@@ -180,6 +218,7 @@ pub fn run(
         verdicts,
         times_s,
         calibration,
+        scaled,
         controls,
     })
 }
