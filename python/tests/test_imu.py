@@ -263,7 +263,10 @@ def test_scale_factors_equal_the_command(cli, tmp_path, estimate):
     for key in ("gyro_scale_factor_ppm", "accel_scale_factor_ppm"):
         assert r.summary[key]["identifiable"] == [False, False, False]
     assert "smoothed_sgz_ppm" in r.estimates
-    assert "gyro scale factor, z" in r.html()
+    page = r.html()
+    assert "gyro scale factor, z" in page
+    assert "Not determined: the gyro scale factor x" in page
+    assert "A scale factor shows only through the motion it multiplies" in page
     # Control: the 15-state calibration has no scale factors.
     plain = accelcal.calibrate(imu=table(imu), gnss=table(gnss))
     assert "gyro_scale_factor_ppm" not in plain.summary

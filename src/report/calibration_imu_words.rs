@@ -109,8 +109,45 @@ pub fn findings(s: &Summary) -> Vec<String> {
             }
         ));
     }
+    out.extend(scale_finding(s));
     out.extend(whiteness_findings(s));
     out
+}
+
+/// The scale factors in words, when estimated: which the drive determined and why the others
+/// are not.
+fn scale_finding(s: &Summary) -> Option<String> {
+    let (g, a) = (
+        s.gyro_scale_factor_ppm.as_ref()?,
+        s.accel_scale_factor_ppm.as_ref()?,
+    );
+    let mut open = Vec::new();
+    let mut shut = Vec::new();
+    for (t, what) in [(g, "gyro"), (a, "accelerometer")] {
+        for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+            let name = format!("the {what} scale factor {axis}");
+            if t.identifiable[i] {
+                &mut shut
+            } else {
+                &mut open
+            }
+            .push(name);
+        }
+    }
+    Some(if open.is_empty() {
+        "All six scale factors are determined by the drive: each σ at the end is at most half          of its prior's."
+            .to_string()
+    } else {
+        format!(
+            "{}Not determined: {}. A scale factor shows only through the motion it multiplies —              a gyro's through turning about its axis, an accelerometer's through specific force              along it beyond what its bias takes up — so a drive without turns and at nearly              constant speed leaves it at its prior.",
+            if shut.is_empty() {
+                String::new()
+            } else {
+                format!("Determined by the drive: {}. ", listed(&shut))
+            },
+            listed(&open)
+        )
+    })
 }
 
 /// The whiteness tests in words: a correlated GNSS position error, a velocity model that misses
