@@ -189,3 +189,60 @@ fn the_block_sparse_products_over_21_states_equal_the_dense_ones() {
         &(outside * x)
     ));
 }
+
+/// Van Loan's exact Φ and Q_d over `t` for constant F and S over 21 states.
+fn van_loan(f: &Matrix21, s: &Matrix21, t: f64) -> (Matrix21, Matrix21) {
+    let n = STATES_WITH_SCALE;
+    let mut m = nalgebra::DMatrix::<f64>::zeros(2 * n, 2 * n);
+    m.view_mut((0, 0), (n, n)).copy_from(&(-f * t));
+    m.view_mut((0, n), (n, n)).copy_from(&(s * t));
+    m.view_mut((n, n), (n, n)).copy_from(&(f.transpose() * t));
+    let e = m.exp();
+    let phi = Matrix21::from_fn(|i, j| e[(n + j, n + i)]);
+    let q = phi * Matrix21::from_fn(|i, j| e[(i, n + j)]);
+    (phi, q)
+}
+
+#[test]
+fn interval_phi_and_q_over_21_states_match_van_loan() {
+    let s = scene();
+    let big_f = analytic_f(&s);
+    let noise = discrete::NoiseDensities {
+        accel_vrw_m_s_per_sqrt_s: 0.1 / 60.0,
+        gyro_arw_rad_per_sqrt_s: 0.1_f64.to_radians() / 60.0,
+        gyro_bias_density: 2.0 * (50.0_f64 / 3600.0).to_radians().powi(2) / 3600.0,
+        accel_bias_density: 2.0 * (0.25e-3 * 9.8_f64).powi(2) / 1800.0,
+    };
+    let big_s = Matrix21::from_diagonal(&noise.diagonal_of::<STATES_WITH_SCALE>());
+    let t = crate::ins::filter::DEFAULT_COVARIANCE_INTERVAL_S;
+    let (phi_exact, q_exact) = van_loan(&big_f, &big_s, t);
+    let phi = discrete::transition_third_order(&big_f, t);
+    let q = discrete::process_noise_series(&big_f, &noise, t);
+    // The bounds of the 15-state test: Φ's remainder ‖A⁴‖e^a/24, Q_d's ‖M₅‖T⁶e^(2a)/720.
+    let a_mat = big_f * t;
+    let a = a_mat.norm();
+    let phi_bound = (a_mat * a_mat * a_mat * a_mat).norm() * a.exp() / 24.0;
+    let mut m = big_s;
+    for _ in 0..5 {
+        let fm = big_f * m;
+        m = fm + fm.transpose();
+    }
+    let q_bound = m.norm() * t.powi(6) * (2.0 * a).exp() / 720.0 / q_exact.norm();
+    let phi_error = (phi - phi_exact).norm();
+    let q_error = (q - q_exact).norm() / q_exact.norm();
+    assert!(
+        phi_error <= phi_bound,
+        "Φ {phi_error:e} beyond {phi_bound:e}"
+    );
+    assert!(q_error <= q_bound, "Q_d {q_error:e} beyond {q_bound:e}");
+    // The scale factors' coupling is in Φ: δs_g reaches the attitude within the interval.
+    let coupling = phi_exact.fixed_view::<3, 3>(ATTITUDE, GYRO_SCALE).norm();
+    assert!(
+        coupling > 0.0
+            && (phi.fixed_view::<3, 3>(ATTITUDE, GYRO_SCALE).norm() - coupling).abs()
+                < 1e-6 * coupling
+    );
+    // Negative control: the second-order Φ misses the bound.
+    let second = discrete::transition(&big_f, t);
+    assert!((second - phi_exact).norm() > phi_bound);
+}
