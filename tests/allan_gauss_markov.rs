@@ -172,3 +172,72 @@ fn gauss_markov_intervals_cover_and_a_log_without_a_hump_is_not_resolved() {
         "the hump resolved in only {resolved} of {SEEDS} logs with one"
     );
 }
+
+/// The files take the fitted term where a hump shows it, and say so where none does: a log of the
+/// hump above on the x accelerometer and white noise on the z gyro. allan.json's record, imu.yaml's
+/// KF-GINS σ (abstd, mGal) and corrtime (h), and noise.toml's keys equal the fit's own numbers;
+/// the gyro, with no hump, keeps its rule of thumb and says it is not determined by the log.
+#[test]
+fn the_files_take_the_fitted_gauss_markov_term() {
+    use accelcal::allan::imu::export::{allan_json, imu_yaml, noise_toml};
+    use accelcal::allan::imu::{Channel, ImuSamples, analyse_imu};
+    let log = ImuSamples {
+        channels: vec![
+            (Channel::Ax, HUMP.samples(SAMPLES, 5)),
+            (
+                Channel::Gz,
+                StaticLog {
+                    offset_m_s2: 0.0,
+                    ..WHITE
+                }
+                .samples(SAMPLES, 6),
+            ),
+        ],
+        sample_period_s: WHITE.sample_period_s,
+    };
+    let imu = analyse_imu(&log, CONFIDENCE).unwrap();
+    let (ax, gz) = (&imu.channels[0].analysis, &imu.channels[1].analysis);
+    let g = &ax.gauss_markov;
+    assert!(g.resolved, "{g:?}");
+    assert!(!gz.gauss_markov.resolved, "{:?}", gz.gauss_markov);
+    let (sigma, tc) = (g.sigma.unwrap(), g.correlation_time_s.unwrap());
+    let json: serde_json::Value = serde_json::from_str(&allan_json(&imu)).unwrap();
+    let record = &json["channels"]["ax_m_s2"]["gauss_markov"];
+    assert_eq!(record["resolved"], true);
+    assert_eq!(record["sigma"]["value"].as_f64(), Some(sigma));
+    assert_eq!(record["correlation_time_s"]["value"].as_f64(), Some(tc));
+    assert_eq!(
+        record["correlation_time_s"]["lower"].as_f64(),
+        g.correlation_time_lower_s
+    );
+    let gyro = &json["channels"]["gz_rad_s"]["gauss_markov"];
+    assert_eq!(gyro["resolved"], false);
+    assert!(gyro["correlation_time_s"]["value"].is_null());
+    assert!(
+        gyro["reason"]
+            .as_str()
+            .is_some_and(|r| r.starts_with("no hump"))
+    );
+    let text = imu_yaml(&imu, "gm.csv");
+    let y = &yaml_rust2::YamlLoader::load_from_str(&text).unwrap()[0];
+    let kf = &y["imunoise"];
+    assert_eq!(kf["corrtime"].as_f64(), Some(tc / 3600.0), "{text}");
+    assert_eq!(kf["abstd"][0].as_f64(), Some(sigma / 1e-5), "{text}");
+    assert!(text.contains("fitted T_c of ax_m_s2's hump"), "{text}");
+    let toml = noise_toml(&imu, "gm.csv");
+    let t: toml::Table = toml.parse().unwrap();
+    let imu_keys = &t["imu"];
+    assert_eq!(imu_keys["accel_bias_model"].as_str(), Some("gauss_markov"));
+    assert_eq!(
+        imu_keys["accel_bias_correlation_time_s"].as_float(),
+        Some(tc)
+    );
+    assert_eq!(imu_keys["accel_bias_sigma_m_s2"].as_float(), Some(sigma));
+    // The gyro alone: no hump, the rule of thumb, said to be undetermined.
+    let gyro_only = ImuSamples {
+        channels: vec![log.channels[1].clone()],
+        ..log
+    };
+    let text = imu_yaml(&analyse_imu(&gyro_only, CONFIDENCE).unwrap(), "white.csv");
+    assert!(text.contains("not determined by the log"), "{text}");
+}

@@ -4,7 +4,10 @@
 
 use serde_json::{Map, Value, json};
 
-use super::{Channel, ImuAnalysis, Largest, Sensor, value_or_bound};
+use super::{
+    Channel, ImuAnalysis, Largest, Sensor, correlation_time_s, fitted_correlation_time,
+    value_or_bound,
+};
 use crate::allan::export::{AllanRecord, GAUSS_MARKOV_PEAK_RATIO, num, ten_digits};
 use crate::allan::{Analysis, Reading, Term};
 use crate::format::sig;
@@ -241,22 +244,6 @@ fn gauss_markov_sigma(a: &Analysis) -> f64 {
         .unwrap_or_else(|| value_of(a, Term::BiasInstability) / GAUSS_MARKOV_PEAK_RATIO)
 }
 
-/// The Gauss–Markov correlation time of an axis's bias, s: the fitted T_c where the log resolves
-/// the term, else the rule of thumb τ_min/1.89 (the Allan minimum taken for the hump's peak,
-/// IEEE Std 952, annex C), which the log does not determine ([`fitted_correlation_time`] tells
-/// which).
-pub fn correlation_time_s(a: &Analysis) -> f64 {
-    a.gauss_markov
-        .correlation_time_s
-        .filter(|_| a.gauss_markov.resolved)
-        .unwrap_or_else(|| a.tau_at_minimum_s() / 1.89)
-}
-
-/// Whether [`correlation_time_s`] of the axis is the fitted T_c (not the rule of thumb).
-pub fn fitted_correlation_time(a: &Analysis) -> bool {
-    a.gauss_markov.resolved && a.gauss_markov.correlation_time_s.is_some()
-}
-
 /// A number of one axis's analysis.
 type AxisValue = fn(&Analysis) -> f64;
 
@@ -266,8 +253,8 @@ fn kf_gins_block(imu: &ImuAnalysis) -> String {
     let mut s = String::from(
         "# KF-GINS (i2Nav) `imunoise`: arw °/√h, vrw m/s/√h; gbstd °/h and abstd mGal the stationary\n\
          # σ of a first-order Gauss–Markov bias: the fitted σ where the axis's Allan variance shows\n\
-         # the hump, else B/0.6643 (B an upper bound where unresolved); corrtime h, the largest of\n\
-         # the axes' T_c (fitted where a hump shows it, else τ_min/1.89 at the Allan minimum). Scale\n\
+         # the hump, else B/0.6643 (B an upper bound where unresolved); corrtime h, the largest\n\
+         # fitted T_c of the axes that show a hump, else the largest τ_min/1.89 (a rule of thumb). Scale\n\
          # factors (gsstd, asstd) are not measured by a static log: set them from the datasheet.\n\
          imunoise:\n",
     );
@@ -290,9 +277,16 @@ fn kf_gins_block(imu: &ImuAnalysis) -> String {
             s.push_str(&format!("  {key}: {}\n", per_axis(imu, sensor, f)));
         }
     }
+    // The fitted T_c where some axis resolves a hump (a rule of thumb elsewhere is not a
+    // measurement to take the largest of), else the largest rule of thumb.
+    let any_fitted = imu
+        .channels
+        .iter()
+        .any(|c| fitted_correlation_time(&c.analysis));
     let longest = imu
         .channels
         .iter()
+        .filter(|c| !any_fitted || fitted_correlation_time(&c.analysis))
         .max_by(|a, b| correlation_time_s(&a.analysis).total_cmp(&correlation_time_s(&b.analysis)));
     if let Some(c) = longest {
         let corrtime_s = correlation_time_s(&c.analysis);
