@@ -30,7 +30,7 @@ pub struct GaussMarkovTestRecord {
 }
 
 /// `gauss_markov` of `allan.json`: the first-order Gauss–Markov bias where a hump shows one
-/// ([`super::gauss_markov_fit`]).
+/// ([`crate::allan::gauss_markov_fit`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct GaussMarkovRecord {
     /// Whether the log resolves the term.
