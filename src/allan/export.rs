@@ -5,6 +5,10 @@ use serde::Serialize;
 use super::{Analysis, Feature, Reading, Term, TermEstimate};
 use crate::format::sig;
 
+#[path = "export_gauss_markov.rs"]
+mod gauss_markov_records;
+pub use gauss_markov_records::{GaussMarkovRecord, GaussMarkovTestRecord, IntervalRecord};
+
 /// A term in `allan.json`: `value` null when unresolved, `upper` then its upper bound.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TermRecord {
@@ -136,6 +140,8 @@ pub struct AllanRecord {
     pub fit_holds: Vec<bool>,
     /// The fitted terms.
     pub fit: FitRecord,
+    /// The Gauss–Markov bias.
+    pub gauss_markov: GaussMarkovRecord,
 }
 
 fn record(a: &Analysis, term: Term) -> Option<TermRecord> {
@@ -185,6 +191,7 @@ impl AllanRecord {
                 tau_s: a.fit.points.iter().map(|p| p.tau_s).collect(),
                 resolution_sigmas: super::fit::RESOLUTION_SIGMAS,
             },
+            gauss_markov: GaussMarkovRecord::from(&a.gauss_markov),
         }
     }
 }

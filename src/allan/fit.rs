@@ -163,7 +163,7 @@ impl Fit {
 }
 
 /// The design matrix of `terms` at the τ of `points`.
-fn design(points: &[FitPoint], terms: &[Term]) -> DMatrix<f64> {
+pub(super) fn design(points: &[FitPoint], terms: &[Term]) -> DMatrix<f64> {
     DMatrix::from_fn(points.len(), terms.len(), |i, j| {
         terms[j].coefficient(points[i].tau_s)
     })
@@ -171,7 +171,7 @@ fn design(points: &[FitPoint], terms: &[Term]) -> DMatrix<f64> {
 
 /// The iterated weighted fit of `points` on the columns of `a`, constrained (θ ≥ 0) or not, with
 /// the weights of the last pass; `None` when the normal equations are singular.
-fn weighted_fit(
+pub(super) fn weighted_fit(
     points: &[FitPoint],
     a: &DMatrix<f64>,
     constrained: bool,
@@ -246,7 +246,7 @@ pub fn whisker_floor(
 }
 
 /// The sandwich covariance H·AᵀW·C·WA·H of a solution.
-fn sandwich(
+pub(super) fn sandwich(
     a: &DMatrix<f64>,
     w: &DVector<f64>,
     h: &DMatrix<f64>,
@@ -282,7 +282,7 @@ pub fn fit_unconstrained(
 
 /// The exact covariance of the estimates at `points` for the white-phase, white-rate and
 /// random-walk levels of `theta`.
-fn exact_covariance(
+pub(super) fn exact_covariance(
     points: &[FitPoint],
     samples: usize,
     tau0_s: f64,
@@ -310,7 +310,7 @@ fn exact_covariance(
 /// The exact covariance knows only white phase, white rate and random-walk noise; where flicker
 /// (B) dominates, the EDF of the noise identified at that τ (Greenhall & Riley 2003) carries its
 /// share of the variance, and the correlation of the other noises stands in for its own.
-fn with_edf_variances(
+pub(super) fn with_edf_variances(
     c: &DMatrix<f64>,
     points: &[FitPoint],
     fitted: &DVector<f64>,

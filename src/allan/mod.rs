@@ -12,7 +12,9 @@
 //!    estimates across τ ([`covariance`]) and a test of the fit ([`goodness`]);
 //! 5. [`reading`]: where the fit departs from the points, the features it lacks (a sinusoid, a
 //!    trend), and the IEEE 952 reading off the curve that replaces the fit when the test rejects
-//!    it.
+//!    it;
+//! 6. [`gauss_markov_fit`]: the Gauss–Markov σ and T_c fitted beside the terms, reported where
+//!    a hump shows them (a test against the fit without), with intervals.
 //!
 //! [`stream`] computes step 1 on a log read piece by piece, in memory independent of its length
 //! (with [`noise_stream`] for step 2), for `allan --imu` on long recordings; [`analyse_grid`]
@@ -29,6 +31,7 @@ pub mod edf;
 pub mod export;
 pub mod fit;
 pub mod gauss_markov;
+pub mod gauss_markov_fit;
 pub mod goodness;
 pub mod imu;
 pub mod log;
@@ -47,6 +50,7 @@ use thiserror::Error;
 use crate::progress::{Cancel, Cancelled};
 
 pub use fit::{Fit, FitPoint, Term, TermEstimate};
+pub use gauss_markov_fit::GaussMarkov;
 pub use noise_id::NoiseId;
 pub use reading::{Departure, Feature, Reading};
 
@@ -124,6 +128,8 @@ pub struct Analysis {
     pub departures: Vec<Departure>,
     /// Features of the curve the model does not have.
     pub features: Vec<Feature>,
+    /// The Gauss–Markov term where a hump shows one ([`gauss_markov_fit`]).
+    pub gauss_markov: GaussMarkov,
 }
 
 impl Analysis {
@@ -329,6 +335,8 @@ fn analyse_points(
     let terms = fitted_terms(&points);
     let fit =
         fit::fit(&fit_points, samples, tau0_s, &terms, confidence).ok_or(AllanError::Constant)?;
+    let gauss_markov =
+        gauss_markov_fit::fit_gauss_markov(&fit_points, samples, tau0_s, &terms, confidence);
     let departures = reading::departures(&points, &fit);
     let features = reading::features(&points, &departures, &fit);
     let (reading, terms) = if fit.goodness.rejected {
@@ -347,5 +355,6 @@ fn analyse_points(
         terms,
         departures,
         features,
+        gauss_markov,
     })
 }

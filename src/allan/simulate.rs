@@ -110,3 +110,41 @@ impl FeatureLog {
         y
     }
 }
+
+/// Key of the random streams of the Gauss–Markov bias (one stream per seed).
+const GAUSS_MARKOV_KEY: u64 = 0x616c_6c61_6e00_0003;
+
+/// A synthetic static log whose bias is a first-order Gauss–Markov process, on top of a
+/// [`StaticLog`] (whose samples it adds to, unchanged).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GaussMarkovLog {
+    /// White noise, random walk and offset.
+    pub base: StaticLog,
+    /// σ, the process's stationary standard deviation (unit of the samples).
+    pub sigma: f64,
+    /// T_c, its correlation time, s.
+    pub correlation_time_s: f64,
+}
+
+impl GaussMarkovLog {
+    /// `samples` rate samples of seed `seed`: the base log's samples plus the process from a
+    /// second stream.
+    ///
+    /// # Formula
+    /// The exact discretization of ḃ = −b/T_c + w (an AR(1) sequence; Gelb, *Applied Optimal
+    /// Estimation*, 1974, §3.8; Maybeck, *Stochastic Models, Estimation and Control* 1, 1979,
+    /// §4.9): b_{i+1} = φb_i + σ√(1 − φ²)·ξ_i, φ = e^{−τ₀/T_c}, b₀ ~ N(0, σ²) (stationary from the
+    /// first sample).
+    pub fn samples(&self, samples: usize, seed: u64) -> Vec<f64> {
+        let mut y = self.base.samples(samples, seed);
+        let mut s = Stream::new(GAUSS_MARKOV_KEY, seed);
+        let phi = (-self.base.sample_period_s / self.correlation_time_s).exp();
+        let drive = self.sigma * (1.0 - phi * phi).sqrt();
+        let mut b = self.sigma * s.normal();
+        for v in y.iter_mut() {
+            *v += b;
+            b = phi * b + drive * s.normal();
+        }
+        y
+    }
+}

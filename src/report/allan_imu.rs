@@ -11,7 +11,7 @@ use super::figures::figure;
 use super::view::FigureView;
 use super::{RenderError, stylesheet};
 use crate::allan::imu::{Channel, ImuAnalysis, Largest, Sensor};
-use crate::allan::{Term, TermEstimate};
+use crate::allan::{GaussMarkov, Term, TermEstimate};
 use crate::format::{count, interval, sig};
 use crate::plot;
 
@@ -118,6 +118,83 @@ fn row(channel: Channel, t: &TermEstimate, axis: &str) -> ImuTermRow {
     }
 }
 
+/// The Gauss–Markov row of `channel`: σ and T_c with their intervals, or "not resolved" and why
+/// (µg or °/h and hours in datasheet units).
+fn gauss_markov_row(channel: Channel, g: &GaussMarkov, axis: &str) -> ImuTermRow {
+    let sensor = channel.sensor();
+    let datasheet_scale = match sensor {
+        Sensor::Accelerometer => (1e6 / 9.806_65, "µg"),
+        Sensor::Gyroscope => (DEG_PER_RAD * 3600.0, "°/h"),
+    };
+    let cells = match (g.sigma, g.sigma_lower, g.correlation_time_s) {
+        (Some(v), Some(lo), Some(tc)) if g.resolved => {
+            let (tlo, thi) = (
+                g.correlation_time_lower_s.unwrap_or(f64::NAN),
+                g.correlation_time_upper_s.unwrap_or(f64::NAN),
+            );
+            let sigma = |scale: f64| {
+                let (v, lo, hi) = interval(v * scale, lo * scale, g.sigma_upper * scale, 3);
+                format!("{v} [{lo}, {hi}]")
+            };
+            let tc_in = |scale: f64| {
+                let (v, lo, hi) = interval(tc * scale, tlo * scale, thi * scale, 3);
+                format!("{v} [{lo}, {hi}]")
+            };
+            (
+                format!(
+                    "σ = {} {}; T_c = {} s",
+                    sigma(1.0),
+                    sensor.rate_unit(),
+                    tc_in(1.0)
+                ),
+                format!(
+                    "σ = {} {}; T_c = {} h",
+                    sigma(datasheet_scale.0),
+                    datasheet_scale.1,
+                    tc_in(1.0 / 3600.0)
+                ),
+            )
+        }
+        _ => {
+            let why = g.reason.as_deref().unwrap_or("not resolved");
+            (format!("not resolved ({why})"), "not resolved".to_string())
+        }
+    };
+    ImuTermRow {
+        name: format!("{} Gauss–Markov bias σ, T_c", sensor.key()),
+        axis: axis.to_string(),
+        si: cells.0,
+        datasheet: cells.1,
+    }
+}
+
+/// The summary's Gauss–Markov row of `sensor`: the axis of the largest resolved σ, else a row
+/// saying no axis resolves it.
+fn gauss_markov_summary(imu: &ImuAnalysis, sensor: Sensor) -> Option<ImuTermRow> {
+    let first = imu.of(sensor).next()?;
+    let resolved = imu
+        .of(sensor)
+        .filter(|c| c.analysis.gauss_markov.resolved)
+        .max_by(|a, b| {
+            let s = |c: &&crate::allan::imu::ChannelAnalysis| {
+                c.analysis.gauss_markov.sigma.unwrap_or(0.0)
+            };
+            s(a).total_cmp(&s(b))
+        });
+    Some(match resolved {
+        Some(c) => gauss_markov_row(
+            c.channel,
+            &c.analysis.gauss_markov,
+            &format!("largest: {}", c.channel.column()),
+        ),
+        None => {
+            let mut row = gauss_markov_row(first.channel, &first.analysis.gauss_markov, "none");
+            row.si = "not resolved on any axis".to_string();
+            row
+        }
+    })
+}
+
 /// The summary row of a sensor's largest term (the estimate itself, else its bound).
 fn summary_row(imu: &ImuAnalysis, l: &Largest) -> Option<ImuTermRow> {
     let c = imu.channels.iter().find(|c| c.channel == l.channel)?;
@@ -164,10 +241,15 @@ pub fn view(imu: &ImuAnalysis, source: &str, command: &str) -> Result<AllanImuVi
                 .terms
                 .iter()
                 .map(|t| row(c.channel, t, c.channel.axis()))
+                .chain([gauss_markov_row(
+                    c.channel,
+                    &c.analysis.gauss_markov,
+                    c.channel.axis(),
+                )])
                 .collect(),
         });
     }
-    let summary = Sensor::ALL
+    let summary: Vec<ImuTermRow> = Sensor::ALL
         .into_iter()
         .flat_map(|sensor| {
             [
@@ -179,6 +261,11 @@ pub fn view(imu: &ImuAnalysis, source: &str, command: &str) -> Result<AllanImuVi
             .filter_map(move |term| imu.largest(sensor, term))
         })
         .filter_map(|l| summary_row(imu, &l))
+        .chain(
+            Sensor::ALL
+                .into_iter()
+                .filter_map(|sensor| gauss_markov_summary(imu, sensor)),
+        )
         .collect();
     let columns: Vec<&str> = imu.channels.iter().map(|c| c.channel.column()).collect();
     Ok(AllanImuView {

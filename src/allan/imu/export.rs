@@ -4,7 +4,10 @@
 
 use serde_json::{Map, Value, json};
 
-use super::{Channel, ImuAnalysis, Largest, Sensor, value_or_bound};
+use super::{
+    Channel, ImuAnalysis, Largest, Sensor, correlation_time_s, fitted_correlation_time,
+    value_or_bound,
+};
 use crate::allan::export::{AllanRecord, GAUSS_MARKOV_PEAK_RATIO, num, ten_digits};
 use crate::allan::{Analysis, Reading, Term};
 use crate::format::sig;
@@ -144,7 +147,9 @@ fn key_comment(l: &Largest, unit: &str, discrete: f64, discrete_unit: &str) -> S
 /// Discrete equivalents at the rate f = 1/τ₀ (Kalibr wiki, "IMU Noise Model"; Trawny &
 /// Roumeliotis 2005): white noise σ_d = σ·√f, random walk σ_bd = σ_b/√f.
 /// KF-GINS units: ARW °/√h = rad/√s·(180/π)·60, VRW m/s/√h = m/s/√s·60; the bias a first-order
-/// Gauss–Markov process with σ_b = B/0.6643 and τ_b = τ_min/1.89 (IEEE Std 952, annex C).
+/// Gauss–Markov process, σ_b and τ_b fitted where a hump shows them
+/// ([`crate::allan::gauss_markov_fit`]), else σ_b = B/0.6643 and τ_b = τ_min/1.89 (IEEE Std 952,
+/// annex C).
 pub fn imu_yaml(imu: &ImuAnalysis, source: &str) -> String {
     let rate_hz = 1.0 / imu.sample_period_s;
     let mut s = format!(
@@ -229,15 +234,14 @@ fn value_of(a: &Analysis, term: Term) -> f64 {
     a.term(term).map_or(f64::NAN, |t| value_or_bound(t).0)
 }
 
-/// The stationary σ of a first-order Gauss–Markov bias whose Allan deviation peaks at the axis's
-/// B (or B's bound): B/0.6643 (IEEE Std 952, annex C).
+/// The stationary σ of an axis's first-order Gauss–Markov bias: the fitted σ where the log
+/// resolves the term ([`crate::allan::gauss_markov_fit`]), else the σ whose Allan deviation
+/// peaks at the axis's B (or B's bound), B/0.6643 (IEEE Std 952, annex C).
 fn gauss_markov_sigma(a: &Analysis) -> f64 {
-    value_of(a, Term::BiasInstability) / GAUSS_MARKOV_PEAK_RATIO
-}
-
-/// The Gauss–Markov correlation time of an axis's bias, s: τ_min/1.89 (IEEE Std 952, annex C).
-pub fn correlation_time_s(a: &Analysis) -> f64 {
-    a.tau_at_minimum_s() / 1.89
+    a.gauss_markov
+        .sigma
+        .filter(|_| a.gauss_markov.resolved)
+        .unwrap_or_else(|| value_of(a, Term::BiasInstability) / GAUSS_MARKOV_PEAK_RATIO)
 }
 
 /// A number of one axis's analysis.
@@ -248,9 +252,10 @@ type AxisValue = fn(&Analysis) -> f64;
 fn kf_gins_block(imu: &ImuAnalysis) -> String {
     let mut s = String::from(
         "# KF-GINS (i2Nav) `imunoise`: arw °/√h, vrw m/s/√h; gbstd °/h and abstd mGal the stationary\n\
-         # σ of a first-order Gauss–Markov bias, B/0.6643 (B an upper bound where unresolved);\n\
-         # corrtime h, τ_min/1.89 at the Allan minimum, the largest of the axes. Scale factors\n\
-         # (gsstd, asstd) are not measured by a static log: set them from the datasheet.\n\
+         # σ of a first-order Gauss–Markov bias: the fitted σ where the axis's Allan variance shows\n\
+         # the hump, else B/0.6643 (B an upper bound where unresolved); corrtime h, the largest\n\
+         # fitted T_c of the axes that show a hump, else the largest τ_min/1.89 (a rule of thumb). Scale\n\
+         # factors (gsstd, asstd) are not measured by a static log: set them from the datasheet.\n\
          imunoise:\n",
     );
     let rows: [(Sensor, &str, AxisValue); 4] = [
@@ -272,19 +277,75 @@ fn kf_gins_block(imu: &ImuAnalysis) -> String {
             s.push_str(&format!("  {key}: {}\n", per_axis(imu, sensor, f)));
         }
     }
-    let corrtime_s = imu
+    // The fitted T_c where some axis resolves a hump (a rule of thumb elsewhere is not a
+    // measurement to take the largest of), else the largest rule of thumb.
+    let any_fitted = imu
         .channels
         .iter()
-        .map(|c| correlation_time_s(&c.analysis))
-        .fold(f64::NEG_INFINITY, f64::max);
-    s.push_str(&format!("  corrtime: {}\n", num(corrtime_s / S_PER_H)));
+        .any(|c| fitted_correlation_time(&c.analysis));
+    let longest = imu
+        .channels
+        .iter()
+        .filter(|c| !any_fitted || fitted_correlation_time(&c.analysis))
+        .max_by(|a, b| correlation_time_s(&a.analysis).total_cmp(&correlation_time_s(&b.analysis)));
+    if let Some(c) = longest {
+        let corrtime_s = correlation_time_s(&c.analysis);
+        let note = if fitted_correlation_time(&c.analysis) {
+            format!("fitted T_c of {}'s hump", c.channel.column())
+        } else {
+            format!(
+                "not determined by the log: the rule of thumb τ_min/1.89 on {}, no hump resolved",
+                c.channel.column()
+            )
+        };
+        s.push_str(&format!(
+            "  corrtime: {}  # {note}\n",
+            num(corrtime_s / S_PER_H)
+        ));
+    }
     s
 }
 
-/// The `[imu]` keys of one sensor's bias in `noise.toml`, as the one-column `noise.toml` chooses
-/// its model: a random walk with K when the largest K is resolved, else a Gauss–Markov process
-/// when some axis resolves B, else a random walk with K's bound.
+/// The `[imu]` keys of one sensor's bias in `noise.toml`: a Gauss–Markov process with the fitted
+/// σ and T_c when some axis's Allan variance resolves the hump (the axis of the largest σ); else
+/// as the one-column `noise.toml` chooses its model: a random walk with K when the largest K is
+/// resolved, else a Gauss–Markov process when some axis resolves B (T_c then the rule of thumb
+/// τ_min/1.89, not determined by the log), else a random walk with K's bound.
 fn bias_keys(imu: &ImuAnalysis, sensor: Sensor, prefix: &str, unit: &str, k_unit: &str) -> String {
+    let hump = imu
+        .of(sensor)
+        .filter(|c| fitted_correlation_time(&c.analysis))
+        .max_by(|a, b| gauss_markov_sigma(&a.analysis).total_cmp(&gauss_markov_sigma(&b.analysis)));
+    if let Some(c) = hump {
+        let g = &c.analysis.gauss_markov;
+        let (tc, lo, hi) = (
+            correlation_time_s(&c.analysis),
+            g.correlation_time_lower_s.unwrap_or(f64::NAN),
+            g.correlation_time_upper_s.unwrap_or(f64::NAN),
+        );
+        let short = if tc < 1.0 {
+            "# T_c is below the 1 s the study accepts: the study refuses this file until it is set.\n"
+        } else {
+            ""
+        };
+        return format!(
+            "# A Gauss–Markov bias fitted to the hump of {}'s Allan variance: σ = {} {} [{}, {}],\n\
+             # T_c = {} s [{}, {}] ({} % intervals).\n{short}\
+             {prefix}_bias_model = \"gauss_markov\"\n{prefix}_bias_sigma_{unit} = {}\n\
+             {prefix}_bias_correlation_time_s = {}\n",
+            c.channel.column(),
+            sig(gauss_markov_sigma(&c.analysis), 4),
+            sensor.rate_unit(),
+            sig(g.sigma_lower.unwrap_or(f64::NAN), 3),
+            sig(g.sigma_upper, 3),
+            sig(tc, 4),
+            sig(lo, 3),
+            sig(hi, 3),
+            sig(100.0 * imu.confidence, 3),
+            num(gauss_markov_sigma(&c.analysis)),
+            num(tc)
+        );
+    }
     let (Some(k), Some(b)) = (
         imu.largest(sensor, Term::AccelerationRandomWalk),
         imu.largest(sensor, Term::BiasInstability),
@@ -307,7 +368,8 @@ fn bias_keys(imu: &ImuAnalysis, sensor: Sensor, prefix: &str, unit: &str, k_unit
             ""
         };
         format!(
-            "# B = {} {} on {} dominates: a Gauss–Markov bias, σ_b = B/{GAUSS_MARKOV_PEAK_RATIO}, τ_b = τ_min/1.89.\n{short}\
+            "# B = {} {} on {} dominates: a Gauss–Markov bias, σ_b = B/{GAUSS_MARKOV_PEAK_RATIO}, τ_b = τ_min/1.89\n\
+             # (a rule of thumb: no axis's Allan variance resolves a hump, the log does not determine τ_b).\n{short}\
              {prefix}_bias_model = \"gauss_markov\"\n{prefix}_bias_sigma_{unit} = {}\n\
              {prefix}_bias_correlation_time_s = {}\n",
             sig(b.value, 4),

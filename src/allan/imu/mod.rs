@@ -252,6 +252,22 @@ impl ImuAnalysis {
     }
 }
 
+/// The Gauss–Markov correlation time of an axis's bias, s: the fitted T_c where the log resolves
+/// the term, else the rule of thumb τ_min/1.89 (the Allan minimum taken for the hump's peak,
+/// IEEE Std 952, annex C), which the log does not determine ([`fitted_correlation_time`] tells
+/// which).
+pub fn correlation_time_s(a: &Analysis) -> f64 {
+    a.gauss_markov
+        .correlation_time_s
+        .filter(|_| a.gauss_markov.resolved)
+        .unwrap_or_else(|| a.tau_at_minimum_s() / 1.89)
+}
+
+/// Whether [`correlation_time_s`] of the axis is the fitted T_c (not the rule of thumb).
+pub fn fitted_correlation_time(a: &Analysis) -> bool {
+    a.gauss_markov.resolved && a.gauss_markov.correlation_time_s.is_some()
+}
+
 /// Analyses every channel of `log` as [`analyse`] does one column, at `confidence`.
 ///
 /// # Errors
