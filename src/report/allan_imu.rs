@@ -142,13 +142,13 @@ fn gauss_markov_row(channel: Channel, g: &GaussMarkov, axis: &str) -> ImuTermRow
             };
             (
                 format!(
-                    "σ = {} {}; T_c = {} s",
+                    "σ = {} {}; correlation time {} s",
                     sigma(1.0),
                     sensor.rate_unit(),
                     tc_in(1.0)
                 ),
                 format!(
-                    "σ = {} {}; T_c = {} h",
+                    "σ = {} {}; correlation time {} h",
                     sigma(datasheet_scale.0),
                     datasheet_scale.1,
                     tc_in(1.0 / 3600.0)
@@ -161,7 +161,7 @@ fn gauss_markov_row(channel: Channel, g: &GaussMarkov, axis: &str) -> ImuTermRow
         }
     };
     ImuTermRow {
-        name: format!("{} Gauss–Markov bias σ, T_c", sensor.key()),
+        name: format!("{} Gauss–Markov bias σ and correlation time", sensor.key()),
         axis: axis.to_string(),
         si: cells.0,
         datasheet: cells.1,
