@@ -1,11 +1,15 @@
 //! `calibrate --imu --config FILE`: the assumptions a file sets, each key where it is set and
 //! [`CONSUMER`] where the file is silent.
 //!
-//! The keys are the three-axis study's (`accelcal config --model ins`), so that its file — or
-//! the `noise.toml` that `allan --imu` writes — can be given as it is: `[imu]` the sensor's
-//! statistics, `[filter]` overriding them, `[gnss]` the receiver's σ's and lever arm, `[checks]`
-//! the false-alarm rate; and two of the calibration's own: `axes` in `[imu]`, and `[alignment]`.
-//! The rates (`imu_rate_hz`, `gnss_rate_hz`) are the logs' and may not be set here.
+//! The keys are the three-axis study's (`accelcal config --model ins`), so that the
+//! `noise.toml` that `allan --imu` writes can be given as it is, and the study's statistics
+//! copied over: `[imu]` the sensor's statistics, `[filter]` overriding them (and its
+//! `error_states`), `[gnss]` the receiver's σ's and lever arm, `[checks]` the false-alarm rate;
+//! and two of the calibration's own: `axes` in `[imu]`, and `[alignment]`. The rates
+//! (`imu_rate_hz`, `gnss_rate_hz`) are the logs' and may not be set here, and the study's other
+//! sections (`[drive]`, `[initial]`, `[ensemble]`, `checks.residual_max_lag`) describe a
+//! simulation, not a recording: a file with them is refused (unknown key), so the study's whole
+//! file is not taken as it is.
 
 use serde::Deserialize;
 
