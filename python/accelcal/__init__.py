@@ -91,23 +91,10 @@ def _vector(name: str, x: Any) -> np.ndarray:
 
 def _times(name: str, x: Any) -> np.ndarray:
     """A time-stamp vector, s: finite and increasing."""
-    t = _vector(name, x)
-    bad = np.flatnonzero(~(np.diff(t) > 0.0))
-    if bad.size:
-        i = int(bad[0]) + 1
-        raise ValueError(
-            f"{name}[{i}] = {float(t[i])!r} s is not after {name}[{i - 1}] = {float(t[i - 1])!r} s: "
-            "time stamps must increase"
-        )
-    return t
+    return _imu.increasing(name, _vector(name, x))
 
 
-def _same_length(time_name: str, t: np.ndarray, name: str, x: np.ndarray) -> None:
-    if x.size != t.size:
-        raise ValueError(
-            f"{name} has {x.size} values and {time_name} has {t.size}: expected one value "
-            f"per time stamp (index {min(x.size, t.size)} has no partner)"
-        )
+_same_length = _imu.same_length
 
 
 def _nan(values: Sequence[Optional[float]]) -> np.ndarray:

@@ -72,7 +72,9 @@ def _array(name: str, x: Any, allow_nan: bool) -> np.ndarray:
     return a
 
 
-def _times(name: str, t: np.ndarray) -> np.ndarray:
+def increasing(name: str, t: np.ndarray) -> np.ndarray:
+    """`t` when its time stamps increase, else the ValueError naming the first that does not
+    (the one-axis and the three-axis forms share it)."""
     bad = np.flatnonzero(~(np.diff(t) > 0.0))
     if bad.size:
         i = int(bad[0]) + 1
@@ -83,11 +85,12 @@ def _times(name: str, t: np.ndarray) -> np.ndarray:
     return t
 
 
-def _same_length(log: str, t: np.ndarray, column: str, x: np.ndarray) -> None:
+def same_length(time_name: str, t: np.ndarray, name: str, x: np.ndarray) -> None:
+    """The ValueError of a column `name` whose length is not its time stamps' (`time_name`)."""
     if x.size != t.size:
         raise ValueError(
-            f"{log}[{column!r}] has {x.size} values and {log}['t_s'] has {t.size}: expected one "
-            f"value per time stamp (index {min(x.size, t.size)} has no partner)"
+            f"{name} has {x.size} values and {time_name} has {t.size}: expected one value "
+            f"per time stamp (index {min(x.size, t.size)} has no partner)"
         )
 
 
@@ -111,9 +114,9 @@ def imu_columns(imu: Any) -> Tuple[np.ndarray, List[np.ndarray], str]:
                 f"{', '.join(INCREMENT_COLUMNS)}"
             )
         arrays.append(_array(f"imu[{c!r}]", x, allow_nan=False))
-    t = _times("imu['t_s']", arrays[0])
+    t = increasing("imu['t_s']", arrays[0])
     for c, x in zip(names[1:], arrays[1:]):
-        _same_length("imu", t, c, x)
+        same_length("imu['t_s']", t, f"imu[{c!r}]", x)
     return t, arrays[1:], layout
 
 
@@ -128,14 +131,14 @@ def gnss_columns(gnss: Any) -> Tuple[List[np.ndarray], List[Optional[np.ndarray]
                 f"optionally {', '.join(GNSS_OPTIONAL)}"
             )
         required.append(_array(f"gnss[{c!r}]", x, allow_nan=False))
-    t = _times("gnss['t_s']", required[0])
+    t = increasing("gnss['t_s']", required[0])
     optional: List[Optional[np.ndarray]] = []
     for c in GNSS_OPTIONAL:
         x = _get(gnss, "gnss", c)
         optional.append(None if x is _MISSING else _array(f"gnss[{c!r}]", x, allow_nan=True))
     for c, x in zip(GNSS_COLUMNS[1:] + GNSS_OPTIONAL, required[1:] + optional):
         if x is not None:
-            _same_length("gnss", t, c, x)
+            same_length("gnss['t_s']", t, f"gnss[{c!r}]", x)
     return required, optional
 
 

@@ -266,7 +266,6 @@ pub fn validate(s: &Settings) -> Result<(), ConfigError> {
         ("gnss_time_offset_s", s.gnss_time_offset_s, -MAX_TIME_OFFSET_S, MAX_TIME_OFFSET_S, "in [−0.5, 0.5] s"),
         ("gyro_scale_factor_sigma_ppm", s.gyro_scale_factor_sigma_ppm, scale_lo, 1e5, scale_words),
         ("accel_scale_factor_sigma_ppm", s.accel_scale_factor_sigma_ppm, scale_lo, 1e5, scale_words),
-        ("error_states", s.error_states as f64, 15.0, 21.0, "15, or 21 with the six scale factors"),
     ];
     if s.error_states != 15 && s.error_states != 21 {
         return Err(ConfigError::invalid(

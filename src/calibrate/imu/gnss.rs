@@ -137,25 +137,9 @@ pub fn read_gnss(source: &dyn LogSource) -> Result<Vec<GnssRow>, LogError> {
             return Err(at(line, problem));
         }
         let row = parse_row(&fields, &required, &optional, line).map_err(|p| at(line, p))?;
-        if let Some(p) = rows.last()
-            && row.t_s <= p.t_s
-        {
-            let problem = LogProblem::NotIncreasing {
-                t_s: row.t_s,
-                previous_s: p.t_s,
-            };
-            return Err(at(line, problem));
-        }
-        rows.push(row);
+        push_increasing(&mut rows, row).map_err(|p| at(line, p))?;
     }
-    if rows.is_empty() {
-        let problem = LogProblem::TooFewRows {
-            found: 0,
-            needed: 1,
-        };
-        return Err(LogError::of_file(name, problem));
-    }
-    Ok(rows)
+    some_rows(rows, name)
 }
 
 /// The next line of `reader` into `buf` (at most one byte beyond the longest line accepted);
@@ -348,17 +332,27 @@ pub fn held_gnss(
             check_optional(k, o[k]).map_err(at)?;
         }
         let row = row_of(line, r, o);
-        if let Some(p) = rows.last()
-            && row.t_s <= p.t_s
-        {
-            let problem = LogProblem::NotIncreasing {
-                t_s: row.t_s,
-                previous_s: p.t_s,
-            };
-            return Err(at(problem));
-        }
-        rows.push(row);
+        push_increasing(&mut rows, row).map_err(at)?;
     }
+    some_rows(rows, name)
+}
+
+/// `row` after the rows read so far, or the problem of a time stamp that does not increase.
+fn push_increasing(rows: &mut Vec<GnssRow>, row: GnssRow) -> Result<(), LogProblem> {
+    if let Some(p) = rows.last()
+        && row.t_s <= p.t_s
+    {
+        return Err(LogProblem::NotIncreasing {
+            t_s: row.t_s,
+            previous_s: p.t_s,
+        });
+    }
+    rows.push(row);
+    Ok(())
+}
+
+/// The rows of the log `name`, or its error when it has none.
+fn some_rows(rows: Vec<GnssRow>, name: &str) -> Result<Vec<GnssRow>, LogError> {
     if rows.is_empty() {
         let problem = LogProblem::TooFewRows {
             found: 0,

@@ -5,7 +5,7 @@ use nalgebra::{Matrix3, SVector, UnitQuaternion, Vector3};
 
 use crate::ins::earth::{self, Geodetic};
 use crate::ins::error_state::{
-    self, ACCEL_BIAS, ATTITUDE, BiasDecay, GYRO_BIAS, Matrix15, POSITION, STATES, VELOCITY,
+    self, ACCEL_BIAS, ATTITUDE, BiasDecay, GYRO_BIAS, Matrix15, POSITION, STATES, Square, VELOCITY,
 };
 use crate::ins::mech::{Pva, skew};
 
@@ -193,17 +193,20 @@ fn f_is_the_jacobian_of_the_navigation_equations() {
     );
 }
 
-/// Van Loan's exact Φ and Q_d over `dt` for constant F and S (the reference of the test below).
-fn van_loan(f: &Matrix15, s: &Matrix15, dt: f64) -> (Matrix15, Matrix15) {
-    let n = STATES;
-    let mut m = nalgebra::DMatrix::<f64>::zeros(2 * n, 2 * n);
-    m.view_mut((0, 0), (n, n)).copy_from(&(-f * dt));
-    m.view_mut((0, n), (n, n)).copy_from(&(s * dt));
-    m.view_mut((n, n), (n, n)).copy_from(&(f.transpose() * dt));
+/// Van Loan's exact Φ and Q_d over `dt` for constant F and S over an error state of `N` (the
+/// reference of the tests below and of the 21-state one).
+pub(super) fn van_loan<const N: usize>(
+    f: &Square<N>,
+    s: &Square<N>,
+    dt: f64,
+) -> (Square<N>, Square<N>) {
+    let mut m = nalgebra::DMatrix::<f64>::zeros(2 * N, 2 * N);
+    m.view_mut((0, 0), (N, N)).copy_from(&(-f * dt));
+    m.view_mut((0, N), (N, N)).copy_from(&(s * dt));
+    m.view_mut((N, N), (N, N)).copy_from(&(f.transpose() * dt));
     let e = m.exp();
-    let phi = e.view((n, n), (n, n)).transpose();
-    let phi = Matrix15::from_fn(|i, j| phi[(i, j)]);
-    let q = phi * Matrix15::from_fn(|i, j| e[(i, n + j)]);
+    let phi = Square::<N>::from_fn(|i, j| e[(N + j, N + i)]);
+    let q = phi * Square::<N>::from_fn(|i, j| e[(i, N + j)]);
     (phi, q)
 }
 

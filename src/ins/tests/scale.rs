@@ -190,19 +190,6 @@ fn the_block_sparse_products_over_21_states_equal_the_dense_ones() {
     ));
 }
 
-/// Van Loan's exact Φ and Q_d over `t` for constant F and S over 21 states.
-fn van_loan(f: &Matrix21, s: &Matrix21, t: f64) -> (Matrix21, Matrix21) {
-    let n = STATES_WITH_SCALE;
-    let mut m = nalgebra::DMatrix::<f64>::zeros(2 * n, 2 * n);
-    m.view_mut((0, 0), (n, n)).copy_from(&(-f * t));
-    m.view_mut((0, n), (n, n)).copy_from(&(s * t));
-    m.view_mut((n, n), (n, n)).copy_from(&(f.transpose() * t));
-    let e = m.exp();
-    let phi = Matrix21::from_fn(|i, j| e[(n + j, n + i)]);
-    let q = phi * Matrix21::from_fn(|i, j| e[(i, n + j)]);
-    (phi, q)
-}
-
 #[test]
 fn interval_phi_and_q_over_21_states_match_van_loan() {
     let s = scene();
@@ -215,7 +202,7 @@ fn interval_phi_and_q_over_21_states_match_van_loan() {
     };
     let big_s = Matrix21::from_diagonal(&noise.diagonal_of::<STATES_WITH_SCALE>());
     let t = crate::ins::filter::DEFAULT_COVARIANCE_INTERVAL_S;
-    let (phi_exact, q_exact) = van_loan(&big_f, &big_s, t);
+    let (phi_exact, q_exact) = super::error_state::van_loan(&big_f, &big_s, t);
     let phi = discrete::transition_third_order(&big_f, t);
     let q = discrete::process_noise_series(&big_f, &noise, t);
     // The bounds of the 15-state test: Φ's remainder ‖A⁴‖e^a/24, Q_d's ‖M₅‖T⁶e^(2a)/720.
