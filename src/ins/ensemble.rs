@@ -11,31 +11,33 @@
 
 use std::ops::Range;
 
-use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
+use nalgebra::SVector;
 use rayon::prelude::*;
 
-use crate::ensemble::normalized::{FixInput, NormalizedFix, NormalizedSums, StageInput};
+use crate::ensemble::normalized::{NormalizedFix, NormalizedSums};
 use crate::ensemble::{EnsembleStats, ResidualLayout};
 
 use super::blocks::{self, CHUNK};
-use super::earth::offset;
 use super::error_state::{
     ACCEL_BIAS, ACCEL_SCALE, ATTITUDE, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, VELOCITY, has_scale,
 };
 use super::filter::{Ekf, FilterError};
 use super::gnss;
-use super::logs::fix;
 use super::mech::{Increment, Pva};
 use super::sensors::Imu;
 use super::setup::Study;
 use super::truth::Truth;
 use crate::ensemble::Partition;
+use crate::progress::{Cancel, Cancelled};
 
 mod memory;
+mod realization;
+mod simulated;
 pub use memory::memory_bytes;
+pub use realization::{FixView, filter_realization, realization, start};
+pub use simulated::{SimulatedGnss, SimulatedImu};
 
-/// The GNSS measurement's rows: position and velocity, NED.
-pub const MEASURED: usize = 6;
+pub use super::names::MEASURED;
 
 /// The normalized sums of the three-axis ensemble.
 pub type Sums<const N: usize = STATES> = NormalizedSums<N, MEASURED>;
@@ -197,130 +199,10 @@ pub enum RealizationError {
     },
 }
 
-/// What one realization's filter saw at one fix, after its update.
-pub struct FixView<'a, const N: usize = STATES> {
-    /// The fix's time, s.
-    pub t_s: f64,
-    /// The fix's index.
-    pub fix: usize,
-    /// The errors before and after the update, the correction, P and S.
-    pub input: FixInput<N, MEASURED>,
-    /// The filter after the update.
-    pub ekf: &'a Ekf<N>,
-    /// The true IMU now (its biases).
-    pub imu: &'a Imu,
-}
-
-/// Realization `index`'s true IMU (its prior's draws taken from its stream) and its filter,
-/// started from the truth plus a draw of its prior: position, velocity and attitude errors of
-/// the study's initial σ's, the biases' prior from the filter's model.
-pub fn start<const N: usize>(study: &Study, track: &Track, index: u64) -> (Imu, Ekf<N>) {
-    let mut imu = study.imu(index);
-    let s = &study.initial_sigma;
-    let dr = imu.normals(&Vector3::new(s[0], s[1], s[2]));
-    let dv = imu.normals(&Vector3::new(s[3], s[4], s[5]));
-    let dpsi = imu.normals(&Vector3::new(s[6], s[7], s[8]));
-    let start = Pva {
-        position: offset(&track.start.position, &dr),
-        velocity_ned_m_s: track.start.velocity_ned_m_s + dv,
-        attitude: UnitQuaternion::from_scaled_axis(dpsi) * track.start.attitude,
-    };
-    let ekf = Ekf::new(
-        start,
-        study.prior_of::<N>(),
-        study.filter_noise(),
-        study.filter_decay(),
-        study.filter_gnss.lever_arm_b_m,
-    )
-    .with_earth_rotation(study.filter_earth_rotation_rad_s);
-    (imu, ekf)
-}
-
-/// Runs realization `index` of `study` over `track` — its filter started from the truth plus a
-/// draw of its prior — calling `on_fix` after every update; returns the filter and the IMU at
-/// the end.
-///
-/// # Errors
-/// [`RealizationError`] when a covariance stops being positive definite, or `on_fix`'s.
-pub fn filter_realization<const N: usize>(
-    study: &Study,
-    track: &Track,
-    index: u64,
-    mut on_fix: impl FnMut(&FixView<N>) -> Result<(), RealizationError>,
-) -> Result<(Ekf<N>, Imu), RealizationError> {
-    let drive = study.drive();
-    let (mut imu, mut ekf) = start(study, track, index);
-    let g = &study.filter_gnss;
-    let filter = |source| RealizationError::Filter { index, source };
-    let mut fixes = 0;
-    for (k, (inc, pva)) in track.steps.iter().enumerate() {
-        let raw = imu.read(inc);
-        ekf.propagate(&raw);
-        if (k + 1) % study.imu_steps_per_fix != 0 {
-            continue;
-        }
-        let t = (k + 1) as f64 / study.imu_rate_hz;
-        let mut reading = fix(study, &drive, &mut imu, t, pva);
-        // The filter weighs the fix with the σ's it assumes.
-        reading.position_sigma_m = g.position_sigma_m;
-        reading.velocity_sigma_m_s = g.velocity_sigma_m_s;
-        let (e_prior, p_prior) = (error(&ekf, pva, &imu), ekf.covariance);
-        let innovation = ekf.update(&reading).map_err(filter)?;
-        let e_post = error(&ekf, pva, &imu);
-        if innovation.residual.len() != MEASURED {
-            return Err(RealizationError::Covariance { index, fix: fixes });
-        }
-        let input = FixInput {
-            prior: StageInput {
-                error: e_prior,
-                // Closed loop: the error state is reset to zero after every fix.
-                estimate: SVector::zeros(),
-                covariance: p_prior,
-            },
-            post: StageInput {
-                error: e_post,
-                // The correction the update applied, K·ν: the error's change (to first order).
-                estimate: e_prior - e_post,
-                covariance: ekf.covariance,
-            },
-            residual: SVector::from_fn(|j, _| innovation.residual[j]),
-            residual_covariance: SMatrix::from_fn(|a, b| innovation.covariance[(a, b)]),
-        };
-        on_fix(&FixView {
-            t_s: t,
-            fix: fixes,
-            input,
-            ekf: &ekf,
-            imu: &imu,
-        })?;
-        fixes += 1;
+impl From<std::convert::Infallible> for RealizationError {
+    fn from(never: std::convert::Infallible) -> Self {
+        match never {}
     }
-    Ok((ekf, imu))
-}
-
-/// Realization `index`, its errors, corrections and innovations at every fix normalized by its
-/// own covariances.
-///
-/// # Errors
-/// [`RealizationError`] when a covariance stops being positive definite.
-pub fn realization<const N: usize>(
-    study: &Study,
-    track: &Track,
-    index: u64,
-) -> Result<Normalized<N>, RealizationError> {
-    let mut out = Vec::with_capacity(track.steps.len() / study.imu_steps_per_fix);
-    let (ekf, imu) = filter_realization(study, track, index, |v| {
-        let bad = RealizationError::Covariance { index, fix: v.fix };
-        out.push(NormalizedFix::of(&v.input, v.fix).map_err(|_| bad)?);
-        Ok(())
-    })?;
-    let end = track.steps.last().map_or(&track.start, |x| &x.1);
-    let p = ekf.covariance;
-    Ok(Normalized {
-        fixes: out,
-        final_error: error(&ekf, end, &imu),
-        final_sigma: SVector::from_fn(|k, _| p[(k, k)].sqrt()),
-    })
 }
 
 /// The fixes' times of `study`, s.
@@ -366,15 +248,57 @@ pub fn run_blocks<const N: usize>(
     track: &Track,
     blocks: &Partition,
     range: Range<u64>,
+    progress: impl FnMut(u64),
+    on_block: impl FnMut(u64, &InsSums<N>),
+) -> Result<(), RealizationError> {
+    match try_run_blocks(
+        study,
+        track,
+        blocks,
+        range,
+        progress,
+        on_block,
+        &Cancel::new(),
+    ) {
+        Ok(()) => Ok(()),
+        Err(Stopped::Realization(e)) => Err(e),
+        Err(Stopped::Cancelled(never)) => unreachable!("{never}: the flag is never raised"),
+    }
+}
+
+/// Why an ensemble that can be cancelled stopped.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Stopped {
+    /// A realization failed.
+    #[error(transparent)]
+    Realization(#[from] RealizationError),
+    /// The flag was raised (Ctrl-C).
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
+}
+
+/// [`run_blocks`] polling `cancel` before every chunk: once it is raised, the run stops with
+/// [`Stopped::Cancelled`] and no block after it is handed over.
+///
+/// # Errors
+/// [`Stopped::Realization`] with the first realization's error, in index order;
+/// [`Stopped::Cancelled`].
+pub fn try_run_blocks<const N: usize>(
+    study: &Study,
+    track: &Track,
+    blocks: &Partition,
+    range: Range<u64>,
     mut progress: impl FnMut(u64),
     mut on_block: impl FnMut(u64, &InsSums<N>),
-) -> Result<(), RealizationError> {
+    cancel: &Cancel,
+) -> Result<(), Stopped> {
     let mut done = 0;
     for b in range {
         let mut sums = empty_sums(study, track);
         let indices = blocks.block_realizations(b);
         let mut first = indices.start;
         while first < indices.end {
+            cancel.check()?;
             let last = (first + CHUNK).min(indices.end);
             let chunk: Vec<Result<Normalized<N>, RealizationError>> = (first..last)
                 .into_par_iter()
@@ -408,6 +332,33 @@ pub fn sums<const N: usize>(
     run_blocks(study, track, &blocks, 0..blocks.blocks, progress, |_, s| {
         total.merge(s);
     })?;
+    Ok(total)
+}
+
+/// [`sums`] that stops when `cancel` is raised (polled before every chunk of [`CHUNK`]
+/// realizations), as the one-axis ensemble's `try_sums` does.
+///
+/// # Errors
+/// As [`try_run_blocks`].
+pub fn try_sums<const N: usize>(
+    study: &Study,
+    track: &Track,
+    realizations: u64,
+    progress: impl FnMut(u64),
+    cancel: &Cancel,
+) -> Result<InsSums<N>, Stopped> {
+    let blocks = blocks::partition(realizations);
+    let mut total = empty_sums(study, track);
+    let all = 0..blocks.blocks;
+    try_run_blocks(
+        study,
+        track,
+        &blocks,
+        all,
+        progress,
+        |_, s| total.merge(s),
+        cancel,
+    )?;
     Ok(total)
 }
 

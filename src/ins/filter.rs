@@ -7,19 +7,21 @@
 //! The update is the Joseph form P⁺ = (I − KH)P(I − KH)ᵀ + KRKᵀ with the gain from a Cholesky
 //! factor of the innovation covariance S = HPHᵀ + R (no explicit inverse).
 
-use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, SVector, Vector3};
 use thiserror::Error;
+
+use crate::state::Variable;
 
 use super::discrete::{self, NoiseDensities};
 use super::error_state::{
     self, ACCEL_SCALE, BiasDecay, GYRO_SCALE, Motion, STATES, Square, has_scale,
 };
-use super::gnss::{self, Fix};
+use super::gnss::{Fix, FixUpdate};
 use super::mech::{self, Increment, Pva};
 
 mod correct;
-mod measured;
 mod parts;
+mod update;
 
 pub use correct::apply_correction;
 pub use parts::{LinearView, NOISE_GROUPS};
@@ -38,11 +40,11 @@ pub enum FilterError {
     Covariance,
 }
 
-/// What one fix's update saw: the innovation, its covariance and the normalized squared
-/// innovation (NIS).
+/// What one update saw: the innovation, its covariance and the normalized squared innovation
+/// (NIS).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Innovation<const N: usize = STATES> {
-    /// The fix's time, s.
+    /// The measurement's time, s.
     pub t_s: f64,
     /// The innovation ν (position NED m, then velocity NED m/s where measured).
     pub residual: DVector<f64>,
@@ -50,8 +52,12 @@ pub struct Innovation<const N: usize = STATES> {
     pub covariance: DMatrix<f64>,
     /// νᵀS⁻¹ν.
     pub nis: f64,
-    /// The estimated errors K·ν the update took out of the solution.
+    /// The estimated errors K·ν the update took out of the solution (zero when rejected).
     pub correction: SVector<f64, N>,
+    /// Each component's name, in the residual's order.
+    pub components: Vec<&'static Variable>,
+    /// Whether the update was applied: false when the χ² gate rejected the innovation.
+    pub accepted: bool,
 }
 
 /// How the filter carries its covariance from one IMU step to the next.
@@ -347,70 +353,13 @@ impl<const N: usize> Ekf<N> {
         self.propagate_parts_interval(&phi, &big_f, p.t_s);
     }
 
-    /// The update by `fix` (the pending steps first propagated): the innovation, the
-    /// Joseph-form covariance, the closed-loop correction of the solution and the biases.
+    /// The update by every component of `fix`, ungated ([`Ekf::update_by`] with
+    /// [`FixUpdate::whole`]).
     ///
     /// # Errors
     /// [`FilterError::Innovation`] when S is not positive definite.
     pub fn update(&mut self, fix: &Fix) -> Result<Innovation<N>, FilterError> {
-        self.flush();
-        self.fix_period_steps = Some(self.steps_since_update);
-        self.steps_since_update = 0;
-        let omega = self
-            .before
-            .map_or(Vector3::zeros(), |b| b.dtheta_rad / b.dt_s);
-        let (position, velocity) = gnss::antenna(&self.pva, &self.lever_arm_b_m, &omega);
-        let h6 = gnss::observation_of::<N>(&self.pva, &self.lever_arm_b_m, &omega);
-        let z_r = gnss::ned_difference_m(&position, &fix.position);
-        let r_r = fix.position_sigma_m.component_mul(&fix.position_sigma_m);
-        let (dx, nu, s) = if let Some(v) = fix.velocity_ned_m_s {
-            let mut z = SVector::<f64, 6>::zeros();
-            z.fixed_rows_mut::<3>(0).copy_from(&z_r);
-            z.fixed_rows_mut::<3>(3).copy_from(&(velocity - v));
-            let mut r = SVector::<f64, 6>::zeros();
-            r.fixed_rows_mut::<3>(0).copy_from(&r_r);
-            let sv = &fix.velocity_sigma_m_s;
-            r.fixed_rows_mut::<3>(3).copy_from(&sv.component_mul(sv));
-            self.joseph(&h6, &z, &r, fix.t_s)?
-        } else {
-            let h3 = h6.fixed_rows::<3>(0).into_owned();
-            self.joseph(&h3, &z_r, &r_r, fix.t_s)?
-        };
-        self.correct(&dx);
-        Ok(Innovation {
-            t_s: fix.t_s,
-            nis: nu.1,
-            residual: nu.0,
-            covariance: s,
-            correction: dx,
-        })
-    }
-
-    /// P ← (I − KH)P(I − KH)ᵀ + KRKᵀ for `rows` measurements with observation `h`, innovation
-    /// `z` and noise variances `r`; the estimated errors K·z, (ν, NIS) and S.
-    #[allow(clippy::type_complexity)]
-    fn joseph<const R: usize>(
-        &mut self,
-        h: &SMatrix<f64, R, N>,
-        z: &SVector<f64, R>,
-        r: &SVector<f64, R>,
-        t_s: f64,
-    ) -> Result<(SVector<f64, N>, (DVector<f64>, f64), DMatrix<f64>), FilterError> {
-        let p = &self.covariance;
-        let hp = h * p;
-        let s = hp * h.transpose() + SMatrix::<f64, R, R>::from_diagonal(r);
-        let chol = s.cholesky().ok_or(FilterError::Innovation { t_s })?;
-        // K = P Hᵀ S⁻¹, from S Kᵀ = H P.
-        let k = chol.solve(&hp).transpose();
-        let nis = z.dot(&chol.solve(z));
-        let dx = k * z;
-        let i_kh = Square::<N>::identity() - k * h;
-        let kr = k * SMatrix::<f64, R, R>::from_diagonal(r);
-        let p_new = i_kh * p * i_kh.transpose() + kr * k.transpose();
-        self.covariance = (p_new + p_new.transpose()) * 0.5;
-        let nu = DVector::from_column_slice(z.as_slice());
-        let s = DMatrix::from_column_slice(R, R, s.as_slice());
-        Ok((dx, (nu, nis), s))
+        self.update_by(&FixUpdate::whole(*fix), None)
     }
 
     /// The closed-loop correction by the estimated errors `dx` ([`apply_correction`]).

@@ -17,7 +17,10 @@ use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use super::earth::{self, Geodetic};
 use super::error_state::{ATTITUDE, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, VELOCITY, has_scale};
+use super::measurement::{At, Measurement, Rows};
 use super::mech::{Pva, skew};
+use super::names::MEASUREMENTS;
+use crate::state::Variable;
 
 /// One GNSS fix: the antenna's position and, when measured, its velocity.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -102,4 +105,118 @@ pub fn observation_of<const N: usize>(
         );
     }
     h
+}
+
+/// The position components' names.
+fn position_names() -> &'static [Variable; 3] {
+    MEASUREMENTS[..3]
+        .try_into()
+        .expect("three position components")
+}
+
+/// The velocity components' names.
+fn velocity_names() -> &'static [Variable; 3] {
+    MEASUREMENTS[3..]
+        .try_into()
+        .expect("three velocity components")
+}
+
+/// A fix's antenna position as a measurement: z_r = r̂_a − r̃_a in NED metres, R = diag(σ_r²).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Position(pub Fix);
+
+impl<const N: usize> Measurement<N> for Position {
+    fn t_s(&self) -> f64 {
+        self.0.t_s
+    }
+
+    fn rows(&self, at: &At, rows: &mut Rows<N>) {
+        let omega = &at.rate_ib_b_rad_s;
+        let (position, _) = antenna(at.pva, &at.lever_arm_b_m, omega);
+        let z = ned_difference_m(&position, &self.0.position);
+        let s = &self.0.position_sigma_m;
+        let c = *at.pva.attitude.to_rotation_matrix().matrix();
+        let arm_n = c * at.lever_arm_b_m;
+        rows.push3(
+            (&z, &s.component_mul(s)),
+            &[(POSITION, Matrix3::identity()), (ATTITUDE, -skew(&arm_n))],
+            position_names(),
+            [true; 3],
+        );
+    }
+}
+
+/// A fix's antenna velocity as a measurement, the components `measured` keeps (a receiver
+/// that reports no vertical velocity, or none): z_v = v̂_a − ṽ_a, R = diag(σ_v²).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Velocity {
+    /// The fix (its velocity `None`: no rows).
+    pub fix: Fix,
+    /// North, east, down: which components are measured.
+    pub measured: [bool; 3],
+}
+
+impl<const N: usize> Measurement<N> for Velocity {
+    fn t_s(&self) -> f64 {
+        self.fix.t_s
+    }
+
+    fn rows(&self, at: &At, rows: &mut Rows<N>) {
+        let Some(v) = self.fix.velocity_ned_m_s else {
+            return;
+        };
+        let omega = &at.rate_ib_b_rad_s;
+        let (_, velocity) = antenna(at.pva, &at.lever_arm_b_m, omega);
+        let s = &self.fix.velocity_sigma_m_s;
+        let h = observation_of::<N>(at.pva, &at.lever_arm_b_m, omega);
+        let block = |col: usize| h.fixed_view::<3, 3>(3, col).into_owned();
+        let mut blocks = vec![
+            (VELOCITY, block(VELOCITY)),
+            (ATTITUDE, block(ATTITUDE)),
+            (GYRO_BIAS, block(GYRO_BIAS)),
+        ];
+        if has_scale(N) {
+            blocks.push((GYRO_SCALE, block(GYRO_SCALE)));
+        }
+        rows.push3(
+            (&(velocity - v), &s.component_mul(s)),
+            &blocks,
+            velocity_names(),
+            self.measured,
+        );
+    }
+}
+
+/// A GNSS fix as one update: its position and, where measured, its velocity, stacked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FixUpdate {
+    /// The fix.
+    pub fix: Fix,
+    /// Which velocity components it measures (north, east, down).
+    pub measured: [bool; 3],
+}
+
+impl FixUpdate {
+    /// The update by every component `fix` has.
+    pub fn whole(fix: Fix) -> Self {
+        FixUpdate {
+            fix,
+            measured: [true; 3],
+        }
+    }
+}
+
+impl<const N: usize> Measurement<N> for FixUpdate {
+    fn t_s(&self) -> f64 {
+        self.fix.t_s
+    }
+
+    fn rows(&self, at: &At, rows: &mut Rows<N>) {
+        Measurement::<N>::rows(&Position(self.fix), at, rows);
+        let v = Velocity {
+            fix: self.fix,
+            measured: self.measured,
+        };
+        Measurement::<N>::rows(&v, at, rows);
+    }
 }

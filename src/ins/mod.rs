@@ -10,12 +10,14 @@
 pub mod blocks;
 pub mod discrete;
 pub mod drive;
+pub mod driver;
 pub mod earth;
 pub mod ensemble;
 pub mod error_state;
 pub mod filter;
 pub mod gnss;
 pub mod logs;
+pub mod measurement;
 pub mod mech;
 pub mod names;
 pub mod partial;

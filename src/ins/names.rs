@@ -3,7 +3,6 @@
 
 use crate::state::Variable;
 
-use super::ensemble::MEASURED;
 use super::error_state::STATES_WITH_SCALE;
 
 const fn v(
@@ -75,6 +74,9 @@ pub const VARIABLES: [Variable; STATES_WITH_SCALE] = [
         "1",
     ),
 ];
+
+/// The GNSS measurement's rows: position and velocity, NED.
+pub const MEASURED: usize = 6;
 
 /// The 6 innovation components: the antenna's position and velocity, NED.
 pub const MEASUREMENTS: [Variable; MEASURED] = [

@@ -14,6 +14,7 @@
 
 pub mod align;
 pub mod config;
+mod drive;
 pub mod gnss;
 pub mod linear;
 pub mod noise;

@@ -7,10 +7,12 @@ use thiserror::Error;
 
 use super::Settings;
 use super::align::{self, AlignSettings, Alignment, Plan, Sources};
+use super::drive::{LogFixes, LogSteps, Recorder};
 use super::gnss::{GnssRow, read_gnss};
 use super::read::{HeldSteps, ImuLayout, ImuReader, ImuSpan, ImuStep, StepSource};
 pub use super::step::{FixRecord, bias_sigmas, euler_sigmas};
-use super::step::{Running, part, start, update, velocity_sigmas};
+use super::step::{part, start, velocity_sigmas};
+use crate::ins::driver::{DriveError, Driver, ImuSource, Source, Step};
 use crate::ins::error_state::STATES;
 use crate::ins::filter::{Ekf, FilterError, LinearView};
 use crate::logs::read::LogSource;
@@ -145,60 +147,68 @@ fn run_filter<const N: usize>(
     let plan = align::plan(rows, imu_first_s, &settings).ok_or_else(|| no_heading(gnss_name, s))?;
     let (ra, rh) = (&rows[plan.first], &rows[plan.start]);
     let mut sum_dv = Vector3::zeros();
-    let mut mean_f_b = Vector3::zeros();
-    let mut start_view = None;
-    let mut started: Option<(Ekf<N>, Alignment)> = None;
-    let mut next = plan.start + 1;
-    let mut records = Vec::with_capacity(rows.len() - next);
-    let mut missing = [0; 3];
-    while let Some(step) = first
-        .take()
-        .map_or_else(|| source.next_step(), |f| Ok(Some(f)))?
-    {
-        let (t1, inc) = (step.t_s, step.increment);
-        let t0 = t1 - inc.dt_s;
-        let mut from = t0;
-        if started.is_none() {
-            let (lo, hi) = (t0.max(ra.t_s), t1.min(rh.t_s));
-            if hi > lo {
-                sum_dv += part(&inc, t1, lo, hi).dvel_m_s;
-            }
-            if t1 < rh.t_s {
-                continue;
-            }
-            mean_f_b = sum_dv / (rh.t_s - ra.t_s);
-            let a = align::align(ra, rh, &mean_f_b, &alignment_sources(rh, s));
-            let ekf = start(rh, &a, s, tracked);
-            start_view = tracked.then(|| ekf.linear_view());
-            started = Some((ekf, a));
-            from = rh.t_s;
-        }
-        let mut run = Running {
-            ekf: &mut started.as_mut().expect("started").0,
-            rows,
-            next: &mut next,
-            records: &mut records,
-            missing: &mut missing,
+    // The alignment's window summed, up to the step that holds the heading's fix.
+    let held = loop {
+        let Some(step) = first
+            .take()
+            .map_or_else(|| source.next_step(), |f| Ok(Some(f)))?
+        else {
+            return Err(ImuCalibrateError::Alignment {
+                file: gnss_name.to_string(),
+                reason: format!(
+                    "the IMU log ends before the alignment's fix at {} s",
+                    rh.t_s
+                ),
+            });
         };
-        run.step(&inc, from, t1, s)?;
-    }
-    let (ekf, alignment) = started.ok_or_else(|| ImuCalibrateError::Alignment {
-        file: gnss_name.to_string(),
-        reason: format!(
-            "the IMU log ends before the alignment's fix at {} s",
-            rh.t_s
-        ),
-    })?;
+        let (t1, inc) = (step.t_s, step.increment);
+        let (lo, hi) = ((t1 - inc.dt_s).max(ra.t_s), t1.min(rh.t_s));
+        if hi > lo {
+            sum_dv += part(&inc, t1, lo, hi).dvel_m_s;
+        }
+        if t1 >= rh.t_s {
+            break step;
+        }
+    };
+    let mean_f_b = sum_dv / (rh.t_s - ra.t_s);
+    let alignment = align::align(ra, rh, &mean_f_b, &alignment_sources(rh, s));
+    let mut ekf = start::<N>(rh, &alignment, s, tracked);
+    let start_view = tracked.then(|| ekf.linear_view());
+    let next = plan.start + 1;
+    let mut fixes = LogFixes {
+        rows,
+        next,
+        end: rows.len(),
+        settings: s,
+        missing: [0; 3],
+    };
+    let mut recorder = Recorder::new(rows, next, Vec::with_capacity(rows.len() - next));
+    let mut steps = LogSteps {
+        first: Some(held),
+        source,
+    };
+    Driver::new(vec![&mut fixes as &mut dyn Source<N, LogSteps>])
+        .starting_at(rh.t_s)
+        .run(&mut ekf, &mut steps, &mut recorder)
+        .map_err(drive_error)?;
     Ok(Filtered {
         plan,
         alignment,
-        records,
-        missing,
+        records: recorder.records,
+        missing: fixes.missing,
         ekf,
-        next,
+        next: fixes.next,
         mean_f_b,
         start_view,
     })
+}
+
+/// A driver's error as the calibration's.
+fn drive_error(e: DriveError<LogError>) -> ImuCalibrateError {
+    match e {
+        DriveError::Filter(f) => ImuCalibrateError::Filter(f),
+        DriveError::Other(log) => ImuCalibrateError::Log(log),
+    }
 }
 
 /// Calibrates the recording `imu` + `gnss` with the assumptions `s`.
@@ -275,19 +285,41 @@ fn assemble<const N: usize>(
     })
 }
 
-/// The fixes within half a step after the last sample, updated where the log ends.
+/// The fixes within half a step after the last sample (the first `fixes`), updated where the
+/// log ends.
 fn finish<const N: usize>(
     fixes: usize,
     run: &mut Filtered<N>,
     s: &Settings,
     rows: &[GnssRow],
-) -> Result<(), FilterError> {
-    while run.next < fixes {
-        let record = update(&mut run.ekf, &rows[run.next], s, &mut run.missing)?;
-        run.records.push(record);
-        run.next += 1;
-    }
+) -> Result<(), ImuCalibrateError> {
+    let mut source = LogFixes {
+        rows,
+        next: run.next,
+        end: fixes.max(run.next),
+        settings: s,
+        missing: run.missing,
+    };
+    let mut recorder = Recorder::new(rows, run.next, std::mem::take(&mut run.records));
+    let mut none = NoSteps;
+    Driver::new(vec![&mut source as &mut dyn Source<N, NoSteps>])
+        .drain(&mut run.ekf, &mut none, &mut recorder, f64::INFINITY)
+        .map_err(drive_error)?;
+    run.records = recorder.records;
+    run.missing = source.missing;
+    run.next = source.next;
     Ok(())
+}
+
+/// The IMU source after the log's end.
+struct NoSteps;
+
+impl ImuSource for NoSteps {
+    type Error = LogError;
+
+    fn next_step(&mut self) -> Result<Option<Step>, LogError> {
+        Ok(None)
+    }
 }
 
 /// The error of a recording whose course never gives the heading.

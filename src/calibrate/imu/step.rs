@@ -1,5 +1,5 @@
-//! One step of the calibration's filter: the increments of a part of an IMU step, the filter's
-//! start from the alignment, an update by one fix and its record, and the σ's a record gives.
+//! The calibration's filter: the increments of a part of an IMU step, the filter's start from the
+//! alignment, a fix's record, and the σ's a record gives.
 
 use nalgebra::{Matrix3, SVector, Vector3};
 
@@ -11,7 +11,7 @@ use crate::ins::error_state::{
     ACCEL_BIAS, ACCEL_SCALE, ATTITUDE, BiasDecay, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, Square,
     has_scale,
 };
-use crate::ins::filter::{Ekf, FilterError, LinearView, NOISE_GROUPS};
+use crate::ins::filter::{Ekf, LinearView, NOISE_GROUPS};
 use crate::ins::gnss::Fix;
 use crate::ins::mech::{Increment, Pva};
 
@@ -178,42 +178,6 @@ pub(super) fn start<const N: usize>(
     if tracked { ekf.with_noise_parts() } else { ekf }
 }
 
-/// The running filter and where it is among the fixes.
-pub(super) struct Running<'a, const N: usize> {
-    pub(super) ekf: &'a mut Ekf<N>,
-    pub(super) rows: &'a [GnssRow],
-    pub(super) next: &'a mut usize,
-    pub(super) records: &'a mut Vec<FixRecord<N>>,
-    pub(super) missing: &'a mut [usize; 3],
-}
-
-impl<const N: usize> Running<'_, N> {
-    /// The IMU step `inc` ending at `t1` from `from` on: propagated up to each fix it holds,
-    /// updated there, then to its end.
-    pub(super) fn step(
-        &mut self,
-        inc: &Increment,
-        mut from: f64,
-        t1: f64,
-        s: &Settings,
-    ) -> Result<(), FilterError> {
-        while *self.next < self.rows.len() && self.rows[*self.next].t_s <= t1 {
-            let tf = self.rows[*self.next].t_s;
-            if tf > from {
-                self.ekf.propagate(&part(inc, t1, from, tf));
-                from = tf;
-            }
-            let record = update(self.ekf, &self.rows[*self.next], s, self.missing)?;
-            self.records.push(record);
-            *self.next += 1;
-        }
-        if t1 > from {
-            self.ekf.propagate(&part(inc, t1, from, t1));
-        }
-        Ok(())
-    }
-}
-
 /// The σ's of the velocity at fix `r`: the log's or the default, and for a missing vertical
 /// velocity the σ of the assumption 0.
 pub(super) fn velocity_sigmas(r: &GnssRow, s: &Settings) -> Vector3<f64> {
@@ -221,58 +185,6 @@ pub(super) fn velocity_sigmas(r: &GnssRow, s: &Settings) -> Vector3<f64> {
         Some(_) => r.velocity_sigma_m_s[i].unwrap_or(s.gnss_velocity_sigma_m_s),
         None => s.vertical_velocity_sigma_m_s,
     }))
-}
-
-/// The update by the fix of `row`, recorded.
-pub(super) fn update<const N: usize>(
-    f: &mut Ekf<N>,
-    row: &GnssRow,
-    s: &Settings,
-    missing: &mut [usize; 3],
-) -> Result<FixRecord<N>, FilterError> {
-    let (fix, measured) = fix_of(row, s);
-    for (m, &k) in missing.iter_mut().zip(&measured) {
-        *m += usize::from(!k);
-    }
-    f.flush();
-    let prior_covariance = f.covariance;
-    let transition = f.take_transition().unwrap_or_else(Square::<N>::identity);
-    let linear = f.take_noise_parts().map(|noise_parts| {
-        Box::new(LinearRecord {
-            noise_parts,
-            view: f.linear_view(),
-        })
-    });
-    let nu = f.update_measured(&fix, measured)?;
-    let (mut innovation, mut innovation_sigma) = ([f64::NAN; 6], [f64::NAN; 6]);
-    let components: Vec<usize> = (0..6).filter(|&i| i < 3 || measured[i - 3]).collect();
-    for (k, &i) in components.iter().enumerate() {
-        innovation[i] = nu.residual[k];
-        innovation_sigma[i] = nu.covariance[(k, k)].sqrt();
-    }
-    Ok(FixRecord {
-        line: row.line,
-        t_s: row.t_s,
-        pva: f.pva,
-        gyro_bias_rad_s: f.gyro_bias_rad_s,
-        accel_bias_m_s2: f.accel_bias_m_s2,
-        gyro_scale: f.gyro_scale,
-        accel_scale: f.accel_scale,
-        covariance: f.covariance,
-        prior_covariance,
-        transition,
-        correction: nu.correction,
-        innovation,
-        innovation_sigma,
-        nis: nu.nis,
-        log_det_s: nu
-            .covariance
-            .clone()
-            .cholesky()
-            .map_or(f64::NAN, |c| 2.0 * c.l().diagonal().map(f64::ln).sum()),
-        rows: components.len(),
-        linear,
-    })
 }
 
 /// The σ's of roll, pitch and yaw (rad) from the attitude error's covariance at `pva`: the
