@@ -8,7 +8,8 @@ mod common;
 
 use accelcal::calibrate::imu::Settings;
 use accelcal::calibrate::imu::run::calibrate_of;
-use accelcal::calibrate::imu::summary::{Summary, Triad, summary};
+use accelcal::calibrate::imu::summary::{Summary, summary};
+use accelcal::calibrate::imu::triad::Triad;
 use accelcal::config::ins::InsConfig;
 use accelcal::ins::error_state::STATES_WITH_SCALE;
 use accelcal::ins::logs::write_realization;

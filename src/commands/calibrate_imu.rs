@@ -195,7 +195,7 @@ fn print_result(s: &Summary) -> Result<()> {
     for w in &s.warnings {
         eprintln!("warning: {w}");
     }
-    let triad = |name: &str, t: &accelcal::calibrate::imu::summary::Triad, unit: &str| {
+    let triad = |name: &str, t: &accelcal::calibrate::imu::triad::Triad, unit: &str| {
         let parts: Vec<String> = (0..3)
             .map(|i| {
                 let id = if t.identifiable[i] {

@@ -9,7 +9,7 @@
 //!    step cut there), one record per fix.
 //! 4. `smoother`: the Rauch–Tung–Striebel pass backwards over the fixes.
 //! 5. `summary`: the six biases and the attitude at the end with σ's, intervals and whether the
-//!    drive determined them; the NIS test and the innovations' whiteness per component; every
+//!    drive determined them (each sensor's three a `triad`); the NIS test and the innovations' whiteness per component; every
 //!    assumption made.
 
 pub mod align;
@@ -23,6 +23,7 @@ pub mod scale;
 pub mod smoother;
 mod step;
 pub mod summary;
+pub mod triad;
 
 use nalgebra::Vector3;
 use serde::Serialize;
