@@ -10,9 +10,9 @@ use accelcal::calibrate::imu::run::{Calibrated, calibrate};
 use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary};
 use accelcal::config::ins::{Axes, InsConfig};
+use accelcal::input::csv::read::LogText;
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Study;
-use accelcal::logs::read::LogText;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 

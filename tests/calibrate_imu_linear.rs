@@ -9,10 +9,10 @@ use accelcal::calibrate::imu::noise::log_likelihood;
 use accelcal::calibrate::imu::read::{ImuSpan, ImuStep, read_steps};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ins::InsConfig;
+use accelcal::input::csv::read::LogText;
 use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Study;
-use accelcal::logs::read::LogText;
 
 /// The shipped minute, held.
 fn comma() -> (Vec<GnssRow>, Vec<ImuStep>) {

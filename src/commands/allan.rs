@@ -12,7 +12,7 @@ use accelcal::allan::imu::stream::{ImuRecords, StreamError};
 use accelcal::allan::imu::{self, Channel, ImuAnalysis, Sensor};
 use accelcal::allan::{self, Term, export, log::read_static_log};
 use accelcal::format::{count, interval_digits, sig};
-use accelcal::logs::read::LogFile;
+use accelcal::input::csv::read::LogFile;
 use accelcal::output::StagedFiles;
 use accelcal::report::allan as page;
 use accelcal::report::allan_imu as imu_page;

@@ -17,8 +17,8 @@ use accelcal::calibrate::imu::summary::{Summary, summary, write_estimates};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ConfigText;
 use accelcal::error::ConfigError;
+use accelcal::input::csv::read::{LogFile, LogSource};
 use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
-use accelcal::logs::read::{LogFile, LogSource};
 use accelcal::output::{StagedFiles, check_directory};
 
 /// The files the three-axis calibration writes.

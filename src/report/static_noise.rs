@@ -16,8 +16,8 @@ use crate::allan::section::{Coverage, REPORT_LOG, REPORT_SAMPLES, coverage, cove
 use crate::allan::simulate::StaticLog;
 use crate::allan::{AllanError, Analysis, Term, analyse};
 use crate::format::{count, sig};
-use crate::logs::read::LogText;
-use crate::logs::write::{header, push_row};
+use crate::input::csv::read::LogText;
+use crate::input::csv::text::{header, push_row};
 use crate::plot::{self, PlotError};
 
 /// The Allan figure of `a` (SVG), as `accelcal allan` draws it.

@@ -16,11 +16,11 @@ use crate::calibrate::imu::smoother::{Smoothed, smooth};
 use crate::calibrate::imu::summary::{Summary, summary};
 use crate::calibrate::imu::triad::CONFIDENCE;
 use crate::calibrate::imu::{CONSUMER, Settings};
+use crate::input::LogError;
+use crate::input::csv::read::LogText;
 use crate::ins::error_state::Matrix15;
 use crate::ins::euler_of;
 use crate::ins::mech::Pva;
-use crate::logs::LogError;
-use crate::logs::read::LogText;
 
 /// The shipped IMU log (`t_s` and the six rates, forward-right-down).
 pub const IMU: &[u8] = include_bytes!("../../examples/comma2k19_3d/imu.csv");

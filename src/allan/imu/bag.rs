@@ -6,7 +6,7 @@
 //! Time is the header's stamp, t = (sec − sec₀) + nanosec·10⁻⁹ s with sec₀ the first message's
 //! whole second (exact to the nanosecond over a day, where sec + nanosec·10⁻⁹ would keep 0.2 µs
 //! of an epoch time), checked as a CSV log's time stamps are: strictly increasing, every step
-//! within `logs::steps::ACCEPTED_STEP_RATIO` of the median.
+//! within `input::csv::steps::ACCEPTED_STEP_RATIO` of the median.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -15,7 +15,7 @@ use super::mcap_stream::{McapEvent, McapRecords, visit_mcap};
 use super::stream::{ImuRecords, Record};
 use super::{Channel, ImuSamples};
 use crate::allan::log::{first_gap, median_step};
-use crate::logs::{LogError, LogProblem};
+use crate::input::{LogError, LogProblem};
 
 /// The first bytes of an MCAP file.
 pub const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use super::Channel;
 use super::bag::{IMU_TYPE, MCAP_MAGIC, decode_imu, unreadable};
 use super::stream::{ImuRecords, Record};
-use crate::logs::{LogError, LogProblem};
+use crate::input::{LogError, LogProblem};
 
 /// The longest record the MCAP reader accepts, bytes: a corrupt length then is an error, where
 /// `mcap::MessageStream` (0.26, no limit) panics on a length near 2⁶⁴.

@@ -6,8 +6,8 @@ use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
-use crate::logs::read::{LogSource, decompressed};
-use crate::logs::{LogError, LogProblem};
+use crate::input::csv::read::{LogSource, decompressed};
+use crate::input::{LogError, LogProblem};
 
 /// The bytes of a log read once, kept in a temporary file (unlinked at creation: removed
 /// however the process ends).

@@ -5,8 +5,8 @@
 use super::stream::{ImuRecords, Record};
 use super::{Channel, ImuSamples};
 use crate::allan::log::read_static_log;
-use crate::logs::read::{CsvReader, LogSource};
-use crate::logs::{LogError, LogProblem, echo};
+use crate::input::csv::read::{CsvReader, LogSource};
+use crate::input::{LogError, LogProblem, echo};
 
 /// The log's text, held once and lent to each column's reading under the file's name.
 struct Held<'a> {
@@ -199,7 +199,7 @@ impl ImuRecords for CsvRecords<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::logs::read::LogText;
+    use crate::input::csv::read::LogText;
 
     #[test]
     fn any_channels_are_read_and_the_earliest_problem_is_told() {

@@ -22,7 +22,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::bag::{ImuMessage, Topics, unreadable};
-use crate::logs::LogError;
+use crate::input::LogError;
 
 /// The first bytes of a ROS 1 bag.
 pub const ROSBAG_MAGIC: &[u8] = b"#ROSBAG V2.0\n";

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use super::Channel;
 use super::rosbag1::{IMU_TYPE, Ros1Event, decode_message, visit_ros1};
 use super::stream::{ImuRecords, Record};
-use crate::logs::{LogError, LogProblem};
+use crate::input::{LogError, LogProblem};
 
 /// The chosen `Imu` topic of a ROS 1 bag, as records of the six channels read from disk each
 /// time.

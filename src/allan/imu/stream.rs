@@ -11,8 +11,8 @@ use rayon::prelude::*;
 use super::{Channel, ChannelAnalysis, ImuAnalysis, ImuError};
 use crate::allan::analyse_grid;
 use crate::allan::stream::{AllanStream, StreamingMean};
-use crate::logs::steps::{ACCEPTED_STEP_RATIO, StepMedian};
-use crate::logs::{LogError, LogProblem};
+use crate::input::csv::steps::{ACCEPTED_STEP_RATIO, StepMedian};
+use crate::input::{LogError, LogProblem};
 
 /// Samples of each channel handed to the streams at once.
 const BATCH: usize = 1 << 16;

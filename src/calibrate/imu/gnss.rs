@@ -7,9 +7,9 @@
 
 use std::io::{BufRead, Read};
 
+use crate::input::csv::read::LogSource;
+use crate::input::{LogError, LogProblem, echo};
 use crate::ins::earth::Geodetic;
-use crate::logs::read::LogSource;
-use crate::logs::{LogError, LogProblem, echo};
 
 /// The GNSS log's required columns.
 pub const GNSS_COLUMNS: [&str; 4] = ["t_s", "lat_deg", "lon_deg", "height_m"];
@@ -118,8 +118,8 @@ pub fn read_gnss(source: &dyn LogSource) -> Result<Vec<GnssRow>, LogError> {
             break;
         }
         line += 1;
-        if buf.len() > crate::logs::block::MAX_LINE_BYTES {
-            let limit_bytes = crate::logs::block::MAX_LINE_BYTES;
+        if buf.len() > crate::input::csv::block::MAX_LINE_BYTES {
+            let limit_bytes = crate::input::csv::block::MAX_LINE_BYTES;
             return Err(at(line, LogProblem::LineTooLong { limit_bytes }));
         }
         let text = std::str::from_utf8(&buf).map_err(|_| at(line, LogProblem::NotText))?;
@@ -146,7 +146,7 @@ pub fn read_gnss(source: &dyn LogSource) -> Result<Vec<GnssRow>, LogError> {
 /// false at the end.
 fn next_line(reader: &mut dyn BufRead, buf: &mut Vec<u8>, name: &str) -> Result<bool, LogError> {
     buf.clear();
-    let limit = crate::logs::block::MAX_LINE_BYTES as u64 + 1;
+    let limit = crate::input::csv::block::MAX_LINE_BYTES as u64 + 1;
     let n = reader.take(limit).read_until(b'\n', buf).map_err(|e| {
         let message = e.to_string();
         LogError::of_file(name, LogProblem::Unreadable { message })

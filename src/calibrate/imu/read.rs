@@ -10,10 +10,10 @@
 use nalgebra::Vector3;
 
 use crate::config::ins::Axes;
+use crate::input::csv::read::{CsvReader, LogSource};
+use crate::input::csv::steps::{ACCEPTED_STEP_RATIO, StepAt, StepMedian};
+use crate::input::{LogError, LogProblem};
 use crate::ins::mech::Increment;
-use crate::logs::read::{CsvReader, LogSource};
-use crate::logs::steps::{ACCEPTED_STEP_RATIO, StepAt, StepMedian};
-use crate::logs::{LogError, LogProblem};
 
 /// The IMU log's columns when it holds rates.
 pub const RATE_COLUMNS: [&str; 7] = [

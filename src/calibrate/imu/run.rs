@@ -11,10 +11,10 @@ use super::gnss::{GnssRow, read_gnss};
 use super::read::{HeldSteps, ImuLayout, ImuReader, ImuSpan, ImuStep, StepSource};
 pub use super::step::{FixRecord, bias_sigmas, euler_sigmas};
 use super::step::{Running, part, start, update, velocity_sigmas};
+use crate::input::csv::read::LogSource;
+use crate::input::{LogError, LogProblem};
 use crate::ins::error_state::STATES;
 use crate::ins::filter::{Ekf, FilterError, LinearView};
-use crate::logs::read::LogSource;
-use crate::logs::{LogError, LogProblem};
 
 /// Why a recording cannot be calibrated.
 #[derive(Debug, Error)]

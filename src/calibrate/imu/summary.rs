@@ -369,7 +369,7 @@ pub fn write_estimates<const N: usize>(
         row.extend(sa);
         super::scale::extend_row(&mut row, sm);
         let mut line = String::new();
-        crate::logs::write::push_row(&mut line, &row);
+        crate::input::csv::text::push_row(&mut line, &row);
         out.write_all(line.as_bytes())?;
     }
     Ok(())
