@@ -2,12 +2,25 @@
 //!
 //! - [`csv`]: the CSV text every log is written in (a header row naming the columns, one row per
 //!   sample), its streaming reader, and the one-axis logs read with it: the accelerometer and
-//!   GPS logs of `calibrate --accel --gps`, the static log of `allan --accel`.
+//!   GPS logs of `calibrate --accel --gps`, the static log of `allan --accel`;
+//! - [`imu_channels_csv`]: a static six-axis IMU log as CSV (`allan --imu`);
+//! - the containers of ROS recordings, [`mcap`] (an MCAP file), [`rosbag2`] (a ROS 2 bag
+//!   directory of MCAP files) and [`rosbag1`] (a ROS 1 bag), their messages decoded by
+//!   [`messages`] (`sensor_msgs/Imu`), the chosen topic read by [`recording`];
+//! - [`records`]: what the readers hand on, whatever the format.
 //!
 //! Every reader refuses bad input with a [`LogError`] naming the file, the line (or the message)
-//! and what was expected; none knows what its numbers are used for.
+//! and what was expected; none knows what its numbers are used for. The layer imports nothing of
+//! the analyses above it.
 
 pub mod csv;
+pub mod imu_channels_csv;
+pub mod mcap;
+pub mod messages;
+pub mod recording;
+pub mod records;
+pub mod rosbag1;
+pub mod rosbag2;
 
 use thiserror::Error;
 
@@ -251,4 +264,10 @@ impl LogError {
             problem,
         }
     }
+}
+
+/// The error of the file (or the message) `file` that cannot be read as expected, in
+/// `message`'s words.
+fn unreadable(file: &str, message: String) -> LogError {
+    LogError::of_file(file, LogProblem::Unreadable { message })
 }

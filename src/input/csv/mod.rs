@@ -14,11 +14,15 @@
 //! [`read`] streams a log row by row and refuses bad input with a [`LogError`](super::LogError)
 //! naming the file, the line and what was expected; [`block`] is its fast core; [`steps`] finds
 //! the median time step of a log in bounded memory; [`text`] writes every number so that it
-//! reads back bit for bit; [`arrays`] holds an accelerometer log as two arrays.
+//! reads back bit for bit; [`arrays`] holds an accelerometer log as two arrays; [`static_log`]
+//! reads a static log's column whole (`allan --accel`); [`piped`] keeps a log that can be read
+//! only once (a pipe) so that it can be read again.
 
 pub mod arrays;
 pub mod block;
+pub mod piped;
 pub mod read;
+pub mod static_log;
 pub mod steps;
 pub mod text;
 

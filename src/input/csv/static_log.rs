@@ -1,5 +1,9 @@
-//! A static accelerometer log read into memory, with the step checks of `calibrate`: strictly
-//! increasing time stamps, and every step within [`ACCEPTED_STEP_RATIO`] of the median step.
+//! A static accelerometer log read into memory (`allan --accel`), with the step checks of
+//! `calibrate`: strictly increasing time stamps, and every step within [`ACCEPTED_STEP_RATIO`]
+//! of the median step.
+//!
+//! # Format
+//! The CSV text of [`super`]: `t_s` and the column read (`accel_m_s2`, or any one column named).
 
 use crate::input::csv::read::{AccelReader, LogSource};
 use crate::input::csv::steps::ACCEPTED_STEP_RATIO;
