@@ -8,9 +8,7 @@ use anyhow::{Context, Result};
 use crate::cli::CalibrateArgs;
 use crate::cli::calibrate::EstimateKey;
 use accelcal::calibrate::imu::config::settings_of;
-use accelcal::calibrate::imu::gnss::read_gnss;
 use accelcal::calibrate::imu::noise::{self, ImuKey};
-use accelcal::calibrate::imu::read::read_steps;
 use accelcal::calibrate::imu::run::{Calibrated, ImuCalibrateError, calibrate_held, calibrate_of};
 use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary, write_estimates};
@@ -18,6 +16,8 @@ use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ConfigText;
 use accelcal::error::ConfigError;
 use accelcal::input::csv::read::{LogFile, LogSource};
+use accelcal::input::gnss_csv::read_gnss;
+use accelcal::input::imu_csv::read_steps;
 use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
 use accelcal::output::{StagedFiles, check_directory};
 

@@ -3,6 +3,8 @@
 //! - [`csv`]: the CSV text every log is written in (a header row naming the columns, one row per
 //!   sample), its streaming reader, and the one-axis logs read with it: the accelerometer and
 //!   GPS logs of `calibrate --accel --gps`, the static log of `allan --accel`;
+//! - [`imu_csv`] and [`gnss_csv`]: a drive's six-axis IMU log and its GNSS fixes as CSV
+//!   (`calibrate --imu --gnss`), or their columns held in memory;
 //! - [`imu_channels_csv`]: a static six-axis IMU log as CSV (`allan --imu`);
 //! - the containers of ROS recordings, [`mcap`] (an MCAP file), [`rosbag2`] (a ROS 2 bag
 //!   directory of MCAP files) and [`rosbag1`] (a ROS 1 bag), their messages decoded by
@@ -14,7 +16,9 @@
 //! the analyses above it.
 
 pub mod csv;
+pub mod gnss_csv;
 pub mod imu_channels_csv;
+pub mod imu_csv;
 pub mod mcap;
 pub mod messages;
 pub mod recording;

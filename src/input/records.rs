@@ -1,8 +1,13 @@
 //! The records the readers hand on, whatever the format they read: no format is defined here.
 //!
-//! A static IMU log's six channels ([`Channel`], each of a [`Sensor`]), held whole
-//! ([`ImuSamples`]) or read record by record from disk as often as an analysis needs
-//! ([`Record`]s through [`ImuRecords`]).
+//! - A static IMU log's six channels ([`Channel`], each of a [`Sensor`]), held whole
+//!   ([`ImuSamples`]) or read record by record from disk as often as an analysis needs
+//!   ([`Record`]s through [`ImuRecords`]).
+//! - A drive's IMU steps ([`ImuStep`]: an [`Increment`] each, in body axes forward-right-down)
+//!   and its GNSS fixes ([`GnssRow`]: a [`Geodetic`] position on WGS-84), as a calibration reads
+//!   them; the navigation layer (`ins`) takes the two as its own.
+
+use nalgebra::Vector3;
 
 use super::{LogError, LogProblem};
 
@@ -114,4 +119,63 @@ pub trait ImuRecords {
 
     /// The error of `problem` for the whole log.
     fn error(&self, problem: LogProblem) -> LogError;
+}
+
+/// One step of the IMU log: the increments over (`t_s − dt_s`, `t_s`], in body axes
+/// forward-right-down.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImuStep {
+    /// Line of the row that ends the step.
+    pub line: u64,
+    /// The step's end, s.
+    pub t_s: f64,
+    /// Δθ, Δv and the step's length.
+    pub increment: Increment,
+}
+
+/// What the IMU measured over one step ending at t_k: the integrals of its angular rate and of
+/// its specific force in body axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Increment {
+    /// Δθ = ∫ω_ib^b dt, rad.
+    pub dtheta_rad: Vector3<f64>,
+    /// Δv = ∫f^b dt, m/s.
+    pub dvel_m_s: Vector3<f64>,
+    /// t_k − t_{k−1}, s.
+    pub dt_s: f64,
+}
+
+/// One row of the GNSS log.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GnssRow {
+    /// Line in the file.
+    pub line: u64,
+    /// Time of validity, s.
+    pub t_s: f64,
+    /// The antenna's position.
+    pub position: Geodetic,
+    /// Velocity north, east, down (m/s); `None` where not measured.
+    pub velocity_ned_m_s: [Option<f64>; 3],
+    /// The position's σ north, east, down (m), where the log gives it.
+    pub position_sigma_m: [Option<f64>; 3],
+    /// The velocity's σ per component (m/s), where the log gives it.
+    pub velocity_sigma_m_s: [Option<f64>; 3],
+}
+
+impl GnssRow {
+    /// The horizontal velocity, when both components are measured.
+    pub fn horizontal_velocity(&self) -> Option<(f64, f64)> {
+        Some((self.velocity_ned_m_s[0]?, self.velocity_ned_m_s[1]?))
+    }
+}
+
+/// A position on the ellipsoid: geodetic latitude and longitude, ellipsoidal height.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Geodetic {
+    /// Geodetic latitude L, rad, in [−π/2, π/2].
+    pub lat_rad: f64,
+    /// Longitude λ, rad, east positive.
+    pub lon_rad: f64,
+    /// Height above the ellipsoid h, m.
+    pub height_m: f64,
 }

@@ -1,7 +1,8 @@
 //! `calibrate --imu FILE --gnss FILE`: a whole IMU calibrated from a raw recording — six
 //! channels and geodetic GNSS fixes — through the three-axis error-state filter (`crate::ins`).
 //!
-//! 1. `read`: the GNSS log held (one row per fix), the IMU log streamed once as increments.
+//! 1. The logs read by `crate::input`: the GNSS log held (one row per fix, `input::gnss_csv`),
+//!    the IMU log streamed once as increments (`input::imu_csv`).
 //! 2. `align`: with no attitude given, the filter starts at the first fix fast enough for the
 //!    course to give the heading; roll and pitch come from the mean specific force over the
 //!    window before it, and the prior covariance carries the alignment's errors.
@@ -14,10 +15,8 @@
 
 pub mod align;
 pub mod config;
-pub mod gnss;
 pub mod linear;
 pub mod noise;
-pub mod read;
 pub mod run;
 pub mod scale;
 pub mod smoother;

@@ -7,11 +7,12 @@ use thiserror::Error;
 
 use super::Settings;
 use super::align::{self, AlignSettings, Alignment, Plan, Sources};
-use super::gnss::{GnssRow, read_gnss};
-use super::read::{HeldSteps, ImuLayout, ImuReader, ImuSpan, ImuStep, StepSource};
 pub use super::step::{FixRecord, bias_sigmas, euler_sigmas};
 use super::step::{Running, part, start, update, velocity_sigmas};
 use crate::input::csv::read::LogSource;
+use crate::input::gnss_csv::read_gnss;
+use crate::input::imu_csv::{HeldSteps, ImuLayout, ImuReader, ImuSpan, StepSource};
+use crate::input::records::{GnssRow, ImuStep};
 use crate::input::{LogError, LogProblem};
 use crate::ins::error_state::STATES;
 use crate::ins::filter::{Ekf, FilterError, LinearView};

@@ -82,7 +82,7 @@ pub struct Summary {
     /// The GNSS log, as named.
     pub gnss_file: String,
     /// What the IMU rows hold.
-    pub imu_layout: super::read::ImuLayout,
+    pub imu_layout: crate::input::imu_csv::ImuLayout,
     /// IMU rows.
     pub imu_rows: u64,
     /// The median IMU step's rate, Hz.

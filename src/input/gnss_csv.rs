@@ -1,15 +1,18 @@
-//! The GNSS log of geodetic fixes, held whole (one row per fix).
+//! The GNSS log of `calibrate --imu --gnss`: geodetic fixes, held whole (one [`GnssRow`] per
+//! fix), read from CSV or from columns held in memory (the Python package's arrays).
 //!
-//! `t_s,lat_deg,lon_deg,height_m` (WGS-84, ellipsoidal height), optionally
+//! # Format
+//! The CSV text of [`super::csv`] with the columns of `docs/guide/calibrate_imu.md` (§ The
+//! recordings): `t_s,lat_deg,lon_deg,height_m` (WGS-84, ellipsoidal height), optionally
 //!   `vn_m_s,ve_m_s,vd_m_s` and the σ's `sigma_n_m,sigma_e_m,sigma_d_m`,
 //!   `sigma_vn_m_s,sigma_ve_m_s,sigma_vd_m_s`; in those optional columns an empty cell or `nan`
 //!   means "not measured".
 
 use std::io::{BufRead, Read};
 
-use crate::input::csv::read::LogSource;
-use crate::input::{LogError, LogProblem, echo};
-use crate::ins::earth::Geodetic;
+use super::csv::read::LogSource;
+use super::records::{Geodetic, GnssRow};
+use super::{LogError, LogProblem, echo};
 
 /// The GNSS log's required columns.
 pub const GNSS_COLUMNS: [&str; 4] = ["t_s", "lat_deg", "lon_deg", "height_m"];
@@ -25,30 +28,6 @@ pub const GNSS_OPTIONAL: [&str; 9] = [
     "sigma_ve_m_s",
     "sigma_vd_m_s",
 ];
-
-/// One row of the GNSS log.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GnssRow {
-    /// Line in the file.
-    pub line: u64,
-    /// Time of validity, s.
-    pub t_s: f64,
-    /// The antenna's position.
-    pub position: Geodetic,
-    /// Velocity north, east, down (m/s); `None` where not measured.
-    pub velocity_ned_m_s: [Option<f64>; 3],
-    /// The position's σ north, east, down (m), where the log gives it.
-    pub position_sigma_m: [Option<f64>; 3],
-    /// The velocity's σ per component (m/s), where the log gives it.
-    pub velocity_sigma_m_s: [Option<f64>; 3],
-}
-
-impl GnssRow {
-    /// The horizontal velocity, when both components are measured.
-    pub fn horizontal_velocity(&self) -> Option<(f64, f64)> {
-        Some((self.velocity_ned_m_s[0]?, self.velocity_ned_m_s[1]?))
-    }
-}
 
 /// A field's number: `None` for an empty cell or `nan` where `optional`, else a finite number.
 fn field(text: &str, column: &'static str, optional: bool) -> Result<Option<f64>, LogProblem> {
