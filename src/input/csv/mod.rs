@@ -3,8 +3,8 @@
 //! A log is UTF-8 text: a header row naming the columns, then one row per sample, fields
 //! separated by commas — comma-separated values as RFC 4180 describes them, without quoted
 //! fields (every field is a number); the columns are this project's, named with their units
-//! (the table below, and each reader's). The header must hold each required column once; other
-//! columns are ignored.
+//! (`docs/guide/logs.md`: the rules, the table below and the three-axis logs). The header must
+//! hold each required column once; other columns are ignored.
 //!
 //! | file | columns |
 //! |---|---|

@@ -1,6 +1,7 @@
 //! The text of a CSV log's rows: every number in the shortest form that parses back to the same
 //! double (Rust's `{}` and `{:e}`, both shortest round-trip representations), so that a log
-//! written with it reads back bit for bit through [`super::read`].
+//! written with it reads back bit for bit through [`super::read`] (the logs' CSV rules are
+//! `docs/guide/logs.md`'s).
 
 use std::fmt::Write as _;
 
