@@ -12,11 +12,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use accelcal::allan::log::read_static_log;
 use accelcal::allan::simulate::StaticLog;
 use accelcal::allan::{analyse, deviation};
-use accelcal::logs::read::LogFile;
-use accelcal::logs::write::{header, push_row};
+use accelcal::input::csv::read::LogFile;
+use accelcal::input::csv::static_log::read_static_log;
+use accelcal::input::csv::text::{header, push_row};
 
 const LOG: StaticLog = StaticLog {
     sample_period_s: 0.01,

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use accelcal::calibrate::pass::{Integrated, Start, reduce};
-use accelcal::logs::read::{LogFile, LogSource, read_gps};
+use accelcal::input::csv::read::{LogFile, LogSource, read_gps};
 use accelcal::model::BiasModel;
 
 fn median(v: &mut [f64]) -> f64 {

@@ -4,8 +4,8 @@
 //! The pipeline, one module per step, each depending only on the ones before it:
 //! [`config`] → [`model`] → [`state`] → [`filter`] → [`simulation`] → [`realization`], [`ensemble`] →
 //! [`stats`], [`checks`] → [`study`], [`sensitivity`] → [`export`], [`plot`] → [`report`].
-//! Below the study, [`logs`] reads and writes sensor logs and [`calibrate`] runs the filter and a
-//! smoother over them; [`allan`] measures the accelerometer's noise terms from a static log.
+//! Below the study, [`input`] reads the sensor logs, [`logs`] writes those of a simulated run,
+//! and [`calibrate`] runs the filter and a smoother over them; [`allan`] measures the accelerometer's noise terms from a static log.
 //! [`format`](mod@format), [`output`], [`progress`] and [`error`] are leaves every step may use. The `accelcal` binary (`src/main.rs`) parses the command line and calls
 //! [`study`], [`sensitivity`], [`calibrate`], [`export`] and [`report`].
 #![warn(missing_docs)]
@@ -19,6 +19,7 @@ pub mod error;
 pub mod export;
 pub mod filter;
 pub mod format;
+pub mod input;
 pub mod ins;
 pub mod lanes;
 pub mod likelihood;

@@ -1,11 +1,11 @@
-//! Calibrate from arrays (`logs::arrays::AccelArrays`, the Python package's entry) gives the
+//! Calibrate from arrays (`input::csv::arrays::AccelArrays`, the Python package's entry) gives the
 //! bytes that calibrate from the same log's text gives, on the shipped comma2k19 minute: the
 //! summary, the per-fix estimates and (through the arrays' text form) the per-sample ones.
 
 use accelcal::calibrate::{self, Settings};
 use accelcal::config::Config;
-use accelcal::logs::arrays::AccelArrays;
-use accelcal::logs::read::{AccelReader, LogSource, LogText};
+use accelcal::input::csv::arrays::AccelArrays;
+use accelcal::input::csv::read::{AccelReader, LogSource, LogText};
 
 const ACCEL: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),

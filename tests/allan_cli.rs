@@ -5,7 +5,7 @@ use std::path::Path;
 use std::process::Command;
 
 use accelcal::allan::simulate::StaticLog;
-use accelcal::logs::write::{header, push_row};
+use accelcal::input::csv::text::{header, push_row};
 
 fn write_log(path: &Path, columns: &[&str], rows: impl Iterator<Item = Vec<f64>>) {
     let mut text = header(columns);

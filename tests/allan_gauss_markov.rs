@@ -179,8 +179,9 @@ fn gauss_markov_intervals_cover_and_a_log_without_a_hump_is_not_resolved() {
 /// the gyro, with no hump, keeps its rule of thumb and says it is not determined by the log.
 #[test]
 fn the_files_take_the_fitted_gauss_markov_term() {
+    use accelcal::allan::imu::analyse_imu;
     use accelcal::allan::imu::export::{allan_json, imu_yaml, noise_toml};
-    use accelcal::allan::imu::{Channel, ImuSamples, analyse_imu};
+    use accelcal::input::records::{Channel, ImuSamples};
     let log = ImuSamples {
         channels: vec![
             (Channel::Ax, HUMP.samples(SAMPLES, 5)),

@@ -9,7 +9,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 
 use accelcal::allan::simulate::StaticLog;
-use accelcal::logs::write::{header, push_row};
+use accelcal::input::csv::text::{header, push_row};
 use serde_json::Value;
 
 const COLUMNS: [&str; 6] = [

@@ -10,7 +10,7 @@ use accelcal::allan::deviation::{mean, octave_factors, overlapping_avars, phase}
 use accelcal::allan::noise_id::{block_means, identify};
 use accelcal::allan::simulate::StaticLog;
 use accelcal::allan::stream::{AllanStream, EXACT_MAX_M};
-use accelcal::logs::write::{header, push_row};
+use accelcal::input::csv::text::{header, push_row};
 use serde_json::Value;
 
 const TAU0_S: f64 = 0.01;

@@ -8,7 +8,7 @@ use std::process::Command;
 use accelcal::allan::edf::greenhall_edf;
 use accelcal::allan::simulate::StaticLog;
 use accelcal::allan::{analyse, deviation};
-use accelcal::logs::write::{header, push_row};
+use accelcal::input::csv::text::{header, push_row};
 
 fn relative(a: f64, b: f64) -> f64 {
     (a / b - 1.0).abs()

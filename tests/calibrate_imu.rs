@@ -10,9 +10,9 @@ use accelcal::calibrate::imu::run::{Calibrated, calibrate};
 use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary};
 use accelcal::config::ins::{Axes, InsConfig};
+use accelcal::input::csv::read::LogText;
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Study;
-use accelcal::logs::read::LogText;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 
@@ -270,9 +270,9 @@ fn missing_fixes_leave_the_biases_within_their_sigmas() {
 /// offset's holds 0 (one recording: a check of the machinery, not of the coverage).
 #[test]
 fn noise_estimate_finds_the_receivers_sigma_and_no_offset() {
-    use accelcal::calibrate::imu::gnss::read_gnss;
     use accelcal::calibrate::imu::noise::{ImuKey, estimate};
-    use accelcal::calibrate::imu::read::read_steps;
+    use accelcal::input::gnss_csv::read_gnss;
+    use accelcal::input::imu_csv::read_steps;
     // The drive's first 240 s (three turns, two climbs, four speed changes) keep it quick.
     let mut config = InsConfig::default();
     config.drive.duration_s = 240.0;

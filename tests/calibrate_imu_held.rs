@@ -5,10 +5,10 @@
 
 use std::path::PathBuf;
 
-use accelcal::calibrate::imu::gnss::{GNSS_COLUMNS, GNSS_OPTIONAL, held_gnss, read_gnss};
-use accelcal::calibrate::imu::read::{ImuLayout, held_steps, read_steps};
 use accelcal::config::ins::Axes;
-use accelcal::logs::read::LogFile;
+use accelcal::input::csv::read::LogFile;
+use accelcal::input::gnss_csv::{GNSS_COLUMNS, GNSS_OPTIONAL, held_gnss, read_gnss};
+use accelcal::input::imu_csv::{ImuLayout, held_steps, read_steps};
 
 fn example(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -15,9 +15,9 @@ use accelcal::calibrate::imu::Settings;
 use accelcal::calibrate::imu::run::calibrate;
 use accelcal::calibrate::imu::summary::{Summary, summary};
 use accelcal::config::ins::InsConfig;
+use accelcal::input::csv::read::LogText;
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Study;
-use accelcal::logs::read::LogText;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 

@@ -3,16 +3,17 @@
 //! near them (within a tenth of the χ²₁ threshold an interval's end rests on), on the shipped
 //! comma2k19 minute and on a simulated drive.
 
-use accelcal::calibrate::imu::gnss::{GnssRow, read_gnss};
 use accelcal::calibrate::imu::linear::Linearized;
 use accelcal::calibrate::imu::noise::log_likelihood;
-use accelcal::calibrate::imu::read::{ImuSpan, ImuStep, read_steps};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ins::InsConfig;
+use accelcal::input::csv::read::LogText;
+use accelcal::input::gnss_csv::read_gnss;
+use accelcal::input::imu_csv::{ImuSpan, read_steps};
+use accelcal::input::records::{GnssRow, ImuStep};
 use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Study;
-use accelcal::logs::read::LogText;
 
 /// The shipped minute, held.
 fn comma() -> (Vec<GnssRow>, Vec<ImuStep>) {

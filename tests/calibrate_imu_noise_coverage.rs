@@ -5,13 +5,13 @@
 
 mod common;
 
-use accelcal::calibrate::imu::gnss::read_gnss;
 use accelcal::calibrate::imu::noise::{ImuKey, estimate};
-use accelcal::calibrate::imu::read::read_steps;
 use accelcal::config::ins::InsConfig;
+use accelcal::input::csv::read::LogText;
+use accelcal::input::gnss_csv::read_gnss;
+use accelcal::input::imu_csv::read_steps;
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Study;
-use accelcal::logs::read::LogText;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 

@@ -8,12 +8,13 @@ mod common;
 
 use accelcal::calibrate::imu::Settings;
 use accelcal::calibrate::imu::run::calibrate_of;
-use accelcal::calibrate::imu::summary::{Summary, Triad, summary};
+use accelcal::calibrate::imu::summary::{Summary, summary};
+use accelcal::calibrate::imu::triad::Triad;
 use accelcal::config::ins::InsConfig;
+use accelcal::input::csv::read::LogText;
 use accelcal::ins::error_state::STATES_WITH_SCALE;
 use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Study;
-use accelcal::logs::read::LogText;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 

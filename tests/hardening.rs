@@ -6,8 +6,8 @@ mod common;
 
 use std::path::Path;
 
-use accelcal::logs::LogProblem;
-use accelcal::logs::read::{AccelReader, LogText};
+use accelcal::input::LogProblem;
+use accelcal::input::csv::read::{AccelReader, LogText};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -310,7 +310,7 @@ fn a_header_of_a_million_columns_is_checked_at_once_and_quoted_in_short() {
         panic!("a missing column")
     };
     assert!(
-        found.chars().count() < accelcal::logs::MAX_ECHO_CHARS + 40,
+        found.chars().count() < accelcal::input::MAX_ECHO_CHARS + 40,
         "{found}"
     );
     assert!(found.starts_with("c0,c1,c2,") && found.contains("7888891 characters"));

@@ -1,7 +1,7 @@
 //! `accelcal.calibrate`: the calibration of `accelcal calibrate` from arrays. The accelerometer's
-//! arrays are read in place (`logs::arrays::AccelArrays`: calibrate's pass takes the slices, no
+//! arrays are read in place (`input::csv::arrays::AccelArrays`: calibrate's pass takes the slices, no
 //! text in between); the GPS fixes, a few thousand rows, are written once as the GPS log's CSV in
-//! memory with every number in its shortest round-trip form (`logs::write::push_row`), which
+//! memory with every number in its shortest round-trip form (`input::csv::text::push_row`), which
 //! reads back as the same doubles. Every number equals the command line's on the same data.
 
 use numpy::PyReadonlyArray1;
@@ -11,11 +11,11 @@ use accelcal::calibrate::summary::Calibration;
 use accelcal::calibrate::{self, Settings};
 use accelcal::config::Config;
 use accelcal::error::ConfigError;
+use accelcal::input::csv::GPS_COLUMNS;
+use accelcal::input::csv::arrays::AccelArrays;
+use accelcal::input::csv::read::LogText;
+use accelcal::input::csv::text::{header, push_row};
 use accelcal::likelihood::{Key, Request};
-use accelcal::logs::GPS_COLUMNS;
-use accelcal::logs::arrays::AccelArrays;
-use accelcal::logs::read::LogText;
-use accelcal::logs::write::{header, push_row};
 
 use crate::config::{self, Source};
 

@@ -1,7 +1,7 @@
 //! `accelcal.calibrate(imu=…, gnss=…)`: the three-axis calibration of
 //! `accelcal calibrate --imu --gnss` from columns. The IMU's columns become the reader's steps
-//! (`calibrate::imu::read::held_steps`) and the GNSS columns its rows
-//! (`calibrate::imu::gnss::held_gnss`) with no text in between; the filter runs on them as the
+//! (`input::imu_csv::held_steps`) and the GNSS columns its rows
+//! (`input::gnss_csv::held_gnss`) with no text in between; the filter runs on them as the
 //! command's `--estimate-noise` path runs on the logs it holds (`run::calibrate_held`). Every
 //! number equals the command line's on the same data.
 
@@ -9,14 +9,15 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 
 use accelcal::calibrate::imu::config::settings_of;
-use accelcal::calibrate::imu::gnss::{GnssRow, held_gnss};
 use accelcal::calibrate::imu::noise::{self, ImuKey};
-use accelcal::calibrate::imu::read::{ImuLayout, ImuSpan, ImuStep, held_steps};
 use accelcal::calibrate::imu::run::{Calibrated, calibrate_held};
 use accelcal::calibrate::imu::smoother::{Smoothed, smooth};
 use accelcal::calibrate::imu::summary::{Summary, summary, write_estimates};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::error::ConfigError;
+use accelcal::input::gnss_csv::held_gnss;
+use accelcal::input::imu_csv::{ImuLayout, ImuSpan, held_steps};
+use accelcal::input::records::{GnssRow, ImuStep};
 use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
 
 use crate::config::Source;

@@ -34,7 +34,6 @@ pub mod gauss_markov;
 pub mod gauss_markov_fit;
 pub mod goodness;
 pub mod imu;
-pub mod log;
 pub mod nnls;
 pub mod noise_id;
 pub mod noise_stream;

@@ -6,7 +6,7 @@
 
 use crate::error::FilterError;
 use crate::filter::{ErrorStateModel, propagate_over};
-use crate::logs::GpsFix;
+use crate::input::csv::GpsFix;
 use crate::simulation::measurement;
 use crate::state::step::Euler;
 use crate::state::{ErrorState, MeasMatrix, MeasVector, StateMatrix, StateModel, StateVector};

@@ -4,7 +4,8 @@
 
 use crate::error::FilterError;
 use crate::filter::ErrorStateModel;
-use crate::logs::{GpsFix, LogError, LogProblem};
+use crate::input::csv::GpsFix;
+use crate::input::{LogError, LogProblem};
 use crate::model::NoiseStats;
 use crate::simulation::measurement;
 use crate::state::{ErrorState, StateMatrix, StateModel, StateVector};

@@ -11,10 +11,11 @@ use std::sync::mpsc;
 
 use rayon::prelude::*;
 
-use crate::logs::block::{BLOCK_BYTES, Block, Layout, MAX_LINE_BYTES, Rows, parse_block};
-use crate::logs::read::{LogSource, open_blocks};
-use crate::logs::steps::{StepAt, StepMedian};
-use crate::logs::{ACCEL_COLUMNS, GpsFix, LogError, LogProblem};
+use crate::input::csv::block::{BLOCK_BYTES, Block, Layout, MAX_LINE_BYTES, Rows, parse_block};
+use crate::input::csv::read::{LogSource, open_blocks};
+use crate::input::csv::steps::{StepAt, StepMedian};
+use crate::input::csv::{ACCEL_COLUMNS, GpsFix};
+use crate::input::{LogError, LogProblem};
 use crate::state::BiasModel;
 
 pub use super::integration::{Integrated, Start, update_time_s};

@@ -3,8 +3,8 @@
 
 use std::io::Write;
 
-use crate::logs::read::AccelReader;
-use crate::logs::{LogError, LogProblem};
+use crate::input::csv::read::AccelReader;
+use crate::input::{LogError, LogProblem};
 use crate::state::ErrorState;
 
 use super::forward::{FilteredFix, Forward};

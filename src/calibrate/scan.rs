@@ -2,8 +2,9 @@
 //! steps accepted around it, whether the nominal recursion applies, and which step each GPS
 //! fix falls in.
 
-use crate::logs::steps::ACCEPTED_STEP_RATIO;
-use crate::logs::{AccelSample, GpsFix, LogError, LogProblem};
+use crate::input::csv::steps::ACCEPTED_STEP_RATIO;
+use crate::input::csv::{AccelSample, GpsFix};
+use crate::input::{LogError, LogProblem};
 
 use super::StepMode;
 use super::integration::update_time_s;

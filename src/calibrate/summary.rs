@@ -3,7 +3,7 @@
 
 use serde::Serialize;
 
-use crate::logs::write::push_row;
+use crate::input::csv::text::push_row;
 use crate::state::{BiasModel, ErrorState, StateMatrix, StateVector};
 
 use super::StepMode;

@@ -6,13 +6,16 @@ use std::io::{IsTerminal, Write as _};
 use anyhow::{Context, Result};
 
 use crate::cli::AllanArgs;
-use accelcal::allan::imu::piped::PipedLog;
-use accelcal::allan::imu::read::CsvRecords;
-use accelcal::allan::imu::stream::{ImuRecords, StreamError};
-use accelcal::allan::imu::{self, Channel, ImuAnalysis, Sensor};
-use accelcal::allan::{self, Term, export, log::read_static_log};
+use accelcal::allan::imu::stream::StreamError;
+use accelcal::allan::imu::{self, ImuAnalysis};
+use accelcal::allan::{self, Term, export};
 use accelcal::format::{count, interval_digits, sig};
-use accelcal::logs::read::LogFile;
+use accelcal::input::csv::piped::PipedLog;
+use accelcal::input::csv::read::LogFile;
+use accelcal::input::csv::static_log::read_static_log;
+use accelcal::input::imu_channels_csv::CsvRecords;
+use accelcal::input::recording;
+use accelcal::input::records::{Channel, ImuRecords, Sensor};
 use accelcal::output::StagedFiles;
 use accelcal::report::allan as page;
 use accelcal::report::allan_imu as imu_page;
@@ -175,8 +178,8 @@ fn analyse_imu_log(args: &AllanArgs, path: &std::path::Path) -> Result<ImuAnalys
     let regular_file = std::fs::metadata(path).is_ok_and(|m| m.is_file());
     let spill_dir = spill_directory(&args.out);
     let piped: PipedLog;
-    let records: Box<dyn ImuRecords + '_> = if imu::bag::is_recording(path) {
-        imu::bag::open_recording(path, args.topic.as_deref())?
+    let records: Box<dyn ImuRecords + '_> = if recording::is_recording(path) {
+        recording::open_recording(path, args.topic.as_deref())?
     } else if args.topic.is_some() {
         return Err(super::logs::UsageError(format!(
             "--topic names a topic of an MCAP file or a ROS 2 bag; {} is read as CSV",

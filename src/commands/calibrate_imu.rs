@@ -8,17 +8,17 @@ use anyhow::{Context, Result};
 use crate::cli::CalibrateArgs;
 use crate::cli::calibrate::EstimateKey;
 use accelcal::calibrate::imu::config::settings_of;
-use accelcal::calibrate::imu::gnss::read_gnss;
 use accelcal::calibrate::imu::noise::{self, ImuKey};
-use accelcal::calibrate::imu::read::read_steps;
 use accelcal::calibrate::imu::run::{Calibrated, ImuCalibrateError, calibrate_held, calibrate_of};
 use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary, write_estimates};
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ConfigText;
 use accelcal::error::ConfigError;
+use accelcal::input::csv::read::{LogFile, LogSource};
+use accelcal::input::gnss_csv::read_gnss;
+use accelcal::input::imu_csv::read_steps;
 use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
-use accelcal::logs::read::{LogFile, LogSource};
 use accelcal::output::{StagedFiles, check_directory};
 
 /// The files the three-axis calibration writes.
@@ -195,7 +195,7 @@ fn print_result(s: &Summary) -> Result<()> {
     for w in &s.warnings {
         eprintln!("warning: {w}");
     }
-    let triad = |name: &str, t: &accelcal::calibrate::imu::summary::Triad, unit: &str| {
+    let triad = |name: &str, t: &accelcal::calibrate::imu::triad::Triad, unit: &str| {
         let parts: Vec<String> = (0..3)
             .map(|i| {
                 let id = if t.identifiable[i] {

@@ -24,7 +24,7 @@ use accelcal::config::{Config, ConfigText, DEFAULT_TOML};
 use accelcal::ensemble::{EnsembleRun, partial};
 use accelcal::error::{ConfigError, FilterError};
 use accelcal::format::{count, sig};
-use accelcal::logs::LogError;
+use accelcal::input::LogError;
 use accelcal::model::{Model, Work};
 use accelcal::output::write_atomic;
 use accelcal::study::Progress;

@@ -14,15 +14,7 @@ use super::error_state::STATES;
 use super::filter::{Ekf, FilterError, Innovation};
 use super::measurement::{Gate, Measurement};
 use super::mech::Increment;
-
-/// One IMU step: the increments over (`t_s − increment.dt_s`, `t_s`], body axes.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Step {
-    /// The step's end, s.
-    pub t_s: f64,
-    /// Δθ (rad), Δv (m/s) and Δt (s) over the step.
-    pub increment: Increment,
-}
+pub use crate::input::records::ImuStep;
 
 /// Where the IMU's steps come from, in time order.
 pub trait ImuSource {
@@ -32,7 +24,7 @@ pub trait ImuSource {
     ///
     /// # Errors
     /// The source's problem at that step.
-    fn next_step(&mut self) -> Result<Option<Step>, Self::Error>;
+    fn next_step(&mut self) -> Result<Option<ImuStep>, Self::Error>;
 }
 
 /// A source of timed measurements, in time order, made with the IMU source `C` at hand (a

@@ -8,6 +8,9 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
+// The position the GNSS readers hand on: defined with them, below this layer.
+pub use crate::input::records::Geodetic;
+
 /// Semi-major axis a, m (TR8350.2 table 3.1).
 pub const SEMI_MAJOR_AXIS_M: f64 = 6_378_137.0;
 /// Flattening f = 1/298.257223563 (TR8350.2 table 3.1).
@@ -26,17 +29,6 @@ pub const GRAVITY_EQUATOR_M_S2: f64 = 9.780_325_335_9;
 pub const SOMIGLIANA_K: f64 = 0.001_931_852_652_41;
 /// m = ω²a²b/GM (TR8350.2 table 3.4).
 pub const GRAVITY_RATIO_M: f64 = 0.003_449_786_506_84;
-
-/// A position on the ellipsoid: geodetic latitude and longitude, ellipsoidal height.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Geodetic {
-    /// Geodetic latitude L, rad, in [−π/2, π/2].
-    pub lat_rad: f64,
-    /// Longitude λ, rad, east positive.
-    pub lon_rad: f64,
-    /// Height above the ellipsoid h, m.
-    pub height_m: f64,
-}
 
 /// The meridian radius of curvature R_N and the transverse (prime-vertical) radius R_E at
 /// latitude `lat_rad`, m.

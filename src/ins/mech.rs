@@ -12,6 +12,9 @@ use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use super::earth::{self, Geodetic, Local, nav_to_earth};
 
+// The increments the IMU readers hand on: defined with them, below this layer.
+pub use crate::input::records::Increment;
+
 /// The navigation state: position, velocity and attitude.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pva {
@@ -22,18 +25,6 @@ pub struct Pva {
     /// Attitude q_b^n: a vector's body components (forward-right-down) to its NED components
     /// (Hamilton product, scalar first).
     pub attitude: UnitQuaternion<f64>,
-}
-
-/// What the IMU measured over one step ending at t_k: the integrals of its angular rate and of
-/// its specific force in body axes.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Increment {
-    /// Δθ = ∫ω_ib^b dt, rad.
-    pub dtheta_rad: Vector3<f64>,
-    /// Δv = ∫f^b dt, m/s.
-    pub dvel_m_s: Vector3<f64>,
-    /// t_k − t_{k−1}, s.
-    pub dt_s: f64,
 }
 
 /// The skew-symmetric matrix \[a×\] with \[a×\]b = a × b.

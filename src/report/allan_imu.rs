@@ -10,9 +10,10 @@ use super::allan::{series, term_row, verdict_sentence};
 use super::figures::figure;
 use super::view::FigureView;
 use super::{RenderError, stylesheet};
-use crate::allan::imu::{Channel, ImuAnalysis, Largest, Sensor};
+use crate::allan::imu::{ImuAnalysis, Largest};
 use crate::allan::{GaussMarkov, Term, TermEstimate};
 use crate::format::{count, interval, sig};
+use crate::input::records::{Channel, Sensor};
 use crate::plot;
 
 /// The page.

@@ -12,7 +12,8 @@ use super::{RenderError, stylesheet};
 use crate::calibrate::imu::noise::ImuKey;
 use crate::calibrate::imu::run::Calibrated;
 use crate::calibrate::imu::smoother::Smoothed;
-use crate::calibrate::imu::summary::{CONFIDENCE, Summary, Triad};
+use crate::calibrate::imu::summary::Summary;
+use crate::calibrate::imu::triad::{CONFIDENCE, Triad};
 use crate::calibrate::robust::conditional_page_words;
 use crate::format::{count, fixed, interval, percent, short, sig};
 

@@ -6,7 +6,8 @@
 
 use super::calibration_imu_words::{listed, nis_words, whiteness_findings};
 use super::rich::rich;
-use crate::calibrate::imu::summary::{CONFIDENCE, Summary, Triad};
+use crate::calibrate::imu::summary::Summary;
+use crate::calibrate::imu::triad::{CONFIDENCE, Triad};
 use crate::calibrate::robust::conditional_page_words;
 use crate::format::{fixed, percent, sig};
 use crate::stats::normal_bound;

@@ -11,13 +11,13 @@ use super::kind::{Built, Context, SectionKind, SectionView};
 use super::outline::{Figure, Label, Table};
 
 use super::{RenderError, ReportInput};
-use crate::allan::log::read_static_log;
 use crate::allan::section::{Coverage, REPORT_LOG, REPORT_SAMPLES, coverage, covers};
 use crate::allan::simulate::StaticLog;
 use crate::allan::{AllanError, Analysis, Term, analyse};
 use crate::format::{count, sig};
-use crate::logs::read::LogText;
-use crate::logs::write::{header, push_row};
+use crate::input::csv::read::LogText;
+use crate::input::csv::static_log::read_static_log;
+use crate::input::csv::text::{header, push_row};
 use crate::plot::{self, PlotError};
 
 /// The Allan figure of `a` (SVG), as `accelcal allan` draws it.

@@ -7,8 +7,8 @@
 use crate::calibrate::summary::Calibration;
 use crate::calibrate::{self, CalibrateError, Settings};
 use crate::config::Config;
+use crate::input::csv::read::LogText;
 use crate::likelihood::{Key, NoiseEstimate, Request};
-use crate::logs::read::LogText;
 
 /// The shipped accelerometer log as recorded (gravity's component along the axis included).
 pub const ACCEL_RAW: &[u8] = include_bytes!("../../examples/comma2k19/accel_raw.csv");

@@ -8,18 +8,19 @@
 
 use thiserror::Error;
 
-use crate::calibrate::imu::gnss::read_gnss;
 use crate::calibrate::imu::noise::{self, ImuKey};
-use crate::calibrate::imu::read::read_steps;
 use crate::calibrate::imu::run::{Calibrated, ImuCalibrateError, calibrate_held, euler_sigmas};
 use crate::calibrate::imu::smoother::{Smoothed, smooth};
-use crate::calibrate::imu::summary::{CONFIDENCE, Summary, summary};
+use crate::calibrate::imu::summary::{Summary, summary};
+use crate::calibrate::imu::triad::CONFIDENCE;
 use crate::calibrate::imu::{CONSUMER, Settings};
+use crate::input::LogError;
+use crate::input::csv::read::LogText;
+use crate::input::gnss_csv::read_gnss;
+use crate::input::imu_csv::read_steps;
 use crate::ins::error_state::Matrix15;
 use crate::ins::euler_of;
 use crate::ins::mech::Pva;
-use crate::logs::LogError;
-use crate::logs::read::LogText;
 
 /// The shipped IMU log (`t_s` and the six rates, forward-right-down).
 pub const IMU: &[u8] = include_bytes!("../../examples/comma2k19_3d/imu.csv");
@@ -226,7 +227,7 @@ pub fn compare(c: &Calibrated, smoothed: &[Smoothed], reference: &[Pose]) -> Att
 
 /// The calibration of the held logs with `s`, its summary, smoothed solution and comparison.
 fn run_with(
-    held: (&[crate::calibrate::imu::gnss::GnssRow], &Held),
+    held: (&[crate::input::records::GnssRow], &Held),
     s: &Settings,
     reference: &[Pose],
     estimate: Option<noise::NoiseEstimate>,
@@ -247,9 +248,9 @@ fn run_with(
 }
 
 type Held = (
-    Vec<crate::calibrate::imu::read::ImuStep>,
-    crate::calibrate::imu::read::ImuSpan,
-    crate::calibrate::imu::read::ImuLayout,
+    Vec<crate::input::records::ImuStep>,
+    crate::input::imu_csv::ImuSpan,
+    crate::input::imu_csv::ImuLayout,
 );
 
 /// The minute calibrated with no configuration and with [`REPORT_KEYS`] estimated.

@@ -7,7 +7,7 @@ use accelcal::calibrate::diagnose::{Diagnostics, whiteness};
 use accelcal::calibrate::summary::Calibration;
 use accelcal::calibrate::{Settings, prepare};
 use accelcal::config::{Config, TruthModel};
-use accelcal::logs::read::LogText;
+use accelcal::input::csv::read::LogText;
 use accelcal::logs::write::LogWriter;
 use accelcal::random::Stream;
 use accelcal::simulation::run_realization;

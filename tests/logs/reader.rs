@@ -4,9 +4,9 @@
 //! white space, both give the same rows (values bit for bit, lines) and the same first problem,
 //! whatever the block size.
 
-use accelcal::logs::LogProblem;
-use accelcal::logs::block::{Rows, parse_block};
-use accelcal::logs::read::{CsvReader, LogText, open_blocks};
+use accelcal::input::LogProblem;
+use accelcal::input::csv::block::{Rows, parse_block};
+use accelcal::input::csv::read::{CsvReader, LogText, open_blocks};
 use proptest::prelude::*;
 
 /// A row or its problem: (line, values' bits) or (line, problem).

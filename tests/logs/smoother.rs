@@ -3,7 +3,7 @@
 
 use accelcal::calibrate::{Settings, prepare};
 use accelcal::config::{Config, TruthModel};
-use accelcal::logs::read::LogText;
+use accelcal::input::csv::read::LogText;
 use accelcal::logs::write::LogWriter;
 use accelcal::simulation::run_realization;
 use accelcal::stats::chi_squared_band;

@@ -4,13 +4,11 @@
 
 use serde_json::{Map, Value, json};
 
-use super::{
-    Channel, ImuAnalysis, Largest, Sensor, correlation_time_s, fitted_correlation_time,
-    value_or_bound,
-};
+use super::{ImuAnalysis, Largest, correlation_time_s, fitted_correlation_time, value_or_bound};
 use crate::allan::export::{AllanRecord, GAUSS_MARKOV_PEAK_RATIO, num, ten_digits};
 use crate::allan::{Analysis, Reading, Term};
 use crate::format::sig;
+use crate::input::records::{Channel, Sensor};
 
 /// Degrees per radian.
 const DEG_PER_RAD: f64 = 180.0 / std::f64::consts::PI;

@@ -8,34 +8,20 @@
 //! random walk (rad/s/√s) (IEEE Std 952-1997, annex C; the accelerometer's names are those of
 //! IEEE Std 1293-2018).
 //!
-//! [`read`] reads a CSV log, [`bag`] an MCAP file or a ROS 2 bag; [`export`] writes the files.
+//! The log is read by [`crate::input`] (a CSV log by [`crate::input::imu_channels_csv`], an MCAP
+//! file or a ROS bag by [`crate::input::recording`]), into the channels' samples or as records
+//! read again from disk; [`stream`] analyses the records; [`export`] writes the files.
 
-pub mod bag;
 pub mod export;
-pub mod mcap_stream;
-pub mod piped;
-pub mod read;
-pub mod rosbag1;
-pub mod rosbag1_stream;
 pub mod stream;
 
 use thiserror::Error;
 
 use super::{AllanError, Analysis, Reading, Term, TermEstimate, analyse};
+use crate::input::records::{Channel, ImuSamples, Sensor};
 
-/// The two sensors of an IMU.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Sensor {
-    /// The accelerometers, m/s².
-    Accelerometer,
-    /// The gyros, rad/s.
-    Gyroscope,
-}
-
+/// The words of the sensors' terms in the files and on the page.
 impl Sensor {
-    /// Both, in the log's order.
-    pub const ALL: [Sensor; 2] = [Sensor::Accelerometer, Sensor::Gyroscope];
-
     /// The sensor's word in `allan.json` and `imu.yaml`.
     pub fn key(self) -> &'static str {
         match self {
@@ -102,73 +88,6 @@ impl Sensor {
             Sensor::Gyroscope => "rad/s",
         }
     }
-}
-
-/// The six channels of a three-axis IMU log: a closed set, each with its column.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Channel {
-    /// Specific force along x, m/s².
-    Ax,
-    /// Specific force along y, m/s².
-    Ay,
-    /// Specific force along z, m/s².
-    Az,
-    /// Angular rate about x, rad/s.
-    Gx,
-    /// Angular rate about y, rad/s.
-    Gy,
-    /// Angular rate about z, rad/s.
-    Gz,
-}
-
-impl Channel {
-    /// Every channel, in the order of the three-axis log's columns.
-    pub const ALL: [Channel; 6] = [
-        Channel::Ax,
-        Channel::Ay,
-        Channel::Az,
-        Channel::Gx,
-        Channel::Gy,
-        Channel::Gz,
-    ];
-
-    /// The column of the three-axis log (`ins::logs`' imu.csv).
-    pub fn column(self) -> &'static str {
-        match self {
-            Channel::Ax => "ax_m_s2",
-            Channel::Ay => "ay_m_s2",
-            Channel::Az => "az_m_s2",
-            Channel::Gx => "gx_rad_s",
-            Channel::Gy => "gy_rad_s",
-            Channel::Gz => "gz_rad_s",
-        }
-    }
-
-    /// The sensor the channel belongs to.
-    pub fn sensor(self) -> Sensor {
-        match self {
-            Channel::Ax | Channel::Ay | Channel::Az => Sensor::Accelerometer,
-            Channel::Gx | Channel::Gy | Channel::Gz => Sensor::Gyroscope,
-        }
-    }
-
-    /// The axis, x, y or z.
-    pub fn axis(self) -> &'static str {
-        match self {
-            Channel::Ax | Channel::Gx => "x",
-            Channel::Ay | Channel::Gy => "y",
-            Channel::Az | Channel::Gz => "z",
-        }
-    }
-}
-
-/// The samples of every channel a log holds, on one time base.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ImuSamples {
-    /// Each channel present and its samples, in [`Channel::ALL`]'s order.
-    pub channels: Vec<(Channel, Vec<f64>)>,
-    /// The median step τ₀, s.
-    pub sample_period_s: f64,
 }
 
 /// A channel the analysis cannot use.

@@ -8,43 +8,15 @@
 
 use rayon::prelude::*;
 
-use super::{Channel, ChannelAnalysis, ImuAnalysis, ImuError};
+use super::{ChannelAnalysis, ImuAnalysis, ImuError};
 use crate::allan::analyse_grid;
 use crate::allan::stream::{AllanStream, StreamingMean};
-use crate::logs::steps::{ACCEPTED_STEP_RATIO, StepMedian};
-use crate::logs::{LogError, LogProblem};
+use crate::input::csv::steps::{ACCEPTED_STEP_RATIO, StepMedian};
+use crate::input::records::{ImuRecords, Record};
+use crate::input::{LogError, LogProblem};
 
 /// Samples of each channel handed to the streams at once.
 const BATCH: usize = 1 << 16;
-
-/// One sample of every channel present, and where it is (for messages).
-#[derive(Clone, Copy, Debug)]
-pub struct Record {
-    /// Time stamp, s.
-    pub t_s: f64,
-    /// The channels' values, in the order of [`ImuRecords::channels`].
-    pub values: [f64; 6],
-    /// Its line in a CSV file, or its message's index in a recording.
-    pub at: u64,
-}
-
-/// A log that can be read from its start more than once, record by record.
-pub trait ImuRecords {
-    /// The channels present, in [`Channel::ALL`]'s order.
-    fn channels(&self) -> &[Channel];
-
-    /// Hands every record to `visit` in order, stopping at its first error.
-    ///
-    /// # Errors
-    /// [`LogError`] of the reading (a malformed row or message) or of `visit`.
-    fn read(&self, visit: &mut dyn FnMut(&Record) -> Result<(), LogError>) -> Result<(), LogError>;
-
-    /// The error of `problem` at the record `at` (its line or its message).
-    fn error_at(&self, at: u64, problem: LogProblem) -> LogError;
-
-    /// The error of `problem` for the whole log.
-    fn error(&self, problem: LogProblem) -> LogError;
-}
 
 /// Why a streamed analysis stopped.
 #[derive(Debug)]

@@ -13,7 +13,7 @@
 
 use nalgebra::{SMatrix, Vector3};
 
-use super::gnss::GnssRow;
+use crate::input::records::GnssRow;
 use crate::ins::earth::{self, Geodetic};
 use crate::ins::error_state::{ACCEL_BIAS, ATTITUDE, Matrix15, VELOCITY};
 

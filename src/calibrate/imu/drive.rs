@@ -5,16 +5,16 @@
 use nalgebra::SVector;
 
 use super::Settings;
-use super::gnss::GnssRow;
-use super::read::{ImuStep, StepSource};
 use super::step::{FixRecord, LinearRecord, fix_of};
-use crate::ins::driver::{Due, ImuSource, Observer, Source, Step, Update};
+use crate::input::LogError;
+use crate::input::imu_csv::StepSource;
+use crate::input::records::{GnssRow, ImuStep};
+use crate::ins::driver::{Due, ImuSource, Observer, Source, Update};
 use crate::ins::error_state::Square;
 use crate::ins::filter::Ekf;
 use crate::ins::gnss::FixUpdate;
 use crate::ins::measurement::Measurement;
 use crate::ins::names::MEASUREMENTS;
-use crate::logs::LogError;
 
 /// The IMU log's steps from the one that holds the filter's start on.
 pub(super) struct LogSteps<'a> {
@@ -27,15 +27,11 @@ pub(super) struct LogSteps<'a> {
 impl ImuSource for LogSteps<'_> {
     type Error = LogError;
 
-    fn next_step(&mut self) -> Result<Option<Step>, LogError> {
-        let step = match self.first.take() {
-            Some(s) => Some(s),
-            None => self.source.next_step()?,
-        };
-        Ok(step.map(|s| Step {
-            t_s: s.t_s,
-            increment: s.increment,
-        }))
+    fn next_step(&mut self) -> Result<Option<ImuStep>, LogError> {
+        match self.first.take() {
+            Some(s) => Ok(Some(s)),
+            None => self.source.next_step(),
+        }
     }
 }
 

@@ -22,10 +22,10 @@ use nalgebra::{SMatrix, SVector, Vector3};
 
 use super::Settings;
 use super::align;
-use super::gnss::GnssRow;
-use super::read::{HeldSteps, ImuStep};
 use super::run::{ImuCalibrateError, alignment_sources, filter_tracked, shifted};
 use super::step::{fix_of, initial_covariance, noise};
+use crate::input::imu_csv::HeldSteps;
+use crate::input::records::{GnssRow, ImuStep};
 use crate::ins::discrete::transition_congruence;
 use crate::ins::error_state::{ATTITUDE, STATES, Square};
 use crate::ins::filter::{LinearView, NOISE_GROUPS};

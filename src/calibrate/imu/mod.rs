@@ -1,7 +1,8 @@
 //! `calibrate --imu FILE --gnss FILE`: a whole IMU calibrated from a raw recording — six
 //! channels and geodetic GNSS fixes — through the three-axis error-state filter (`crate::ins`).
 //!
-//! 1. `read`: the GNSS log held (one row per fix), the IMU log streamed once as increments.
+//! 1. The logs read by `crate::input`: the GNSS log held (one row per fix, `input::gnss_csv`),
+//!    the IMU log streamed once as increments (`input::imu_csv`).
 //! 2. `align`: with no attitude given, the filter starts at the first fix fast enough for the
 //!    course to give the heading; roll and pitch come from the mean specific force over the
 //!    window before it, and the prior covariance carries the alignment's errors.
@@ -9,21 +10,20 @@
 //!    step cut there), one record per fix.
 //! 4. `smoother`: the Rauch–Tung–Striebel pass backwards over the fixes.
 //! 5. `summary`: the six biases and the attitude at the end with σ's, intervals and whether the
-//!    drive determined them; the NIS test and the innovations' whiteness per component; every
+//!    drive determined them (each sensor's three a `triad`); the NIS test and the innovations' whiteness per component; every
 //!    assumption made.
 
 pub mod align;
 pub mod config;
 mod drive;
-pub mod gnss;
 pub mod linear;
 pub mod noise;
-pub mod read;
 pub mod run;
 pub mod scale;
 pub mod smoother;
 mod step;
 pub mod summary;
+pub mod triad;
 
 use nalgebra::Vector3;
 use serde::Serialize;

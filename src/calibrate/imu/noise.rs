@@ -17,10 +17,10 @@ use serde::Serialize;
 
 use super::Settings;
 use super::config::MAX_TIME_OFFSET_S;
-use super::gnss::GnssRow;
 use super::linear::Linearized;
-use super::read::{HeldSteps, ImuSpan, ImuStep};
 use super::run::{filter, shifted};
+use crate::input::imu_csv::{HeldSteps, ImuSpan};
+use crate::input::records::{GnssRow, ImuStep};
 use crate::ins::error_state::{STATES, STATES_WITH_SCALE};
 use crate::likelihood::{Fit, climb, maximize};
 use crate::progress::{Cancel, Cancelled};

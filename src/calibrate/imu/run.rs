@@ -8,15 +8,16 @@ use thiserror::Error;
 use super::Settings;
 use super::align::{self, AlignSettings, Alignment, Plan, Sources};
 use super::drive::{LogFixes, LogSteps, Recorder};
-use super::gnss::{GnssRow, read_gnss};
-use super::read::{HeldSteps, ImuLayout, ImuReader, ImuSpan, ImuStep, StepSource};
 pub use super::step::{FixRecord, bias_sigmas, euler_sigmas};
 use super::step::{part, start, velocity_sigmas};
-use crate::ins::driver::{DriveError, Driver, ImuSource, Source, Step};
+use crate::input::csv::read::LogSource;
+use crate::input::gnss_csv::read_gnss;
+use crate::input::imu_csv::{HeldSteps, ImuLayout, ImuReader, ImuSpan, StepSource};
+use crate::input::records::{GnssRow, ImuStep};
+use crate::input::{LogError, LogProblem};
+use crate::ins::driver::{DriveError, Driver, ImuSource, Source};
 use crate::ins::error_state::STATES;
 use crate::ins::filter::{Ekf, FilterError, LinearView};
-use crate::logs::read::LogSource;
-use crate::logs::{LogError, LogProblem};
 
 /// Why a recording cannot be calibrated.
 #[derive(Debug, Error)]
@@ -317,7 +318,7 @@ struct NoSteps;
 impl ImuSource for NoSteps {
     type Error = LogError;
 
-    fn next_step(&mut self) -> Result<Option<Step>, LogError> {
+    fn next_step(&mut self) -> Result<Option<ImuStep>, LogError> {
         Ok(None)
     }
 }

@@ -12,7 +12,7 @@
 use super::Settings;
 use super::smoother::Smoothed;
 use super::step::{FixRecord, scale_sigmas};
-use super::summary::{IDENTIFIABLE_SIGMA_RATIO, Triad, triad};
+use super::triad::{IDENTIFIABLE_SIGMA_RATIO, Triad, triad};
 use crate::ins::error_state::has_scale;
 
 /// One million: a scale factor in ppm.

@@ -5,7 +5,7 @@ use nalgebra::{Matrix3, SVector, Vector3};
 
 use super::Settings;
 use super::align::{self, Alignment};
-use super::gnss::GnssRow;
+use crate::input::records::GnssRow;
 use crate::ins::discrete::NoiseDensities;
 use crate::ins::error_state::{
     ACCEL_BIAS, ACCEL_SCALE, ATTITUDE, BiasDecay, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, Square,

@@ -11,32 +11,10 @@ use super::Settings;
 use super::noise::NoiseEstimate;
 use super::run::{Calibrated, FixRecord, bias_sigmas, euler_sigmas};
 use super::smoother::Smoothed;
+use super::triad::{IDENTIFIABLE_SIGMA_RATIO, Triad, triad};
 use crate::calibrate::diagnose::whiteness::{Whiteness, whiteness};
 use crate::calibrate::{NisTest, nis_test_rows};
 use crate::ins::euler_of;
-
-/// The confidence of the intervals.
-pub const CONFIDENCE: f64 = 0.95;
-
-/// A quantity is determined by the drive when its σ at the end is at most this fraction of the
-/// σ it would have from its prior and its process noise alone: the data then carry at least
-/// three times the prior's information about it.
-pub const IDENTIFIABLE_SIGMA_RATIO: f64 = 0.5;
-
-/// Three estimates in body axes (x, y, z) with their σ's and intervals.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Triad {
-    /// The estimates.
-    pub value: [f64; 3],
-    /// Their σ's.
-    pub sigma: [f64; 3],
-    /// The intervals' lower ends (`CONFIDENCE`).
-    pub lower: [f64; 3],
-    /// Their upper ends.
-    pub upper: [f64; 3],
-    /// Whether the drive determined each ([`IDENTIFIABLE_SIGMA_RATIO`]).
-    pub identifiable: [bool; 3],
-}
 
 /// The attitude at the end, degrees.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -104,7 +82,7 @@ pub struct Summary {
     /// The GNSS log, as named.
     pub gnss_file: String,
     /// What the IMU rows hold.
-    pub imu_layout: super::read::ImuLayout,
+    pub imu_layout: crate::input::imu_csv::ImuLayout,
     /// IMU rows.
     pub imu_rows: u64,
     /// The median IMU step's rate, Hz.
@@ -152,17 +130,6 @@ pub const COMPONENTS: [&str; 6] = [
     "velocity_east",
     "velocity_down",
 ];
-
-pub(super) fn triad(value: [f64; 3], sigma: [f64; 3], prior: [f64; 3]) -> Triad {
-    let z = crate::stats::normal_bound(1.0 - CONFIDENCE);
-    Triad {
-        value,
-        sigma,
-        lower: [0, 1, 2].map(|i| value[i] - z * sigma[i]),
-        upper: [0, 1, 2].map(|i| value[i] + z * sigma[i]),
-        identifiable: [0, 1, 2].map(|i| sigma[i] <= IDENTIFIABLE_SIGMA_RATIO * prior[i]),
-    }
-}
 
 /// The σ a bias would have at `t` s after the start from its prior and its process alone.
 fn prior_sigma(sigma0: f64, k: f64, tau: Option<f64>, t: f64) -> f64 {
@@ -402,7 +369,7 @@ pub fn write_estimates<const N: usize>(
         row.extend(sa);
         super::scale::extend_row(&mut row, sm);
         let mut line = String::new();
-        crate::logs::write::push_row(&mut line, &row);
+        crate::input::csv::text::push_row(&mut line, &row);
         out.write_all(line.as_bytes())?;
     }
     Ok(())

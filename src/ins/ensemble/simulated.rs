@@ -3,7 +3,7 @@
 //! step that falls on the GNSS rate, its noise drawn from the same stream after the step's.
 
 use crate::ins::drive::Drive;
-use crate::ins::driver::{ImuSource, Source, Step};
+use crate::ins::driver::{ImuSource, ImuStep, Source};
 use crate::ins::gnss::FixUpdate;
 use crate::ins::logs::fix;
 use crate::ins::measurement::Measurement;
@@ -38,13 +38,15 @@ impl SimulatedImu<'_> {
 impl ImuSource for SimulatedImu<'_> {
     type Error = std::convert::Infallible;
 
-    fn next_step(&mut self) -> Result<Option<Step>, Self::Error> {
+    fn next_step(&mut self) -> Result<Option<ImuStep>, Self::Error> {
         let Some((inc, _)) = self.track.steps.get(self.steps) else {
             return Ok(None);
         };
         let increment = self.imu.read(inc);
         self.steps += 1;
-        Ok(Some(Step {
+        Ok(Some(ImuStep {
+            // The row of imu.csv it would be (the header is line 1).
+            line: self.steps as u64 + 1,
             t_s: self.steps as f64 / self.study.imu_rate_hz,
             increment,
         }))

@@ -1,9 +1,13 @@
-//! A static accelerometer log read into memory, with the step checks of `calibrate`: strictly
-//! increasing time stamps, and every step within [`ACCEPTED_STEP_RATIO`] of the median step.
+//! A static accelerometer log read into memory (`allan --accel`), with the step checks of
+//! `calibrate`: strictly increasing time stamps, and every step within [`ACCEPTED_STEP_RATIO`]
+//! of the median step.
+//!
+//! # Format
+//! The CSV text of [`super`]: `t_s` and the column read (`accel_m_s2`, or any one column named).
 
-use crate::logs::read::{AccelReader, LogSource};
-use crate::logs::steps::ACCEPTED_STEP_RATIO;
-use crate::logs::{LogError, LogProblem};
+use crate::input::csv::read::{AccelReader, LogSource};
+use crate::input::csv::steps::ACCEPTED_STEP_RATIO;
+use crate::input::{LogError, LogProblem};
 
 /// The samples of one axis and the median step τ₀.
 #[derive(Clone, Debug, PartialEq)]
@@ -227,7 +231,7 @@ fn line_of(source: &dyn LogSource, column: &'static str, index: usize) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::logs::read::LogText;
+    use crate::input::csv::read::LogText;
 
     #[test]
     fn a_gap_names_its_line() {
@@ -249,13 +253,13 @@ mod tests {
         let times: Vec<f64> = (0..1001)
             .map(|i| i as f64 * 0.01 + ((i * 7) % 5) as f64 * 1e-4)
             .collect();
-        let mut m = crate::logs::steps::StepMedian::new();
+        let mut m = crate::input::csv::steps::StepMedian::new();
         for w in times.windows(2) {
             m.add(w[1] - w[0]);
         }
         assert_eq!(median_step(&times), m.median());
         assert_eq!(median_step(&times[..1000]), {
-            let mut m = crate::logs::steps::StepMedian::new();
+            let mut m = crate::input::csv::steps::StepMedian::new();
             times[..1000].windows(2).for_each(|w| m.add(w[1] - w[0]));
             m.median()
         });

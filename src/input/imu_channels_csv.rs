@@ -1,12 +1,18 @@
-//! A static three-axis IMU log as CSV: `t_s` and any of the six channel columns, each column
-//! read and checked exactly as the one-column form reads its column ([`read_static_log`]:
-//! every row by the log reader, the steps against the median), from the text read once.
+//! A static three-axis IMU log as CSV (`allan --imu`): `t_s` and any of the six channel
+//! columns, each column read and checked exactly as the one-column form reads its column
+//! ([`read_static_log`]: every row by the log reader, the steps against the median), from the
+//! text read once; or its channels read as [`Record`]s, the file read again as often as an
+//! analysis needs ([`CsvRecords`]).
+//!
+//! # Format
+//! The CSV text of [`super::csv`]; the columns are [`Channel::column`]'s (`ax_m_s2`, …,
+//! `gz_rad_s`: specific force in m/s², angular rate in rad/s), those of the three-axis study's
+//! `imu.csv` (`ins::logs`).
 
-use super::stream::{ImuRecords, Record};
-use super::{Channel, ImuSamples};
-use crate::allan::log::read_static_log;
-use crate::logs::read::{CsvReader, LogSource};
-use crate::logs::{LogError, LogProblem, echo};
+use super::csv::read::{CsvReader, LogSource};
+use super::csv::static_log::read_static_log;
+use super::records::{Channel, ImuRecords, ImuSamples, Record};
+use super::{LogError, LogProblem, echo};
 
 /// The log's text, held once and lent to each column's reading under the file's name.
 struct Held<'a> {
@@ -118,7 +124,7 @@ pub fn read_imu_log(source: &dyn LogSource) -> Result<ImuSamples, LogError> {
 }
 
 /// A CSV log of a file, read as records of its channels each time it is read
-/// ([`super::stream`]).
+/// (`allan::imu::stream`).
 pub struct CsvRecords<'a> {
     source: &'a dyn LogSource,
     channels: Vec<Channel>,
@@ -199,7 +205,7 @@ impl ImuRecords for CsvRecords<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::logs::read::LogText;
+    use crate::input::csv::read::LogText;
 
     #[test]
     fn any_channels_are_read_and_the_earliest_problem_is_told() {

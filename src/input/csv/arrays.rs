@@ -5,9 +5,10 @@
 
 use std::io::{BufRead, Cursor};
 
+use super::ACCEL_COLUMNS;
 use super::read::LogSource;
-use super::write::{header, push_row};
-use super::{ACCEL_COLUMNS, LogError, LogProblem};
+use super::text::{header, push_row};
+use crate::input::{LogError, LogProblem};
 
 /// The accelerometer's samples as arrays: `t_s` (s) and `accel_m_s2` (m/s²), of equal length.
 /// Sample `i` is the log's row `i`, on line `i + 2` of the equivalent CSV (after its header).
@@ -68,7 +69,7 @@ impl LogSource for AccelArrays<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::logs::read::AccelReader;
+    use crate::input::csv::read::AccelReader;
 
     #[test]
     fn the_text_reads_back_as_the_same_doubles() {

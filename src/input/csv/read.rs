@@ -10,7 +10,8 @@ use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
 use super::block::{BLOCK_BYTES, Feed, Layout, MAX_LINE_BYTES, Rows, parse_block};
-use super::{ACCEL_COLUMNS, AccelSample, GPS_COLUMNS, GpsFix, LogError, LogProblem, echo};
+use super::{ACCEL_COLUMNS, AccelSample, GPS_COLUMNS, GpsFix};
+use crate::input::{LogError, LogProblem, echo};
 
 /// A log read from its start: a file can be read again, a pipe only once.
 pub trait LogSource {
@@ -30,7 +31,7 @@ pub trait LogSource {
     }
 
     /// An accelerometer log held as arrays (time stamps in s, samples in m/s², of equal
-    /// length; `logs::arrays::AccelArrays`): calibrate's pass then reads them in place instead
+    /// length; `input::csv::arrays::AccelArrays`): calibrate's pass then reads them in place instead
     /// of parsing text. `None` for a log of text.
     fn accel_columns(&self) -> Option<(&[f64], &[f64])> {
         None

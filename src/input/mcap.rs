@@ -1,16 +1,24 @@
 //! An MCAP file or a ROS 2 bag of MCAP files read record by record from disk (the `mcap`
 //! crate's linear reader fed in pieces: no file is held whole), and the chosen `Imu` topic's
-//! messages as [`Record`]s for [`super::stream`].
+//! messages as [`Record`]s read again from disk as often as an analysis needs.
+//!
+//! # Format
+//! MCAP (mcap.dev/spec, version 0): the magic bytes, then records of an opcode, a u64 length and
+//! their data — Schema, Channel (a topic and its schema), Message (a channel's message) —, most
+//! of them in Chunks (plain, lz4 or zstd, a CRC each), a summary section after the data
+//! whose Footer points at it. The `mcap` crate reads the records: chunks, compression, CRCs.
 
 use std::cell::Cell;
 use std::collections::BTreeMap;
 use std::io::Read as _;
 use std::path::{Path, PathBuf};
 
-use super::Channel;
-use super::bag::{IMU_TYPE, MCAP_MAGIC, decode_imu, unreadable};
-use super::stream::{ImuRecords, Record};
-use crate::logs::{LogError, LogProblem};
+use super::messages::{ROS2_IMU_TYPE, decode_imu};
+use super::records::{Channel, ImuRecords, Record};
+use super::{LogError, LogProblem, unreadable};
+
+/// The first bytes of an MCAP file.
+pub const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
 
 /// The longest record the MCAP reader accepts, bytes: a corrupt length then is an error, where
 /// `mcap::MessageStream` (0.26, no limit) panics on a length near 2⁶⁴.
@@ -142,7 +150,7 @@ impl ImuRecords for McapRecords {
                 let McapEvent::Message(topic, kind, data) = event else {
                     return Ok(());
                 };
-                if kind != IMU_TYPE {
+                if kind != ROS2_IMU_TYPE {
                     return Ok(());
                 }
                 // A lookup by the borrowed name: no allocation per message.

@@ -1,15 +1,18 @@
-//! The GNSS log of geodetic fixes, held whole (one row per fix).
+//! The GNSS log of `calibrate --imu --gnss`: geodetic fixes, held whole (one [`GnssRow`] per
+//! fix), read from CSV or from columns held in memory (the Python package's arrays).
 //!
-//! `t_s,lat_deg,lon_deg,height_m` (WGS-84, ellipsoidal height), optionally
+//! # Format
+//! The CSV text of [`super::csv`] with the columns of `docs/guide/calibrate_imu.md` (§ The
+//! recordings): `t_s,lat_deg,lon_deg,height_m` (WGS-84, ellipsoidal height), optionally
 //!   `vn_m_s,ve_m_s,vd_m_s` and the σ's `sigma_n_m,sigma_e_m,sigma_d_m`,
 //!   `sigma_vn_m_s,sigma_ve_m_s,sigma_vd_m_s`; in those optional columns an empty cell or `nan`
 //!   means "not measured".
 
 use std::io::{BufRead, Read};
 
-use crate::ins::earth::Geodetic;
-use crate::logs::read::LogSource;
-use crate::logs::{LogError, LogProblem, echo};
+use super::csv::read::LogSource;
+use super::records::{Geodetic, GnssRow};
+use super::{LogError, LogProblem, echo};
 
 /// The GNSS log's required columns.
 pub const GNSS_COLUMNS: [&str; 4] = ["t_s", "lat_deg", "lon_deg", "height_m"];
@@ -25,30 +28,6 @@ pub const GNSS_OPTIONAL: [&str; 9] = [
     "sigma_ve_m_s",
     "sigma_vd_m_s",
 ];
-
-/// One row of the GNSS log.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GnssRow {
-    /// Line in the file.
-    pub line: u64,
-    /// Time of validity, s.
-    pub t_s: f64,
-    /// The antenna's position.
-    pub position: Geodetic,
-    /// Velocity north, east, down (m/s); `None` where not measured.
-    pub velocity_ned_m_s: [Option<f64>; 3],
-    /// The position's σ north, east, down (m), where the log gives it.
-    pub position_sigma_m: [Option<f64>; 3],
-    /// The velocity's σ per component (m/s), where the log gives it.
-    pub velocity_sigma_m_s: [Option<f64>; 3],
-}
-
-impl GnssRow {
-    /// The horizontal velocity, when both components are measured.
-    pub fn horizontal_velocity(&self) -> Option<(f64, f64)> {
-        Some((self.velocity_ned_m_s[0]?, self.velocity_ned_m_s[1]?))
-    }
-}
 
 /// A field's number: `None` for an empty cell or `nan` where `optional`, else a finite number.
 fn field(text: &str, column: &'static str, optional: bool) -> Result<Option<f64>, LogProblem> {
@@ -118,8 +97,8 @@ pub fn read_gnss(source: &dyn LogSource) -> Result<Vec<GnssRow>, LogError> {
             break;
         }
         line += 1;
-        if buf.len() > crate::logs::block::MAX_LINE_BYTES {
-            let limit_bytes = crate::logs::block::MAX_LINE_BYTES;
+        if buf.len() > crate::input::csv::block::MAX_LINE_BYTES {
+            let limit_bytes = crate::input::csv::block::MAX_LINE_BYTES;
             return Err(at(line, LogProblem::LineTooLong { limit_bytes }));
         }
         let text = std::str::from_utf8(&buf).map_err(|_| at(line, LogProblem::NotText))?;
@@ -146,7 +125,7 @@ pub fn read_gnss(source: &dyn LogSource) -> Result<Vec<GnssRow>, LogError> {
 /// false at the end.
 fn next_line(reader: &mut dyn BufRead, buf: &mut Vec<u8>, name: &str) -> Result<bool, LogError> {
     buf.clear();
-    let limit = crate::logs::block::MAX_LINE_BYTES as u64 + 1;
+    let limit = crate::input::csv::block::MAX_LINE_BYTES as u64 + 1;
     let n = reader.take(limit).read_until(b'\n', buf).map_err(|e| {
         let message = e.to_string();
         LogError::of_file(name, LogProblem::Unreadable { message })

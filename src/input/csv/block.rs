@@ -7,7 +7,7 @@
 
 use std::io::Read;
 
-use super::{LogError, LogProblem, echo};
+use crate::input::{LogError, LogProblem, echo};
 
 /// The longest data row accepted, bytes: a row is a few numbers, and the limit stops a file
 /// without line ends (a device such as `/dev/zero`) from being read without bound.

@@ -3,32 +3,29 @@
 //! through a memory map, leaving the connections' fields and the messages to decode as here,
 //! and brings bzip2's C library; a flat scan of the records is about as much code as using it.
 //! The file is read from disk record by record, a chunk at a time (`visit_ros1`): memory is
-//! one chunk's, whatever the bag's length; `rosbag1_stream::Ros1Records` reads it so for
-//! [`super::stream`]. A chunk is plain or compressed as rosbag compresses: lz4 (the LZ4 frame
+//! one chunk's, whatever the bag's length; [`Ros1Records`] reads it so, the chosen `Imu` topic
+//! as [`Record`]s read again from disk as often as an analysis needs. A chunk is plain or compressed as rosbag compresses: lz4 (the LZ4 frame
 //! format, the `lz4` crate) or bz2 (the `bzip2` crate on its pure-Rust `libbz2-rs-sys`).
 //!
-//! # Formula
+//! # Format
 //! ROS bag format 2.0 (wiki.ros.org/Bags/Format/2.0): after `#ROSBAG V2.0\n`, records of a
 //! little-endian u32 header length, the header's fields (each a u32 length then `name=value`),
 //! a u32 data length and the data. `op` = 0x05 a chunk (its data the records 0x07 connection —
 //! `conn`, `topic`, the type in its data's fields — and 0x02 message — `conn`, its data the
 //! message; the header's `compression` none, lz4 or bz2 and `size` the records' length), 0x03
-//! the bag header (`index_pos`), 0x04 and 0x06 indices. A `sensor_msgs/Imu` message is ROS 1
-//! serialized (little-endian, unaligned): header {u32 seq, u32 sec, u32 nsec, string frame_id as
-//! u32 length + bytes}, then 37 float64 (orientation, its covariance, angular velocity, its
-//! covariance, linear acceleration, its covariance).
+//! the bag header (`index_pos`), 0x04 and 0x06 indices. A message is ROS 1 serialized, decoded
+//! by [`super::messages`].
 
+use std::cell::Cell;
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use super::bag::{ImuMessage, Topics, unreadable};
-use crate::logs::LogError;
+use super::messages::{ROS1_IMU_TYPE, decode_ros1_message, u32_at};
+use super::records::{Channel, ImuRecords, Record};
+use super::{LogError, LogProblem, unreadable};
 
 /// The first bytes of a ROS 1 bag.
 pub const ROSBAG_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
-
-/// The ROS 1 type of an IMU message.
-pub const IMU_TYPE: &str = "sensor_msgs/Imu";
 
 /// Whether the file at `path` starts as a ROS 1 bag does.
 pub fn is_ros1(path: &Path) -> bool {
@@ -36,10 +33,6 @@ pub fn is_ros1(path: &Path) -> bool {
     std::fs::File::open(path)
         .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
         .is_ok_and(|()| head == ROSBAG_MAGIC)
-}
-
-fn u32_at(b: &[u8], at: usize) -> Option<u32> {
-    Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
 }
 
 /// The fields `name=value` of a record's header (or a connection's data).
@@ -66,22 +59,6 @@ fn record(b: &[u8], at: usize) -> Option<RawRecord<'_>> {
     let data_len = u32_at(b, data_at)? as usize;
     let data = b.get(data_at + 4..data_at + 4 + data_len)?;
     Some((header, data, data_at + 4 + data_len))
-}
-
-/// Decodes a ROS 1 serialized `sensor_msgs/Imu`.
-fn decode(data: &[u8]) -> Option<ImuMessage> {
-    let (sec, nanosec) = (u32_at(data, 4)?, u32_at(data, 8)?);
-    let start = 16 + u32_at(data, 12)? as usize;
-    let f = |k: usize| -> Option<f64> {
-        let at = start + 8 * k;
-        Some(f64::from_le_bytes(data.get(at..at + 8)?.try_into().ok()?))
-    };
-    Some(ImuMessage {
-        sec: i32::try_from(sec).ok()?,
-        nanosec,
-        angular_velocity: [f(13)?, f(14)?, f(15)?],
-        linear_acceleration: [f(25)?, f(26)?, f(27)?],
-    })
 }
 
 /// What [`visit_ros1`] hands on: a connection (topic, type), then each message on it.
@@ -341,42 +318,67 @@ fn index_topics(path: &Path) -> Option<BTreeMap<String, String>> {
     (!out.is_empty()).then_some(out)
 }
 
-/// Reads the connections and `Imu` messages of the ROS 1 bag at `path` into `topics`.
-///
-/// # Errors
-/// As [`visit_ros1`], and a message too short for an `Imu`.
-pub(super) fn read_ros1(path: &Path, topics: &mut Topics) -> Result<(), LogError> {
-    let file = path.display().to_string();
-    visit_ros1(path, &mut |event| {
-        match event {
-            Ros1Event::Connection(topic, kind) => {
-                topics
-                    .types
-                    .entry(topic.to_string())
-                    .or_insert(kind.to_string());
-            }
-            Ros1Event::Message(topic, kind, data) if kind == IMU_TYPE => {
-                let list = topics.imu.entry(topic.to_string()).or_default();
-                list.push(decode_message(&file, topic, list.len(), data)?);
-            }
-            Ros1Event::Message(..) => {}
-        }
-        Ok(())
-    })
+/// The chosen `Imu` topic of a ROS 1 bag, as records of the six channels read from disk each
+/// time.
+pub struct Ros1Records {
+    path: PathBuf,
+    topic: String,
+    /// The first message's whole second, once read.
+    sec0: Cell<Option<i64>>,
 }
 
-/// The `Imu` message `index` of `topic`, or the error naming it.
-pub(super) fn decode_message(
-    file: &str,
-    topic: &str,
-    index: usize,
-    data: &[u8],
-) -> Result<ImuMessage, LogError> {
-    decode(data).ok_or_else(|| {
-        let at = format!("{file}, topic {topic}, message {index}");
-        unreadable(
-            &at,
-            format!("{} bytes: too short for a {IMU_TYPE} message", data.len()),
-        )
-    })
+impl Ros1Records {
+    /// The `Imu` topic `topic` of the bag at `path`.
+    pub(super) fn new(path: &Path, topic: String) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            topic,
+            sec0: Cell::new(None),
+        }
+    }
+}
+
+impl ImuRecords for Ros1Records {
+    fn channels(&self) -> &[Channel] {
+        &Channel::ALL
+    }
+
+    fn read(&self, visit: &mut dyn FnMut(&Record) -> Result<(), LogError>) -> Result<(), LogError> {
+        let file = self.path.display().to_string();
+        // Messages per `Imu` topic: every one is decoded, as the whole-series reader does.
+        let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+        visit_ros1(&self.path, &mut |event| {
+            let Ros1Event::Message(topic, kind, data) = event else {
+                return Ok(());
+            };
+            if kind != ROS1_IMU_TYPE {
+                return Ok(());
+            }
+            if !counts.contains_key(topic) {
+                counts.insert(topic.to_string(), 0);
+            }
+            let k = counts.get_mut(topic).expect("inserted");
+            let m = decode_ros1_message(&file, topic, *k, data)?;
+            let at = *k as u64;
+            *k += 1;
+            if topic != self.topic {
+                return Ok(());
+            }
+            visit(&m.record(&self.sec0, at))
+        })
+    }
+
+    fn error_at(&self, at: u64, problem: LogProblem) -> LogError {
+        let at = format!(
+            "{}, topic {}, message {at}",
+            self.path.display(),
+            self.topic
+        );
+        LogError::of_file(&at, problem)
+    }
+
+    fn error(&self, problem: LogProblem) -> LogError {
+        let at = format!("{}, topic {}", self.path.display(), self.topic);
+        LogError::of_file(&at, problem)
+    }
 }

@@ -1,13 +1,13 @@
 //! A log that can be read only once — a pipe, a FIFO, a device — copied as it arrives to an
 //! anonymous temporary file, which is then read as a file is, as often as the analysis needs
-//! ([`super::stream`] reads it twice): memory stays that of the streams, whatever the length.
+//! (`allan --imu`'s streamed analysis reads it twice): memory stays that of the streams, whatever the length.
 
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
-use crate::logs::read::{LogSource, decompressed};
-use crate::logs::{LogError, LogProblem};
+use crate::input::csv::read::{LogSource, decompressed};
+use crate::input::{LogError, LogProblem};
 
 /// The bytes of a log read once, kept in a temporary file (unlinked at creation: removed
 /// however the process ends).

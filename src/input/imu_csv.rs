@@ -1,6 +1,9 @@
-//! The 6-axis IMU log, streamed as increments.
+//! The 6-axis IMU log of `calibrate --imu`, streamed as increments ([`ImuStep`]s), or its
+//! columns held in memory (the Python package's arrays) turned into the same steps.
 //!
-//! `t_s` and either the mean rates over the step ending at `t_s`
+//! # Format
+//! The CSV text of [`super::csv`] with the columns of `docs/guide/calibrate_imu.md` (§ The
+//! recordings): `t_s` and either the mean rates over the step ending at `t_s`
 //!   (`ax_m_s2,ay_m_s2,az_m_s2,gx_rad_s,gy_rad_s,gz_rad_s`: specific force and angular rate) or
 //!   the increments over that step (`dvx_m_s,dvy_m_s,dvz_m_s,dthx_rad,dthy_rad,dthz_rad`), in
 //!   body axes forward-right-down or forward-left-up. The first row only starts the first step.
@@ -9,11 +12,11 @@
 
 use nalgebra::Vector3;
 
+use super::csv::read::{CsvReader, LogSource};
+use super::csv::steps::{ACCEPTED_STEP_RATIO, StepAt, StepMedian};
+use super::records::{ImuStep, Increment};
+use super::{LogError, LogProblem};
 use crate::config::ins::Axes;
-use crate::ins::mech::Increment;
-use crate::logs::read::{CsvReader, LogSource};
-use crate::logs::steps::{ACCEPTED_STEP_RATIO, StepAt, StepMedian};
-use crate::logs::{LogError, LogProblem};
 
 /// The IMU log's columns when it holds rates.
 pub const RATE_COLUMNS: [&str; 7] = [
@@ -57,18 +60,6 @@ fn choose(found: &[&str], line: u64, file: &str) -> Result<[&'static str; 7], Lo
         (None, Some(_)) => Ok(INCREMENT_COLUMNS),
         _ => Ok(RATE_COLUMNS),
     }
-}
-
-/// One step of the IMU log: the increments over (`t_s − dt_s`, `t_s`], in body axes
-/// forward-right-down.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ImuStep {
-    /// Line of the row that ends the step.
-    pub line: u64,
-    /// The step's end, s.
-    pub t_s: f64,
-    /// Δθ, Δv and the step's length.
-    pub increment: Increment,
 }
 
 /// The IMU log as a stream of steps.
@@ -331,7 +322,7 @@ impl StepSource for HeldSteps<'_> {
 /// The log's first problem, with its line.
 pub fn read_steps(
     imu: &dyn LogSource,
-    axes: crate::config::ins::Axes,
+    axes: Axes,
 ) -> Result<(Vec<ImuStep>, ImuSpan, ImuLayout), LogError> {
     let mut reader = ImuReader::open(imu, axes)?;
     let layout = reader.layout();
