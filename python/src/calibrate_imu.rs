@@ -226,6 +226,9 @@ pub(crate) fn calibrate_imu_arrays(
     let source = config_kind.zip(config_value).map(|(k, v)| Source::of(k, v));
     let settings = settings(source).map_err(crate::config_error)?;
     let keys = keys(estimate, confidence)?;
+    if keys.is_some() {
+        noise::check_estimable(&settings).map_err(crate::config_error)?;
+    }
     let t = imu_t.as_slice().map_err(crate::bad_input)?;
     let columns = slices(&imu_columns)?;
     let required = slices(&gnss_required)?;

@@ -48,6 +48,9 @@ pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
         Some(path) => settings_of(&ConfigText::read(path)?)?,
         None => CONSUMER,
     };
+    if args.estimate_noise {
+        noise::check_estimable(&settings)?;
+    }
     check_directory(&args.out, &FILES)?;
     if !args.quiet && std::io::stderr().is_terminal() {
         eprintln!("checking the logs, aligning and running the filter…");

@@ -75,6 +75,8 @@ pub struct ImuCalibrationView {
     pub tests: Vec<TestRow>,
     /// The NIS test in words, as HTML.
     pub nis_html: String,
+    /// What the χ² innovation gate did.
+    pub gate: String,
     /// Every assumption.
     pub assumptions: Vec<super::calibration_imu_assumptions::AssumptionRow>,
     /// The five figures.
@@ -289,6 +291,7 @@ pub fn view<const N: usize>(
         alignment: alignment_rows(s),
         tests: test_rows(s),
         nis_html: super::calibration_imu_words::nis_words(s),
+        gate: super::calibration_imu_words::gate_words(s),
         assumptions: super::calibration_imu_assumptions::rows(&s.assumptions, &estimated_fields(s)),
         figures: super::calibration_imu_figures::figures(c, s, smoothed)?,
         command: command.to_string(),

@@ -63,6 +63,7 @@ pub fn rows(a: &Settings, estimated: &[&str]) -> Vec<AssumptionRow> {
         false_alarm_rate: _,
         gnss_time_offset_s: _,
         error_states: _,
+        innovation_gate: _,
         gyro_scale_factor_sigma_ppm: _,
         accel_scale_factor_sigma_ppm: _,
     } = *a;
@@ -99,6 +100,7 @@ pub fn rows(a: &Settings, estimated: &[&str]) -> Vec<AssumptionRow> {
         heading_offset_sigma_deg: "σ of the IMU's heading about the course" => unit("°"),
         false_alarm_rate: "each test's false-alarm rate α" => value,
         error_states: "the filter's error states (21: the scale factors estimated too)" => |n: usize| n.to_string(),
+        innovation_gate: "a χ² gate at α on each fix's innovation (a rejected fix is left out)" => |on: bool| if on { "on" } else { "off" }.to_string(),
         gyro_scale_factor_sigma_ppm: "gyro scale factors' prior σ (with 21 states)" => unit("ppm"),
         accel_scale_factor_sigma_ppm: "accelerometer scale factors' prior σ (with 21 states)" => unit("ppm"),
     )

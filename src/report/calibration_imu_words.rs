@@ -203,3 +203,52 @@ pub(super) fn whiteness_findings(s: &Summary) -> Vec<String> {
     }
     out
 }
+
+/// What the χ² innovation gate did, in a sentence or two: off (and how to turn it on), or how
+/// many fixes it rejected against the count chance explains, and the first of them.
+pub fn gate_words(s: &Summary) -> String {
+    let g = &s.gate;
+    if !g.enabled {
+        return "No innovation was gated: every fix updated the filter ([filter] \
+                innovation_gate = true tests each fix's NIS against the χ² quantile at α and \
+                leaves out those above it)."
+            .to_string();
+    }
+    let n = g.rejected.len();
+    let head = format!(
+        "The χ² gate at α = {} tested {} fixes and rejected {n} (chance explains {}); the \
+         rejected fixes are left out of the filter and of the tests above.",
+        g.false_alarm_rate,
+        g.tested,
+        sig(g.expected_by_chance, 3)
+    );
+    let listed: Vec<String> = g
+        .rejected
+        .iter()
+        .take(5)
+        .map(|r| {
+            format!(
+                "line {} at {} s (NIS {} above {}, largest in {} at {}σ)",
+                r.line,
+                sig(r.t_s, 6),
+                sig(r.nis, 3),
+                sig(r.threshold, 3),
+                r.component.replace('_', " "),
+                sig(r.normalized, 3)
+            )
+        })
+        .collect();
+    match n {
+        0 => head,
+        _ => format!(
+            "{head} {}: {}{}.",
+            if n > 5 { "The first five" } else { "They" },
+            listed.join("; "),
+            if n > 5 {
+                "; all in summary.json's gate"
+            } else {
+                ""
+            }
+        ),
+    }
+}

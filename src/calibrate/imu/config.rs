@@ -41,6 +41,7 @@ struct Statistics {
     gyro_scale_factor_sigma_ppm: Option<f64>,
     accel_scale_factor_sigma_ppm: Option<f64>,
     error_states: Option<u32>,
+    innovation_gate: Option<bool>,
 }
 
 #[derive(Clone, Debug, Default, Deserialize)]
@@ -194,13 +195,32 @@ pub fn settings_of(text: &ConfigText) -> Result<Settings, ConfigError> {
             .filter
             .error_states
             .map_or(c.error_states, |n| n as usize),
+        innovation_gate: file.filter.innovation_gate.unwrap_or(c.innovation_gate),
         gyro_scale_factor_sigma_ppm: pick(|s| s.gyro_scale_factor_sigma_ppm)
             .unwrap_or(c.gyro_scale_factor_sigma_ppm),
         accel_scale_factor_sigma_ppm: pick(|s| s.accel_scale_factor_sigma_ppm)
             .unwrap_or(c.accel_scale_factor_sigma_ppm),
     };
+    gate_in_filter(&file).map_err(|e| text.locate(e))?;
     validate(&s).map_err(|e| text.locate(in_section(e, t)))?;
     Ok(s)
+}
+
+/// The gate is the filter's: `innovation_gate` in `[imu]` or `[gnss]` is refused.
+fn gate_in_filter(file: &File) -> Result<(), ConfigError> {
+    for (field, stats) in [
+        ("imu.innovation_gate", &file.imu),
+        ("gnss.innovation_gate", &file.gnss),
+    ] {
+        if let Some(v) = stats.innovation_gate {
+            return Err(ConfigError::invalid(
+                field,
+                v,
+                "set in [filter] (the filter's gate)",
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `e` naming its key by the section that sets it (`filter.…` before `imu.…`, as the value is

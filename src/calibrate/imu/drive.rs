@@ -146,6 +146,7 @@ impl<const N: usize, C: ?Sized> Observer<N, C> for Recorder<'_, N> {
                 .cholesky()
                 .map_or(f64::NAN, |c| 2.0 * c.l().diagonal().map(f64::ln).sum()),
             rows: nu.components.len(),
+            accepted: nu.accepted,
             linear,
         });
         Ok(())

@@ -6,8 +6,9 @@
 //! 2. `align`: with no attitude given, the filter starts at the first fix fast enough for the
 //!    course to give the heading; roll and pitch come from the mean specific force over the
 //!    window before it, and the prior covariance carries the alignment's errors.
-//! 3. `run`: the filter from that fix on, each fix at its own time between IMU samples (the
-//!    step cut there), one record per fix.
+//! 3. `run`: the filter from that fix on through the driver (`drive`: the logs as its sources),
+//!    each fix at its own time between IMU samples (the step cut there), tested by the χ² gate
+//!    when `[filter] innovation_gate = true`, one record per fix.
 //! 4. `smoother`: the Rauch–Tung–Striebel pass backwards over the fixes.
 //! 5. `summary`: the six biases and the attitude at the end with σ's, intervals and whether the
 //!    drive determined them (each sensor's three a `triad`); the NIS test and the innovations' whiteness per component; every
@@ -16,6 +17,7 @@
 pub mod align;
 pub mod config;
 mod drive;
+pub mod gate;
 pub mod linear;
 pub mod noise;
 pub mod run;
@@ -65,6 +67,7 @@ pub const CONSUMER: Settings = Settings {
     heading_offset_sigma_deg: 2.0,
     false_alarm_rate: 0.01,
     error_states: 15,
+    innovation_gate: false,
     gyro_scale_factor_sigma_ppm: 10_000.0,
     accel_scale_factor_sigma_ppm: 10_000.0,
 };
@@ -112,6 +115,9 @@ pub struct Settings {
     pub false_alarm_rate: f64,
     /// The filter's error states: 15, or 21 with the six scale factors.
     pub error_states: usize,
+    /// Whether every fix's innovation is tested by a χ² gate at [`Settings::false_alarm_rate`]
+    /// (a rejected fix is left out of the filter, the NIS test and the whiteness, and listed).
+    pub innovation_gate: bool,
     /// The gyro scale factors' prior σ, ppm (with 21 states).
     pub gyro_scale_factor_sigma_ppm: f64,
     /// The accelerometer scale factors' prior σ, ppm (with 21 states).

@@ -19,6 +19,7 @@ use super::Settings;
 use super::config::MAX_TIME_OFFSET_S;
 use super::linear::Linearized;
 use super::run::{filter, shifted};
+use crate::error::ConfigError;
 use crate::input::imu_csv::{HeldSteps, ImuSpan};
 use crate::input::records::{GnssRow, ImuStep};
 use crate::ins::error_state::{STATES, STATES_WITH_SCALE};
@@ -259,6 +260,23 @@ fn fixes_in_reach(rows: &[GnssRow], span: &ImuSpan, start: usize) -> usize {
         .iter()
         .filter(|r| r.t_s + MAX_TIME_OFFSET_S <= span.last_s)
         .count()
+}
+
+/// Whether the noise statistics can be estimated under `s`: not with the χ² gate, whose
+/// rejected fixes the likelihood does not yet leave out.
+///
+/// # Errors
+/// [`ConfigError::Invalid`] naming `filter.innovation_gate`.
+pub fn check_estimable(s: &Settings) -> Result<(), ConfigError> {
+    if s.innovation_gate {
+        return Err(ConfigError::invalid(
+            "filter.innovation_gate",
+            true,
+            "false with --estimate-noise: the likelihood of the noise statistics does not yet \
+             leave the gate's rejected fixes out",
+        ));
+    }
+    Ok(())
 }
 
 /// Maximises ℓ over `keys` from `s` (the others held), with each key's profile-likelihood

@@ -18,6 +18,7 @@ use crate::input::{LogError, LogProblem};
 use crate::ins::driver::{DriveError, Driver, ImuSource, Source};
 use crate::ins::error_state::STATES;
 use crate::ins::filter::{Ekf, FilterError, LinearView};
+use crate::ins::measurement::Gate;
 
 /// Why a recording cannot be calibrated.
 #[derive(Debug, Error)]
@@ -189,6 +190,7 @@ fn run_filter<const N: usize>(
         source,
     };
     Driver::new(vec![&mut fixes as &mut dyn Source<N, LogSteps>])
+        .with_gate(gate_of(s))
         .starting_at(rh.t_s)
         .run(&mut ekf, &mut steps, &mut recorder)
         .map_err(drive_error)?;
@@ -202,6 +204,11 @@ fn run_filter<const N: usize>(
         mean_f_b,
         start_view,
     })
+}
+
+/// The χ² gate `s` asks for, at its false-alarm rate.
+fn gate_of(s: &Settings) -> Option<Gate> {
+    s.innovation_gate.then(|| Gate::new(s.false_alarm_rate))
 }
 
 /// A driver's error as the calibration's.
@@ -304,6 +311,7 @@ fn finish<const N: usize>(
     let mut recorder = Recorder::new(rows, run.next, std::mem::take(&mut run.records));
     let mut none = NoSteps;
     Driver::new(vec![&mut source as &mut dyn Source<N, NoSteps>])
+        .with_gate(gate_of(s))
         .drain(&mut run.ekf, &mut none, &mut recorder, f64::INFINITY)
         .map_err(drive_error)?;
     run.records = recorder.records;

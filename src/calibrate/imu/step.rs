@@ -15,6 +15,16 @@ use crate::ins::filter::{Ekf, LinearView, NOISE_GROUPS};
 use crate::ins::gnss::Fix;
 use crate::ins::mech::{Increment, Pva};
 
+/// The innovation components' names, in the record's order.
+pub const COMPONENTS: [&str; 6] = [
+    "position_north",
+    "position_east",
+    "position_down",
+    "velocity_north",
+    "velocity_east",
+    "velocity_down",
+];
+
 /// One fix's filtered estimates.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FixRecord<const N: usize = STATES> {
@@ -50,6 +60,9 @@ pub struct FixRecord<const N: usize = STATES> {
     pub log_det_s: f64,
     /// The components measured.
     pub rows: usize,
+    /// Whether the filter took the fix: false when the χ² gate rejected its innovation (its
+    /// covariance is then the prior, its correction zero).
+    pub accepted: bool,
     /// What a likelihood linearized about this run needs of the fix; `None` unless the run
     /// tracked it ([`crate::calibrate::imu::run::filter_tracked`]).
     pub linear: Option<Box<LinearRecord<N>>>,

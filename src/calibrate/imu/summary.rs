@@ -8,6 +8,7 @@ use std::io::{self, Write};
 use serde::Serialize;
 
 use super::Settings;
+use super::gate::GateRecord;
 use super::noise::NoiseEstimate;
 use super::run::{Calibrated, FixRecord, bias_sigmas, euler_sigmas};
 use super::smoother::Smoothed;
@@ -105,8 +106,10 @@ pub struct Summary {
     pub accel_scale_factor_ppm: Option<Triad>,
     /// The attitude at the end.
     pub attitude_deg: Attitude,
-    /// The NIS test over the fixes.
+    /// The NIS test over the fixes the filter took.
     pub nis: NisTest,
+    /// What the χ² innovation gate did.
+    pub gate: GateRecord,
     /// Whiteness of each innovation component's normalized sequence.
     pub whiteness: Vec<ComponentWhiteness>,
     /// Whether the intervals rest on a model a test rejects.
@@ -121,15 +124,7 @@ pub struct Summary {
     pub noise_estimate: Option<NoiseEstimate>,
 }
 
-/// The innovation components' names, in the record's order.
-pub const COMPONENTS: [&str; 6] = [
-    "position_north",
-    "position_east",
-    "position_down",
-    "velocity_north",
-    "velocity_east",
-    "velocity_down",
-];
+pub use super::step::COMPONENTS;
 
 /// The σ a bias would have at `t` s after the start from its prior and its process alone.
 fn prior_sigma(sigma0: f64, k: f64, tau: Option<f64>, t: f64) -> f64 {
@@ -192,7 +187,7 @@ pub fn summary<const N: usize>(c: &Calibrated<N>, s: &Settings, imu_file: &str) 
         imu_rows: c.span.rows,
         imu_rate_hz: 1.0 / c.span.median_step_s,
         fixes: c.fixes,
-        fixes_used: c.records.len(),
+        fixes_used: c.records.iter().filter(|r| r.accepted).count(),
         alignment,
         gyro_bias_rad_s: gyro,
         accel_bias_m_s2: accel,
@@ -201,6 +196,7 @@ pub fn summary<const N: usize>(c: &Calibrated<N>, s: &Settings, imu_file: &str) 
         attitude_deg: attitude,
         intervals_conditional: !rejected_by.is_empty(),
         nis,
+        gate: super::gate::record(&c.records, s),
         whiteness,
         rejected_by,
         warnings,
@@ -214,14 +210,13 @@ fn tests<const N: usize>(
     c: &Calibrated<N>,
     s: &Settings,
 ) -> (NisTest, Vec<ComponentWhiteness>, Vec<String>) {
-    let nis: Vec<f64> = c.records.iter().map(|r| r.nis).collect();
-    let rows: Vec<usize> = c.records.iter().map(|r| r.rows).collect();
+    let taken = || c.records.iter().filter(|r| r.accepted);
+    let nis: Vec<f64> = taken().map(|r| r.nis).collect();
+    let rows: Vec<usize> = taken().map(|r| r.rows).collect();
     let nis = nis_test_rows(&nis, &rows, s.false_alarm_rate);
     let whiteness: Vec<ComponentWhiteness> = (0..6)
         .filter_map(|i| {
-            let u: Vec<f64> = c
-                .records
-                .iter()
+            let u: Vec<f64> = taken()
                 .filter(|r| r.innovation[i].is_finite())
                 .map(|r| r.innovation[i] / r.innovation_sigma[i])
                 .collect();
