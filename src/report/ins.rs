@@ -15,7 +15,7 @@ use crate::format::{count, fixed, sig};
 use crate::ins::names::{MEASUREMENTS, VARIABLES};
 use crate::plot::{self, TraceSeries};
 use crate::stats::binomial_band;
-use crate::study::ins::{Control, InsStudy, SCALE_PPM};
+use crate::study::ins::{Control, InsResults, SCALE_PPM};
 
 const TRACK: Figure = Figure::Named("ins-track");
 const TRACE: Figure = Figure::Named("ins-trace");
@@ -120,7 +120,7 @@ fn failed(v: &Verdicts) -> Vec<&'static str> {
 }
 
 /// What the consistent filter and each control show.
-fn findings(s: &InsStudy) -> String {
+fn findings(s: &InsResults) -> String {
     let mut out = String::new();
     let f = failed(&s.verdicts);
     out.push_str(&if f.is_empty() && s.verdicts.all_passed() {
@@ -195,7 +195,7 @@ fn since(first: Option<(&'static str, f64, String)>) -> String {
 ///
 /// # Errors
 /// [`RenderError`] when a figure cannot be drawn.
-pub fn view(s: &InsStudy, numbers: &Numbers) -> Result<InsView, RenderError> {
+pub fn view(s: &InsResults, numbers: &Numbers) -> Result<InsView, RenderError> {
     let col = |i: usize| -> Vec<f64> { s.track.iter().map(|p| p[i]).collect() };
     let track = figure(
         "fig-ins-track",
@@ -289,7 +289,7 @@ pub struct InsRecord {
     pub final_sigma: Vec<(&'static str, f64, f64)>,
 }
 
-fn record(s: &InsStudy) -> InsRecord {
+fn record(s: &InsResults) -> InsRecord {
     let verdicts = |v: &Verdicts| {
         v.checks
             .iter()

@@ -44,7 +44,7 @@ pub struct Trace {
 
 /// The three-axis section's results.
 #[derive(Clone, Debug)]
-pub struct InsStudy {
+pub struct InsResults {
     /// Its configuration (the default three-axis file).
     pub config: InsConfig,
     /// Realizations of each ensemble.
@@ -185,7 +185,7 @@ pub fn run(
     config: &InsConfig,
     realizations: u64,
     progress: &mut dyn Progress,
-) -> Result<InsStudy, RealizationError> {
+) -> Result<InsResults, RealizationError> {
     let scenario = Scenario::from_config(config).expect("a valid three-axis configuration");
     let track = Track::of(&scenario);
     let (verdicts, calibration, times_s) =
@@ -210,7 +210,7 @@ pub fn run(
             times_s,
         });
     }
-    Ok(InsStudy {
+    Ok(InsResults {
         config: config.clone(),
         realizations,
         track: track_every_second(&scenario, &track),
