@@ -16,7 +16,7 @@
 pub mod align;
 pub mod config;
 mod drive;
-pub mod linear;
+pub mod linearized;
 pub mod noise;
 pub mod run;
 pub mod scale;

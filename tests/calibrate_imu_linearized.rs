@@ -1,9 +1,9 @@
-//! The likelihood linearized about one run of the three-axis filter (`calibrate::imu::linear`)
+//! The likelihood linearized about one run of the three-axis filter (`calibrate::imu::linearized`)
 //! against the likelihood of rerunning the filter: equal at the run's own statistics, close
 //! near them (within a tenth of the χ²₁ threshold an interval's end rests on), on the shipped
 //! comma2k19 minute and on a simulated drive.
 
-use accelcal::calibrate::imu::linear::Linearized;
+use accelcal::calibrate::imu::linearized::Linearized;
 use accelcal::calibrate::imu::noise::log_likelihood;
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ins::InsConfig;
