@@ -15,9 +15,9 @@ use std::time::Instant;
 use accelcal::config::ins::InsConfig;
 use accelcal::ins::ensemble::{self, Track, error};
 use accelcal::ins::filter::Propagation;
-use accelcal::ins::logs::fix;
 use accelcal::ins::mech;
 use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::fix;
 
 fn arg(name: &str) -> Option<String> {
     let args: Vec<String> = std::env::args().collect();

@@ -11,8 +11,8 @@ use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary};
 use accelcal::config::ins::{Axes, InsConfig};
 use accelcal::input::csv::read::LogText;
-use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::write_realization;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 

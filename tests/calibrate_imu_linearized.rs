@@ -12,8 +12,8 @@ use accelcal::input::gnss_csv::read_gnss;
 use accelcal::input::imu_csv::{ImuSpan, read_steps};
 use accelcal::input::records::{GnssRow, ImuStep};
 use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
-use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::write_realization;
 
 /// The shipped minute, held.
 fn comma() -> (Vec<GnssRow>, Vec<ImuStep>) {

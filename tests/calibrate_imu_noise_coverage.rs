@@ -10,8 +10,8 @@ use accelcal::config::ins::InsConfig;
 use accelcal::input::csv::read::LogText;
 use accelcal::input::gnss_csv::read_gnss;
 use accelcal::input::imu_csv::read_steps;
-use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::write_realization;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 

@@ -13,8 +13,8 @@ use accelcal::calibrate::imu::triad::Triad;
 use accelcal::config::ins::InsConfig;
 use accelcal::input::csv::read::LogText;
 use accelcal::ins::error_state::STATES_WITH_SCALE;
-use accelcal::ins::logs::write_realization;
 use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::write_realization;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 

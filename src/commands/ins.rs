@@ -17,9 +17,9 @@ use accelcal::export;
 use accelcal::ins::blocks;
 use accelcal::ins::ensemble::{self as ins_ensemble, InsSums, Track};
 use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
-use accelcal::ins::logs::write_realization;
 use accelcal::ins::partial::{self, InsPartialHeader, MergedSums};
 use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::write_realization;
 use accelcal::output::{AtomicFile, ScratchFile, StagedFiles, check_directory};
 use accelcal::study::Progress;
 

@@ -5,10 +5,10 @@
 use crate::ins::drive::Drive;
 use crate::ins::driver::{ImuSource, ImuStep, Source};
 use crate::ins::gnss::FixUpdate;
-use crate::ins::logs::fix;
 use crate::ins::measurement::Measurement;
 use crate::ins::sensors::Imu;
 use crate::ins::setup::Scenario;
+use crate::ins::simulated_logs::fix;
 
 use super::Track;
 

@@ -4,8 +4,8 @@ use crate::config::ins::InsConfig;
 use crate::ins::ensemble::Track;
 use crate::ins::error_state::Matrix15;
 use crate::ins::filter::{DEFAULT_COVARIANCE_INTERVAL_S, Ekf, Propagation};
-use crate::ins::logs::fix;
 use crate::ins::setup::Scenario;
+use crate::ins::simulated_logs::fix;
 
 /// P before each update of realization `index`, its covariance propagated as `propagation` says.
 fn covariances(

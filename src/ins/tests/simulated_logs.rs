@@ -6,8 +6,8 @@ use nalgebra::Vector3;
 use crate::config::ins::InsConfig;
 use crate::ins::drive::Drive;
 use crate::ins::gnss;
-use crate::ins::logs::{GNSS_HEADER, IMU_HEADER, TRUTH_HEADER, write_realization};
 use crate::ins::setup::Scenario;
+use crate::ins::simulated_logs::{GNSS_HEADER, IMU_HEADER, TRUTH_HEADER, write_realization};
 use crate::ins::truth::{self, Truth};
 use crate::stats::{Tail, chi_squared_quantile};
 
