@@ -9,8 +9,9 @@ use super::figures::figure;
 use super::kind::{Built, Context, Record, SectionKind, SectionView};
 use super::outline::{Figure, Label, Numbers, Table};
 use super::view::FigureView;
+use super::words::count_words;
 use super::{RenderError, ReportInput, rich};
-use crate::checks::{CheckId, Verdict, Verdicts};
+use crate::checks::{CATALOGUE, CheckId, Verdict, Verdicts};
 use crate::format::{count, fixed, sig};
 use crate::ins::names::{MEASUREMENTS, VARIABLES};
 use crate::plot::{self, TraceSeries};
@@ -63,6 +64,8 @@ pub struct InsView {
     pub realizations: String,
     /// The drive's length, s.
     pub duration_s: String,
+    /// How many checks the catalogue holds, in words ("seven").
+    pub checks_count: String,
     /// The checks' names, the table's columns.
     pub checks: Vec<String>,
     /// The consistent filter, then the controls.
@@ -268,6 +271,7 @@ pub fn view(s: &InsResults, numbers: &Numbers) -> Result<InsView, RenderError> {
         biases_table: numbers.table(BIASES),
         realizations: count(s.realizations),
         duration_s: fixed(s.config.drive.duration_s, 0),
+        checks_count: count_words(CATALOGUE.len()),
         checks: CheckId::ALL.iter().map(|c| c.name().to_string()).collect(),
         rows,
         biases,
