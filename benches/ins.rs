@@ -15,9 +15,9 @@ use std::time::Instant;
 use accelcal::config::ins::InsConfig;
 use accelcal::ins::ensemble::{self, Track, error};
 use accelcal::ins::filter::Propagation;
-use accelcal::ins::logs::fix;
 use accelcal::ins::mech;
-use accelcal::ins::setup::Study;
+use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::fix;
 
 fn arg(name: &str) -> Option<String> {
     let args: Vec<String> = std::env::args().collect();
@@ -74,19 +74,19 @@ fn measure(label: &str, repeats: usize, n: u64, mut once: impl FnMut(u64)) -> f6
 
 /// Realization `index` as `ins::ensemble::realization` runs it, with the covariance propagated
 /// as `propagation` says; the sum of its NEES before each update and NIS.
-fn realization(study: &Study, track: &Track, index: u64, propagation: Propagation) -> f64 {
-    let drive = study.drive();
-    let (mut imu, ekf) = accelcal::ins::ensemble::start::<15>(study, track, index);
+fn realization(scenario: &Scenario, track: &Track, index: u64, propagation: Propagation) -> f64 {
+    let drive = scenario.drive();
+    let (mut imu, ekf) = accelcal::ins::ensemble::start::<15>(scenario, track, index);
     let mut ekf = ekf.with_propagation(propagation);
-    let g = &study.filter_gnss;
-    let dt = 1.0 / study.imu_rate_hz;
+    let g = &scenario.filter_gnss;
+    let dt = 1.0 / scenario.imu_rate_hz;
     let mut sum = 0.0;
     for (k, (inc, pva)) in track.steps.iter().enumerate() {
         ekf.propagate(&imu.read(inc));
-        if (k + 1) % study.imu_steps_per_fix != 0 {
+        if (k + 1) % scenario.imu_steps_per_fix != 0 {
             continue;
         }
-        let mut reading = fix(study, &drive, &mut imu, (k + 1) as f64 * dt, pva);
+        let mut reading = fix(scenario, &drive, &mut imu, (k + 1) as f64 * dt, pva);
         reading.position_sigma_m = g.position_sigma_m;
         reading.velocity_sigma_m_s = g.velocity_sigma_m_s;
         let e = error(&ekf, pva, &imu);
@@ -105,31 +105,31 @@ fn main() {
     if let Some(d) = arg("--duration").and_then(|v| v.parse().ok()) {
         c.drive.duration_s = d;
     }
-    let study = Study::from_config(&c).expect("the default study is valid");
+    let scenario = Scenario::from_config(&c).expect("the default scenario is valid");
     let t = Instant::now();
-    let track = Track::of(&study);
+    let track = Track::of(&scenario);
     println!(
         "truth of the {} s drive ({} steps): {:.2} s",
-        study.duration_s,
+        scenario.duration_s,
         track.steps.len(),
         t.elapsed().as_secs_f64()
     );
     if let Some(m) = arg("--profile").and_then(|v| v.parse().ok()) {
         // Only the realizations, for `perf record`.
         for l in 0..m {
-            let r = ensemble::realization::<15>(&study, &track, l);
+            let r = ensemble::realization::<15>(&scenario, &track, l);
             assert!(r.is_ok());
             black_box(&r);
         }
         return;
     }
     measure("sensors only (imu.read)", repeats, n, |l| {
-        let mut imu = study.imu(l);
+        let mut imu = scenario.imu(l);
         let s: f64 = track.steps.iter().map(|(inc, _)| imu.read(inc).dt_s).sum();
         black_box(s);
     });
     measure("sensors and mechanization", repeats, n, |l| {
-        let mut imu = study.imu(l);
+        let mut imu = scenario.imu(l);
         let mut pva = track.start;
         let mut before = None;
         for (inc, _) in &track.steps {
@@ -144,18 +144,18 @@ fn main() {
         repeats,
         n,
         |l| {
-            let r = ensemble::realization::<15>(&study, &track, l);
+            let r = ensemble::realization::<15>(&scenario, &track, l);
             assert!(r.is_ok());
             black_box(&r);
         },
     );
     let dense = measure("realization, dense per-step covariance", repeats, n, |l| {
-        black_box(realization(&study, &track, l, Propagation::Dense));
+        black_box(realization(&scenario, &track, l, Propagation::Dense));
     });
     println!("speed-up over the dense reference: {:.1}×", fast / dense);
     if let Some(m) = arg("--ensemble").and_then(|v| v.parse().ok()) {
         let t = Instant::now();
-        let outcome = ensemble::run::<15>(&study, &track, m);
+        let outcome = ensemble::run::<15>(&scenario, &track, m);
         // Wall time: the figure the ensemble's user waits for.
         let run_s = t.elapsed().as_secs_f64();
         assert!(outcome.is_ok());
@@ -164,7 +164,7 @@ fn main() {
             "ensemble of {m} on {} threads: {run_s:.1} s ({:.1} ms a realization), {} fixes each",
             rayon::current_num_threads(),
             1e3 * run_s / m as f64,
-            track.steps.len() / study.imu_steps_per_fix
+            track.steps.len() / scenario.imu_steps_per_fix
         );
     }
 }

@@ -1,13 +1,23 @@
-//! accelcal: calibrates an accelerometer's bias with GPS through an error-state Kalman filter,
-//! verifies the filter with Monte Carlo statistics, and writes the study up as an HTML report.
+//! accelcal: calibrates inertial sensors with GNSS through error-state Kalman filters, verifies
+//! the filters with Monte Carlo statistics, and writes the results up as HTML reports.
 //!
-//! The pipeline, one module per step, each depending only on the ones before it:
-//! [`config`] → [`model`] → [`state`] → [`filter`] → [`simulation`] → [`realization`], [`ensemble`] →
-//! [`stats`], [`checks`] → [`study`], [`sensitivity`] → [`export`], [`plot`] → [`report`].
-//! Below the study, [`input`] reads the sensor logs, [`logs`] writes those of a simulated run,
-//! and [`calibrate`] runs the filter and a smoother over them; [`allan`] measures the accelerometer's noise terms from a static log.
-//! [`format`](mod@format), [`output`], [`progress`] and [`error`] are leaves every step may use. The `accelcal` binary (`src/main.rs`) parses the command line and calls
-//! [`study`], [`sensitivity`], [`calibrate`], [`export`] and [`report`].
+//! Two worlds, each module depending only on the ones before it:
+//!
+//! - One axis, an accelerometer's bias from GPS: [`config`] → [`model`] → [`state`] →
+//!   [`filter`] → [`simulation`] → [`realization`], [`ensemble`] → [`stats`], [`checks`] →
+//!   [`study`], [`sensitivity`] → [`export`], [`plot`] → [`report`]. [`calibrate`] runs the
+//!   filter and a smoother over recorded logs ([`likelihood`] estimates their noise statistics);
+//!   [`logs`] writes those of a simulated run.
+//! - Three axes, a whole IMU from GNSS: [`input`] reads the recordings (CSV, MCAP, ROS 1 and ROS 2
+//!   bags); [`ins`] is the navigation layer (the Earth, the strapdown mechanization, the
+//!   error-state filter and its measurements, one driver for every run, the Monte Carlo
+//!   ensemble); [`calibrate::imu`] calibrates a recording (`calibrate --imu`); [`report`] writes
+//!   both worlds' pages. [`allan`] measures the noise terms of a static log ([`allan::imu`]: each
+//!   channel of an IMU).
+//!
+//! [`format`](mod@format), [`output`], [`progress`], [`error`], [`lanes`] and [`random`] are
+//! leaves every step may use. The `accelcal` binary (`src/main.rs`) parses the command line and
+//! calls the library; `docs/ARCHITECTURE.md` is the map.
 #![warn(missing_docs)]
 
 pub mod allan;

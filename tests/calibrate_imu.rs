@@ -11,8 +11,8 @@ use accelcal::calibrate::imu::smoother::smooth;
 use accelcal::calibrate::imu::summary::{Summary, summary};
 use accelcal::config::ins::{Axes, InsConfig};
 use accelcal::input::csv::read::LogText;
-use accelcal::ins::logs::write_realization;
-use accelcal::ins::setup::Study;
+use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::write_realization;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 
@@ -32,13 +32,13 @@ struct Recording {
     middle: (f64, [f64; 6]),
 }
 
-fn study() -> Study {
-    Study::from_config(&InsConfig::default()).expect("the default study is valid")
+fn scenario() -> Scenario {
+    Scenario::from_config(&InsConfig::default()).expect("the default scenario is valid")
 }
 
-fn recording(study: &Study, index: u64) -> Recording {
+fn recording(scenario: &Scenario, index: u64) -> Recording {
     let (mut imu, mut gnss, mut truth) = (Vec::new(), Vec::new(), Vec::new());
-    write_realization(study, index, &mut imu, &mut gnss, &mut truth).expect("in memory");
+    write_realization(scenario, index, &mut imu, &mut gnss, &mut truth).expect("in memory");
     let truth = String::from_utf8(truth).expect("text");
     let row =
         |l: &str| -> Vec<f64> { l.split(',').map(|f| f.parse().expect("a number")).collect() };
@@ -105,12 +105,12 @@ fn z_scores(s: &Summary, truth: &[f64; 6]) -> [f64; 6] {
 /// (the half-width control) fall below it; every smoothed σ at most the filtered one.
 #[test]
 fn biases_are_within_their_sigmas_over_many_recordings() {
-    let study = study();
-    let settings = settings_of(&study);
+    let scenario = scenario();
+    let settings = settings_of(&scenario);
     let runs: Vec<([f64; 6], [f64; 6], bool)> = (0..RECORDINGS)
         .into_par_iter()
         .map(|i| {
-            let r = recording(&study, i);
+            let r = recording(&scenario, i);
             let c = calibrated(&r.imu, &r.gnss, &settings);
             let (zs, tighter) = smoothed_z(&c, r.middle.0, &r.middle.1);
             (
@@ -154,9 +154,9 @@ fn biases_are_within_their_sigmas_over_many_recordings() {
 /// same summary bit for bit; written as increments, the same biases to 10⁻⁹ relative.
 #[test]
 fn other_forms_of_one_recording_give_its_numbers() {
-    let study = study();
-    let settings = settings_of(&study);
-    let r = recording(&study, 7);
+    let scenario = scenario();
+    let settings = settings_of(&scenario);
+    let r = recording(&scenario, 7);
     let base = run(&r.imu, &r.gnss, &settings);
     let json = |s: &Summary| {
         let mut v = serde_json::to_value(s).expect("json");
@@ -210,7 +210,7 @@ fn other_forms_of_one_recording_give_its_numbers() {
     let mut inc = String::from("t_s,dvx_m_s,dvy_m_s,dvz_m_s,dthx_rad,dthy_rad,dthz_rad\n");
     for l in r.imu.lines().skip(1) {
         let f: Vec<f64> = l.split(',').map(|x| x.parse().expect("number")).collect();
-        let dt = previous.map_or(1.0 / study.imu_rate_hz, |p| f[0] - p);
+        let dt = previous.map_or(1.0 / scenario.imu_rate_hz, |p| f[0] - p);
         previous = Some(f[0]);
         inc += &format!("{}", f[0]);
         for x in &f[1..] {
@@ -243,10 +243,10 @@ fn other_forms_of_one_recording_give_its_numbers() {
 /// their σ's no smaller than with every fix.
 #[test]
 fn missing_fixes_leave_the_biases_within_their_sigmas() {
-    let study = study();
-    let settings = settings_of(&study);
+    let scenario = scenario();
+    let settings = settings_of(&scenario);
     for i in 0..8 {
-        let r = recording(&study, 100 + i);
+        let r = recording(&scenario, 100 + i);
         let base = run(&r.imu, &r.gnss, &settings);
         let thinned: String = r
             .gnss
@@ -276,9 +276,9 @@ fn noise_estimate_finds_the_receivers_sigma_and_no_offset() {
     // The drive's first 240 s (three turns, two climbs, four speed changes) keep it quick.
     let mut config = InsConfig::default();
     config.drive.duration_s = 240.0;
-    let study = Study::from_config(&config).expect("valid");
-    let truth = settings_of(&study);
-    let r = recording(&study, 11);
+    let scenario = Scenario::from_config(&config).expect("valid");
+    let truth = settings_of(&scenario);
+    let r = recording(&scenario, 11);
     let start = Settings {
         gnss_position_sigma_m: [3.0, 3.0, 2.0],
         ..truth

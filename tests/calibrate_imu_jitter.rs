@@ -16,8 +16,8 @@ use accelcal::calibrate::imu::run::calibrate;
 use accelcal::calibrate::imu::summary::{Summary, summary};
 use accelcal::config::ins::InsConfig;
 use accelcal::input::csv::read::LogText;
-use accelcal::ins::logs::write_realization;
-use accelcal::ins::setup::Study;
+use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::write_realization;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 
@@ -43,11 +43,11 @@ struct Recording {
     truth: Vec<[f64; 6]>,
 }
 
-fn study() -> Study {
+fn scenario() -> Scenario {
     let mut config = InsConfig::default();
     config.imu.imu_rate_hz = FINE_RATE_HZ;
     config.drive.duration_s = DURATION_S;
-    Study::from_config(&config).expect("a valid study")
+    Scenario::from_config(&config).expect("a valid scenario")
 }
 
 fn numbers(line: &str) -> Vec<f64> {
@@ -56,9 +56,9 @@ fn numbers(line: &str) -> Vec<f64> {
         .collect()
 }
 
-fn recording(study: &Study, index: u64) -> Recording {
+fn recording(scenario: &Scenario, index: u64) -> Recording {
     let (mut imu, mut gnss, mut truth) = (Vec::new(), Vec::new(), Vec::new());
-    write_realization(study, index, &mut imu, &mut gnss, &mut truth).expect("in memory");
+    write_realization(scenario, index, &mut imu, &mut gnss, &mut truth).expect("in memory");
     let imu = String::from_utf8(imu).expect("text");
     let truth = String::from_utf8(truth).expect("text");
     Recording {
@@ -165,12 +165,12 @@ fn fixes_between(imu: &str, gnss: &str) -> (usize, usize) {
 /// band's floor on every axis.
 #[test]
 fn jittered_recordings_cover_the_truth() {
-    let study = study();
-    let settings = settings_of(&study);
+    let scenario = scenario();
+    let settings = settings_of(&scenario);
     let z: Vec<[f64; 6]> = (0..RECORDINGS)
         .into_par_iter()
         .map(|i| {
-            let r = recording(&study, i);
+            let r = recording(&scenario, i);
             let (imu, end) = jittered(&r.rows, 1000 + i);
             if i == 0 {
                 let (between, fixes) = fixes_between(&imu, &r.gnss);
@@ -206,9 +206,9 @@ fn jittered_recordings_cover_the_truth() {
 /// differ from this one's by more than 0.1σ on some axis, so the check can fail.
 #[test]
 fn jitter_leaves_the_biases_of_one_recording() {
-    let study = study();
-    let settings = settings_of(&study);
-    let r = recording(&study, 77);
+    let scenario = scenario();
+    let settings = settings_of(&scenario);
+    let r = recording(&scenario, 77);
     let (regular, _) = aggregate(&r.rows, || 3);
     let (between, _) = fixes_between(&regular, &r.gnss);
     assert_eq!(between, 0, "groups of 3 put every fix on a sample");
@@ -221,7 +221,7 @@ fn jitter_leaves_the_biases_of_one_recording() {
         .fold(0.0, f64::max);
     eprintln!("regular against jittered: largest difference {worst:.4}σ");
     assert!(worst <= 0.1, "jitter moves a bias by {worst}σ");
-    let other = recording(&study, 78);
+    let other = recording(&scenario, 78);
     let c = biases(&run(
         &aggregate(&other.rows, || 3).0,
         &other.gnss,
@@ -241,9 +241,9 @@ fn jitter_leaves_the_biases_of_one_recording() {
 fn a_dropped_imu_row_is_refused_with_its_line() {
     let mut config = InsConfig::default();
     config.drive.duration_s = 90.0;
-    let study = Study::from_config(&config).expect("a valid study");
+    let scenario = Scenario::from_config(&config).expect("a valid scenario");
     let (mut imu, mut gnss, mut truth) = (Vec::new(), Vec::new(), Vec::new());
-    write_realization(&study, 3, &mut imu, &mut gnss, &mut truth).expect("in memory");
+    write_realization(&scenario, 3, &mut imu, &mut gnss, &mut truth).expect("in memory");
     let imu = String::from_utf8(imu).expect("text");
     let dir = tempfile::tempdir().expect("a temporary directory");
     std::fs::write(dir.path().join("gnss.csv"), gnss).expect("written");

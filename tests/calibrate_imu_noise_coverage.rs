@@ -10,8 +10,8 @@ use accelcal::config::ins::InsConfig;
 use accelcal::input::csv::read::LogText;
 use accelcal::input::gnss_csv::read_gnss;
 use accelcal::input::imu_csv::read_steps;
-use accelcal::ins::logs::write_realization;
-use accelcal::ins::setup::Study;
+use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::write_realization;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 
@@ -27,10 +27,10 @@ const KEYS: [ImuKey; 3] = [
 ];
 
 /// Per key: whether the interval held the truth, and whether its half-width version did.
-fn covered(study: &Study, index: u64) -> Vec<(bool, bool)> {
-    let truth = settings_of(study);
+fn covered(scenario: &Scenario, index: u64) -> Vec<(bool, bool)> {
+    let truth = settings_of(scenario);
     let (mut imu, mut gnss, mut t) = (Vec::new(), Vec::new(), Vec::new());
-    write_realization(study, index, &mut imu, &mut gnss, &mut t).expect("in memory");
+    write_realization(scenario, index, &mut imu, &mut gnss, &mut t).expect("in memory");
     let rows = read_gnss(&LogText::new("gnss.csv", gnss)).expect("reads");
     let (steps, span, _) = read_steps(&LogText::new("imu.csv", imu), truth.axes).expect("reads");
     // The search starts away from the truth: the σ's doubled and halved, 50 ms of offset.
@@ -65,11 +65,11 @@ fn noise_intervals_cover_the_truth_over_many_recordings() {
     let mut config = InsConfig::default();
     config.drive.duration_s = 240.0;
     config.imu.imu_rate_hz = 100.0;
-    let study = Study::from_config(&config).expect("valid");
+    let scenario = Scenario::from_config(&config).expect("valid");
     let started = std::time::Instant::now();
     let all: Vec<Vec<(bool, bool)>> = (0..RECORDINGS)
         .into_par_iter()
-        .map(|i| covered(&study, 1000 + i))
+        .map(|i| covered(&scenario, 1000 + i))
         .collect();
     let (lo, hi) = band(RECORDINGS, 0.95, FALSE_ALARM / KEYS.len() as f64);
     eprintln!(

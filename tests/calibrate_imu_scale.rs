@@ -13,8 +13,8 @@ use accelcal::calibrate::imu::triad::Triad;
 use accelcal::config::ins::InsConfig;
 use accelcal::input::csv::read::LogText;
 use accelcal::ins::error_state::STATES_WITH_SCALE;
-use accelcal::ins::logs::write_realization;
-use accelcal::ins::setup::Study;
+use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::write_realization;
 use common::imu::{band, settings_of};
 use rayon::prelude::*;
 
@@ -27,29 +27,29 @@ const FALSE_ALARM: f64 = 0.01;
 /// The scale factors' σ of the simulated IMU, ppm.
 const SCALE_PPM: f64 = 3000.0;
 
-fn study(duration_s: f64) -> Study {
+fn scenario(duration_s: f64) -> Scenario {
     let mut c = InsConfig::default();
     c.drive.duration_s = duration_s;
     c.imu.gyro_scale_factor_sigma_ppm = SCALE_PPM;
     c.imu.accel_scale_factor_sigma_ppm = SCALE_PPM;
-    Study::from_config(&c).expect("a valid study")
+    Scenario::from_config(&c).expect("a valid scenario")
 }
 
 /// The assumptions of the simulated sensors with the scale factors estimated.
-fn settings(study: &Study) -> Settings {
+fn settings(scenario: &Scenario) -> Settings {
     Settings {
         error_states: STATES_WITH_SCALE,
         gyro_scale_factor_sigma_ppm: SCALE_PPM,
         accel_scale_factor_sigma_ppm: SCALE_PPM,
-        ..settings_of(study)
+        ..settings_of(scenario)
     }
 }
 
 /// Recording `index` calibrated with 21 states, and the truth at its end: the six biases (gyro
 /// rad/s, accelerometer m/s²), then the six scale factors (ppm).
-fn calibrated(study: &Study, index: u64) -> (Summary, [f64; 12]) {
+fn calibrated(scenario: &Scenario, index: u64) -> (Summary, [f64; 12]) {
     let (mut imu, mut gnss, mut truth) = (Vec::new(), Vec::new(), Vec::new());
-    write_realization(study, index, &mut imu, &mut gnss, &mut truth).expect("in memory");
+    write_realization(scenario, index, &mut imu, &mut gnss, &mut truth).expect("in memory");
     let truth = String::from_utf8(truth).expect("text");
     let header: Vec<&str> = truth.lines().next().expect("a header").split(',').collect();
     assert_eq!(header.len(), 22, "the truth has its scale factors");
@@ -60,7 +60,7 @@ fn calibrated(study: &Study, index: u64) -> (Summary, [f64; 12]) {
         .split(',')
         .map(|f| f.parse().expect("a number"))
         .collect();
-    let s = settings(study);
+    let s = settings(scenario);
     let c = calibrate_of::<STATES_WITH_SCALE>(
         &LogText::new("imu.csv", imu),
         &LogText::new("gnss.csv", gnss),
@@ -83,11 +83,11 @@ fn triads(s: &Summary) -> [(&Triad, usize); 12] {
 
 #[test]
 fn biases_and_scale_factors_are_within_their_sigmas_over_many_recordings() {
-    let study = study(600.0);
+    let scenario = scenario(600.0);
     let z: Vec<[f64; 12]> = (0..RECORDINGS)
         .into_par_iter()
         .map(|index| {
-            let (s, truth) = calibrated(&study, index);
+            let (s, truth) = calibrated(&scenario, index);
             let t = triads(&s);
             std::array::from_fn(|k| {
                 let (triad, i) = t[k];
@@ -121,7 +121,7 @@ fn biases_and_scale_factors_are_within_their_sigmas_over_many_recordings() {
 #[test]
 fn a_level_drive_without_turns_leaves_the_gyros_scale_factors_undetermined() {
     // The drive's first minute: at rest, then a speed change, straight and level throughout.
-    let (level, _) = calibrated(&study(60.0), 0);
+    let (level, _) = calibrated(&scenario(60.0), 0);
     let gyro = level.gyro_scale_factor_ppm.as_ref().expect("estimated");
     assert_eq!(gyro.identifiable, [false; 3], "{gyro:?}");
     assert!(
@@ -134,7 +134,7 @@ fn a_level_drive_without_turns_leaves_the_gyros_scale_factors_undetermined() {
     );
     // The whole drive turns by 90°, −180° and 135°: the vertical gyro's scale factor is then
     // determined (the flag can be true).
-    let (whole, _) = calibrated(&study(600.0), 0);
+    let (whole, _) = calibrated(&scenario(600.0), 0);
     let gyro = whole.gyro_scale_factor_ppm.as_ref().expect("estimated");
     assert!(gyro.identifiable[2], "{gyro:?}");
     eprintln!(
@@ -150,9 +150,9 @@ fn a_level_drive_without_turns_leaves_the_gyros_scale_factors_undetermined() {
 #[test]
 fn a_bad_error_state_is_refused_with_its_key_and_line() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let study = study(60.0);
+    let scenario = scenario(60.0);
     let (mut imu, mut gnss, mut truth) = (Vec::new(), Vec::new(), Vec::new());
-    write_realization(&study, 0, &mut imu, &mut gnss, &mut truth).expect("in memory");
+    write_realization(&scenario, 0, &mut imu, &mut gnss, &mut truth).expect("in memory");
     std::fs::write(dir.path().join("imu.csv"), imu).expect("written");
     std::fs::write(dir.path().join("gnss.csv"), gnss).expect("written");
     for (text, key) in [

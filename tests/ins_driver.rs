@@ -18,9 +18,9 @@ use accelcal::ins::ensemble::{SimulatedGnss, SimulatedImu, Track, error, start};
 use accelcal::ins::error_state::{ACCEL_BIAS, GYRO_BIAS, POSITION, STATES, Square};
 use accelcal::ins::filter::Ekf;
 use accelcal::ins::gnss::FixUpdate;
-use accelcal::ins::logs::fix;
 use accelcal::ins::measurement::{Gate, Measurement};
-use accelcal::ins::setup::Study;
+use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::fix;
 use common::imu::band;
 use nalgebra::{SVector, Vector3};
 use rayon::prelude::*;
@@ -30,11 +30,11 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 const ALPHA: f64 = 0.01;
 
 /// A study of the default drive's first `duration_s` seconds.
-fn study(duration_s: f64, edit: impl FnOnce(&mut InsConfig)) -> Study {
+fn study(duration_s: f64, edit: impl FnOnce(&mut InsConfig)) -> Scenario {
     let mut c = InsConfig::default();
     c.drive.duration_s = duration_s;
     edit(&mut c);
-    Study::from_config(&c).expect("a valid study")
+    Scenario::from_config(&c).expect("a valid scenario")
 }
 
 /// The simulated receiver with every `every`-th fix (from fix `offset`) moved north by
@@ -55,12 +55,12 @@ impl Source<STATES, SimulatedImu<'_>> for Moved {
         let t = Source::<STATES, SimulatedImu<'_>>::next_time(&self.inner).expect("due");
         let k = self.inner.given;
         self.inner.given += 1;
-        let (study, pva) = (imu.study, *imu.truth());
-        let mut reading = fix(study, &imu.drive, &mut imu.imu, t, &pva);
-        reading.position_sigma_m = study.filter_gnss.position_sigma_m;
-        reading.velocity_sigma_m_s = study.filter_gnss.velocity_sigma_m_s;
+        let (scenario, pva) = (imu.scenario, *imu.truth());
+        let mut reading = fix(scenario, &imu.drive, &mut imu.imu, t, &pva);
+        reading.position_sigma_m = scenario.filter_gnss.position_sigma_m;
+        reading.velocity_sigma_m_s = scenario.filter_gnss.velocity_sigma_m_s;
         if k % self.every == self.offset {
-            let north = self.sigmas * study.truth_gnss.position_sigma_m.x;
+            let north = self.sigmas * scenario.truth_gnss.position_sigma_m.x;
             reading.position = offset(&reading.position, &Vector3::new(north, 0.0, 0.0));
         }
         Box::new(FixUpdate::whole(reading))
@@ -110,10 +110,10 @@ impl Observer<STATES, SimulatedImu<'_>> for Seen {
     }
 }
 
-/// Realization `index` of `study` through the driver with `gate`, `outages` and the receiver
+/// Realization `index` of `scenario` through the driver with `gate`, `outages` and the receiver
 /// `gnss` (`None`: the simulated one); the filter at the end and what the observer saw.
 fn run(
-    study: &Study,
+    scenario: &Scenario,
     track: &Track,
     index: u64,
     gate: Option<Gate>,
@@ -121,20 +121,20 @@ fn run(
     moved: Option<(usize, usize, f64)>,
     watch_s: f64,
 ) -> (Ekf, Seen) {
-    let (imu, mut ekf) = start::<STATES>(study, track, index);
+    let (imu, mut ekf) = start::<STATES>(scenario, track, index);
     let mut sim = SimulatedImu {
-        study,
+        scenario,
         track,
-        drive: study.drive(),
+        drive: scenario.drive(),
         imu,
         steps: 0,
     };
-    let inner = SimulatedGnss::of(study, track);
+    let inner = SimulatedGnss::of(scenario, track);
     let mut seen = Seen {
         watch_s,
         ..Seen::default()
     };
-    let mut plain = SimulatedGnss::of(study, track);
+    let mut plain = SimulatedGnss::of(scenario, track);
     let mut shifted;
     let source: &mut dyn Source<STATES, SimulatedImu> = match moved {
         Some((every, offset, sigmas)) => {
@@ -211,7 +211,7 @@ fn the_gate_rejects_every_moved_fix_and_the_biases_stay() {
 }
 
 /// The fixes tested and rejected over `drives` drives of `s`, gated at [`ALPHA`].
-fn rejections(s: &Study, drives: u64) -> (u64, u64) {
+fn rejections(s: &Scenario, drives: u64) -> (u64, u64) {
     let track = Track::of(s);
     let gate = Some(Gate::new(ALPHA));
     (0..drives)
@@ -254,7 +254,7 @@ fn the_gate_rejects_consistent_fixes_at_its_rate() {
 
 /// The position NEES at the first fix after a 60 s outage summed over `n` realizations, and
 /// the median growth of the north σ over the outage.
-fn outage_nees(s: &Study, n: u64) -> (f64, f64) {
+fn outage_nees(s: &Scenario, n: u64) -> (f64, f64) {
     let track = Track::of(s);
     let outage = Outage {
         source: 0,

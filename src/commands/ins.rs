@@ -17,9 +17,9 @@ use accelcal::export;
 use accelcal::ins::blocks;
 use accelcal::ins::ensemble::{self as ins_ensemble, InsSums, Track};
 use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
-use accelcal::ins::logs::write_realization;
 use accelcal::ins::partial::{self, InsPartialHeader, MergedSums};
-use accelcal::ins::setup::Study;
+use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::write_realization;
 use accelcal::output::{AtomicFile, ScratchFile, StagedFiles, check_directory};
 use accelcal::study::Progress;
 
@@ -33,13 +33,13 @@ const IMU_FILE: &str = "imu.csv";
 const GNSS_FILE: &str = "gnss.csv";
 const TRUTH_FILE: &str = "truth.csv";
 
-/// The three-axis study named by `args` (`--config`, `--seed`), validated.
-pub(super) fn load_study(args: &ModelArgs) -> Result<Study, ConfigError> {
+/// The three-axis scenario named by `args` (`--config`, `--seed`), validated.
+pub(super) fn load_scenario(args: &ModelArgs) -> Result<Scenario, ConfigError> {
     load(args, None).map(|(_, s)| s)
 }
 
-/// The configuration and study named by `args`, `realizations` overriding the file's.
-fn load(args: &ModelArgs, realizations: Option<u64>) -> Result<(InsConfig, Study), ConfigError> {
+/// The configuration and scenario named by `args`, `realizations` overriding the file's.
+fn load(args: &ModelArgs, realizations: Option<u64>) -> Result<(InsConfig, Scenario), ConfigError> {
     let text = args.config.as_deref().map(ConfigText::read).transpose()?;
     let locate = |e: ConfigError| match &text {
         Some(t) => t.locate(e),
@@ -56,7 +56,7 @@ fn load(args: &ModelArgs, realizations: Option<u64>) -> Result<(InsConfig, Study
         config.ensemble.realizations = n;
     }
     // A value set on the command line is not the file's: its error points at no line.
-    let study = Study::from_config(&config).map_err(|e| match &e {
+    let scenario = Scenario::from_config(&config).map_err(|e| match &e {
         ConfigError::Invalid { field, .. }
             if *field == "ensemble.realizations" && realizations.is_some() =>
         {
@@ -64,7 +64,7 @@ fn load(args: &ModelArgs, realizations: Option<u64>) -> Result<(InsConfig, Study
         }
         _ => locate(e),
     })?;
-    Ok((config, study))
+    Ok((config, scenario))
 }
 
 /// `ensemble --model ins`: N realizations of the drive, the check catalogue on each
@@ -87,10 +87,10 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         )
         .into());
     }
-    let (config, study) = load(&args.model, args.realizations)?;
-    let bytes = ins_ensemble::memory_bytes(&study);
+    let (config, scenario) = load(&args.model, args.realizations)?;
+    let bytes = ins_ensemble::memory_bytes(&scenario);
     if bytes > MAX_ENSEMBLE_BYTES {
-        let fixes = study.duration_s * study.imu_rate_hz / study.imu_steps_per_fix as f64;
+        let fixes = scenario.duration_s * scenario.imu_rate_hz / scenario.imu_steps_per_fix as f64;
         return Err(ConfigError::invalid(
             "gnss.gnss_rate_hz",
             config.gnss.gnss_rate_hz,
@@ -104,35 +104,39 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         .into());
     }
     if let (Some(shard), Some(path)) = (&args.shard, &args.partial) {
-        return if study.error_states > STATES {
-            run_shard::<STATES_WITH_SCALE>(&config, &study, shard, path, args.model.quiet)
+        return if scenario.error_states > STATES {
+            run_shard::<STATES_WITH_SCALE>(&config, &scenario, shard, path, args.model.quiet)
         } else {
-            run_shard::<STATES>(&config, &study, shard, path, args.model.quiet)
+            run_shard::<STATES>(&config, &scenario, shard, path, args.model.quiet)
         };
     }
     if let Some(path) = &args.json {
         accelcal::output::check_file(path)?;
     }
-    if study.error_states > STATES {
-        run_whole::<STATES_WITH_SCALE>(args, &config, &study)
+    if scenario.error_states > STATES {
+        run_whole::<STATES_WITH_SCALE>(args, &config, &scenario)
     } else {
-        run_whole::<STATES>(args, &config, &study)
+        run_whole::<STATES>(args, &config, &scenario)
     }
 }
 
-/// The whole ensemble of `study` with an error state of `N`, in one process, and its JSON.
-fn run_whole<const N: usize>(args: &EnsembleArgs, config: &InsConfig, study: &Study) -> Result<()> {
+/// The whole ensemble of `scenario` with an error state of `N`, in one process, and its JSON.
+fn run_whole<const N: usize>(
+    args: &EnsembleArgs,
+    config: &InsConfig,
+    scenario: &Scenario,
+) -> Result<()> {
     let start = std::time::Instant::now();
-    let track = Track::of(study);
-    let n = study.realizations;
+    let track = Track::of(scenario);
+    let n = scenario.realizations;
     let mut bar = super::Bar::new(args.model.quiet);
     bar.start("ins", n);
-    let sums = ins_ensemble::sums::<N>(study, &track, n, |done| bar.advance(done))?;
+    let sums = ins_ensemble::sums::<N>(scenario, &track, n, |done| bar.advance(done))?;
     bar.finish();
     let elapsed_s = start.elapsed().as_secs_f64();
     write_document(
         config,
-        study,
+        scenario,
         &sums,
         elapsed_s,
         args.json.as_deref(),
@@ -144,20 +148,20 @@ fn run_whole<const N: usize>(args: &EnsembleArgs, config: &InsConfig, study: &St
 /// its checks' lines, labelled `label` (none when `None`), when it goes to a file.
 fn write_document<const N: usize>(
     config: &InsConfig,
-    study: &Study,
+    scenario: &Scenario,
     sums: &InsSums<N>,
     elapsed_s: f64,
     json: Option<&Path>,
     label: Option<&str>,
 ) -> Result<()> {
-    let outcome = sums.outcome(study);
-    let verdicts = evaluate(&outcome.stats, &Budget::study(study.false_alarm_rate));
+    let outcome = sums.outcome(scenario);
+    let verdicts = evaluate(&outcome.stats, &Budget::study(scenario.false_alarm_rate));
     let doc = export::ins::document(config, &outcome, &verdicts, elapsed_s);
     super::write_json(json, |w| {
         serde_json::to_writer_pretty(w, &doc).map_err(std::io::Error::from)
     })?;
     if let (Some(_), Some(label)) = (json, label) {
-        let n = study.realizations;
+        let n = scenario.realizations;
         let mut lines = super::check_lines(label, n, n as f64 / elapsed_s, &verdicts);
         for c in &doc.summary.checks {
             if let Some(first) = &c.first_failure_member {
@@ -173,12 +177,12 @@ fn write_document<const N: usize>(
 /// written to `path` (see docs/CLUSTER.md).
 fn run_shard<const N: usize>(
     config: &InsConfig,
-    study: &Study,
+    scenario: &Scenario,
     shard: &str,
     path: &Path,
     quiet: bool,
 ) -> Result<()> {
-    let blocks = blocks::partition(study.realizations);
+    let blocks = blocks::partition(scenario.realizations);
     let shard = super::shards::parse_shard(shard, blocks.blocks, blocks.realizations)?;
     let range = blocks.shard_blocks(shard);
     let realizations = range
@@ -193,12 +197,12 @@ fn run_shard<const N: usize>(
     let (spool, spool_file) = ScratchFile::beside(path, "blocks")?;
     let mut spool_w = std::io::BufWriter::new(spool_file);
     let start = std::time::Instant::now();
-    let track = Track::of(study);
+    let track = Track::of(scenario);
     let mut bar = super::Bar::new(quiet);
     bar.start(&format!("ins shard {k}/{m}"), realizations);
     let mut written = Ok(());
     ins_ensemble::run_blocks::<N>(
-        study,
+        scenario,
         &track,
         &blocks,
         range.clone(),
@@ -210,7 +214,7 @@ fn run_shard<const N: usize>(
         },
     )?;
     bar.finish();
-    let empty = ins_ensemble::empty_sums::<N>(study, &track);
+    let empty = ins_ensemble::empty_sums::<N>(scenario, &track);
     let elapsed_s = start.elapsed().as_secs_f64();
     let header = InsPartialHeader::new(config, &empty, shard, range.clone(), elapsed_s);
     written
@@ -270,7 +274,7 @@ pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
     let label = (!args.quiet).then_some(label.as_str());
     let (c, s, t, json) = (
         &merged.config,
-        &merged.study,
+        &merged.scenario,
         merged.elapsed_s,
         args.json.as_deref(),
     );
@@ -306,7 +310,7 @@ pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
         )
         .into());
     };
-    let study = load_study(&args.model)?;
+    let scenario = load_scenario(&args.model)?;
     let names = [IMU_FILE, GNSS_FILE, TRUTH_FILE];
     check_directory(dir, &names)?;
     let mut staged = StagedFiles::create(dir, &names)?;
@@ -315,7 +319,7 @@ pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
             .writers()
             .try_into()
             .map_err(|_| anyhow::anyhow!("three staged log files"))?;
-        write_realization(&study, args.realization, imu, gnss, truth)?
+        write_realization(&scenario, args.realization, imu, gnss, truth)?
     };
     staged.commit()?;
     let deg_h = |x: f64| (x * 3600.0).to_degrees();
@@ -325,8 +329,8 @@ pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
          accelerometer biases {:.3}, {:.3}, {:.3} mg at the start; {} IMU samples and {} fixes \
          written to {} ({IMU_FILE}, {GNSS_FILE}, {TRUTH_FILE})\n",
         args.realization,
-        study.duration_s,
-        study.imu_rate_hz,
+        scenario.duration_s,
+        scenario.imu_rate_hz,
         deg_h(g.x),
         deg_h(g.y),
         deg_h(g.z),

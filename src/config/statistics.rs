@@ -11,7 +11,8 @@
 //! keys (`likelihood::Key`) and the report's parameter table (`report::params`).
 //!
 //! Adding a statistic takes its row here, its fields in the configuration's sections (and in
-//! [`NoiseStats`] with its use in Q or R when the model uses it): see `ARCHITECTURE.md`.
+//! [`NoiseStats`] with its use in Q or R when the model uses it); `tests/statistic_registry.rs`
+//! adds one so (`--features throwaway-statistic`) and finds it in each of those places.
 
 mod table;
 

@@ -7,7 +7,7 @@
 //! # Format
 //! The CSV text of [`super::csv`]; the columns are [`Channel::column`]'s (`ax_m_s2`, …,
 //! `gz_rad_s`: specific force in m/s², angular rate in rad/s), those of the three-axis study's
-//! `imu.csv` (`ins::logs`).
+//! `imu.csv` (`ins::simulated_logs`).
 
 use super::csv::read::{CsvReader, LogSource};
 use super::csv::static_log::read_static_log;

@@ -53,7 +53,7 @@ impl Channel {
         Channel::Gz,
     ];
 
-    /// The column of the three-axis log (`ins::logs`' imu.csv).
+    /// The column of the three-axis log (`ins::simulated_logs`' imu.csv).
     pub fn column(self) -> &'static str {
         match self {
             Channel::Ax => "ax_m_s2",

@@ -25,7 +25,7 @@ use super::filter::{Ekf, FilterError};
 use super::gnss;
 use super::mech::{Increment, Pva};
 use super::sensors::Imu;
-use super::setup::Study;
+use super::setup::Scenario;
 use super::truth::Truth;
 use crate::ensemble::Partition;
 use crate::progress::{Cancel, Cancelled};
@@ -100,10 +100,10 @@ impl<const N: usize> InsSums<N> {
         }
     }
 
-    /// The statistics the checks read and the calibration, for the ensemble of `study`.
-    pub fn outcome(&self, study: &Study) -> Outcome<N> {
+    /// The statistics the checks read and the calibration, for the ensemble of `scenario`.
+    pub fn outcome(&self, scenario: &Scenario) -> Outcome<N> {
         Outcome {
-            stats: self.normalized.stats(constant_states(study)),
+            stats: self.normalized.stats(constant_states(scenario)),
             calibration: self.calibration(),
         }
     }
@@ -142,11 +142,11 @@ pub struct Track {
 }
 
 impl Track {
-    /// The truth of `study`'s drive.
-    pub fn of(study: &Study) -> Self {
-        let drive = study.drive();
-        let truth =
-            Truth::new(&drive, study.start, 1.0 / study.imu_rate_hz).until(study.duration_s);
+    /// The truth of `scenario`'s drive.
+    pub fn of(scenario: &Scenario) -> Self {
+        let drive = scenario.drive();
+        let truth = Truth::new(&drive, scenario.start, 1.0 / scenario.imu_rate_hz)
+            .until(scenario.duration_s);
         let start = truth.pva();
         Track {
             start,
@@ -205,10 +205,10 @@ impl From<std::convert::Infallible> for RealizationError {
     }
 }
 
-/// The fixes' times of `study`, s.
-pub fn fix_times_s(study: &Study, track: &Track) -> Vec<f64> {
-    (1..=track.steps.len() / study.imu_steps_per_fix)
-        .map(|i| (i * study.imu_steps_per_fix) as f64 / study.imu_rate_hz)
+/// The fixes' times of `scenario`, s.
+pub fn fix_times_s(scenario: &Scenario, track: &Track) -> Vec<f64> {
+    (1..=track.steps.len() / scenario.imu_steps_per_fix)
+        .map(|i| (i * scenario.imu_steps_per_fix) as f64 / scenario.imu_rate_hz)
         .collect()
 }
 
@@ -224,11 +224,11 @@ pub fn layout(fixes: usize, max_lag: Option<usize>) -> ResidualLayout {
     ResidualLayout::with_width(fixes, MEASURED, Some(max_lag.unwrap_or(DEFAULT_MAX_LAG)))
 }
 
-/// Empty sums for `study`'s ensemble.
-pub fn empty_sums<const N: usize>(study: &Study, track: &Track) -> InsSums<N> {
-    let times = fix_times_s(study, track);
+/// Empty sums for `scenario`'s ensemble.
+pub fn empty_sums<const N: usize>(scenario: &Scenario, track: &Track) -> InsSums<N> {
+    let times = fix_times_s(scenario, track);
     let n = times.len();
-    let layout = layout(n, study.residual_max_lag);
+    let layout = layout(n, scenario.residual_max_lag);
     InsSums {
         normalized: NormalizedSums::new(times, &layout, [0, n.saturating_sub(1)]),
         sq_error: SVector::zeros(),
@@ -237,14 +237,14 @@ pub fn empty_sums<const N: usize>(study: &Study, track: &Track) -> InsSums<N> {
     }
 }
 
-/// The sums of each block of `range` of an ensemble of `study` cut as `blocks`, handed to
+/// The sums of each block of `range` of an ensemble of `scenario` cut as `blocks`, handed to
 /// `on_block` in block order; `progress` is told how many realizations are done after every
 /// chunk.
 ///
 /// # Errors
 /// The first realization's [`RealizationError`], in index order.
 pub fn run_blocks<const N: usize>(
-    study: &Study,
+    scenario: &Scenario,
     track: &Track,
     blocks: &Partition,
     range: Range<u64>,
@@ -252,7 +252,7 @@ pub fn run_blocks<const N: usize>(
     on_block: impl FnMut(u64, &InsSums<N>),
 ) -> Result<(), RealizationError> {
     match try_run_blocks(
-        study,
+        scenario,
         track,
         blocks,
         range,
@@ -284,7 +284,7 @@ pub enum Stopped {
 /// [`Stopped::Realization`] with the first realization's error, in index order;
 /// [`Stopped::Cancelled`].
 pub fn try_run_blocks<const N: usize>(
-    study: &Study,
+    scenario: &Scenario,
     track: &Track,
     blocks: &Partition,
     range: Range<u64>,
@@ -294,7 +294,7 @@ pub fn try_run_blocks<const N: usize>(
 ) -> Result<(), Stopped> {
     let mut done = 0;
     for b in range {
-        let mut sums = empty_sums(study, track);
+        let mut sums = empty_sums(scenario, track);
         let indices = blocks.block_realizations(b);
         let mut first = indices.start;
         while first < indices.end {
@@ -302,7 +302,7 @@ pub fn try_run_blocks<const N: usize>(
             let last = (first + CHUNK).min(indices.end);
             let chunk: Vec<Result<Normalized<N>, RealizationError>> = (first..last)
                 .into_par_iter()
-                .map(|l| realization(study, track, l))
+                .map(|l| realization(scenario, track, l))
                 .collect();
             for r in chunk {
                 sums.add(&r?);
@@ -316,22 +316,29 @@ pub fn try_run_blocks<const N: usize>(
     Ok(())
 }
 
-/// The sums of the whole ensemble of `realizations` realizations of `study`: its blocks folded
+/// The sums of the whole ensemble of `realizations` realizations of `scenario`: its blocks folded
 /// in block order; `progress` is told how many are done after every chunk.
 ///
 /// # Errors
 /// The first realization's [`RealizationError`], in index order.
 pub fn sums<const N: usize>(
-    study: &Study,
+    scenario: &Scenario,
     track: &Track,
     realizations: u64,
     progress: impl FnMut(u64),
 ) -> Result<InsSums<N>, RealizationError> {
     let blocks = blocks::partition(realizations);
-    let mut total = empty_sums(study, track);
-    run_blocks(study, track, &blocks, 0..blocks.blocks, progress, |_, s| {
-        total.merge(s);
-    })?;
+    let mut total = empty_sums(scenario, track);
+    run_blocks(
+        scenario,
+        track,
+        &blocks,
+        0..blocks.blocks,
+        progress,
+        |_, s| {
+            total.merge(s);
+        },
+    )?;
     Ok(total)
 }
 
@@ -341,17 +348,17 @@ pub fn sums<const N: usize>(
 /// # Errors
 /// As [`try_run_blocks`].
 pub fn try_sums<const N: usize>(
-    study: &Study,
+    scenario: &Scenario,
     track: &Track,
     realizations: u64,
     progress: impl FnMut(u64),
     cancel: &Cancel,
 ) -> Result<InsSums<N>, Stopped> {
     let blocks = blocks::partition(realizations);
-    let mut total = empty_sums(study, track);
+    let mut total = empty_sums(scenario, track);
     let all = 0..blocks.blocks;
     try_run_blocks(
-        study,
+        scenario,
         track,
         &blocks,
         all,
@@ -364,9 +371,9 @@ pub fn try_sums<const N: usize>(
 
 /// Which error states do not move between fixes: a bias whose truth and filter both hold it
 /// constant, and the scale factors (constants in both).
-pub fn constant_states<const N: usize>(study: &Study) -> [bool; N] {
+pub fn constant_states<const N: usize>(scenario: &Scenario) -> [bool; N] {
     use super::sensors::BiasProcess::Constant;
-    let (t, f) = (&study.truth_imu, &study.filter_imu);
+    let (t, f) = (&scenario.truth_imu, &scenario.filter_imu);
     let gyro = matches!(t.gyro_bias, Constant { .. }) && matches!(f.gyro_bias, Constant { .. });
     let accel = matches!(t.accel_bias, Constant { .. }) && matches!(f.accel_bias, Constant { .. });
     std::array::from_fn(|k| {
@@ -376,14 +383,14 @@ pub fn constant_states<const N: usize>(study: &Study) -> [bool; N] {
     })
 }
 
-/// The ensemble's statistics over `realizations` realizations of `study` (indices 0 to N − 1).
+/// The ensemble's statistics over `realizations` realizations of `scenario` (indices 0 to N − 1).
 ///
 /// # Errors
 /// The first realization's [`RealizationError`], in index order.
 pub fn run<const N: usize>(
-    study: &Study,
+    scenario: &Scenario,
     track: &Track,
     realizations: u64,
 ) -> Result<Outcome<N>, RealizationError> {
-    Ok(sums(study, track, realizations, |_| {})?.outcome(study))
+    Ok(sums(scenario, track, realizations, |_| {})?.outcome(scenario))
 }

@@ -16,13 +16,13 @@ pub mod ensemble;
 pub mod error_state;
 pub mod filter;
 pub mod gnss;
-pub mod logs;
 pub mod measurement;
 pub mod mech;
 pub mod names;
 pub mod partial;
 pub mod sensors;
 pub mod setup;
+pub mod simulated_logs;
 pub mod truth;
 
 #[cfg(test)]

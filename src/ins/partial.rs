@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 use super::blocks;
 use super::ensemble::{InsSums, MEASURED, Track, empty_sums};
 use super::error_state::{STATES, STATES_WITH_SCALE};
-use super::setup::Study;
+use super::setup::Scenario;
 use crate::config::ins::InsConfig;
 use crate::ensemble::Partition;
 use crate::ensemble::partial::{
@@ -172,8 +172,8 @@ fn decode_block<const N: usize>(mut sums: InsSums<N>, count: u64, floats: &[f64]
 pub struct InsMerged {
     /// The ensemble's configuration.
     pub config: InsConfig,
-    /// The study it configures.
-    pub study: Study,
+    /// The scenario it configures.
+    pub scenario: Scenario,
     /// The sums of the whole ensemble, folded in block order.
     pub sums: MergedSums,
     /// The shards' run times added up, s.
@@ -236,38 +236,38 @@ pub fn merge<R: BufRead>(files: Vec<(String, R)>) -> Result<InsMerged, PartialEr
         return Err(mismatch("(none)", "no partial file given".to_string()));
     };
     let (first_name, first) = (first.name.clone(), first.header.clone());
-    let study = Study::from_config(&first.config).map_err(|e| {
+    let scenario = Scenario::from_config(&first.config).map_err(|e| {
         mismatch(
             &first_name,
             format!("the configuration in its header is not valid: {e}"),
         )
     })?;
-    let (sums, elapsed_s) = if study.error_states > STATES {
-        let (sums, t) = fold::<R, STATES_WITH_SCALE>(opened, &study, &first, &first_name)?;
+    let (sums, elapsed_s) = if scenario.error_states > STATES {
+        let (sums, t) = fold::<R, STATES_WITH_SCALE>(opened, &scenario, &first, &first_name)?;
         (MergedSums::Scales(sums), t)
     } else {
-        let (sums, t) = fold::<R, STATES>(opened, &study, &first, &first_name)?;
+        let (sums, t) = fold::<R, STATES>(opened, &scenario, &first, &first_name)?;
         (MergedSums::Biases(sums), t)
     };
     Ok(InsMerged {
         config: first.config,
-        study,
+        scenario,
         sums,
         elapsed_s,
     })
 }
 
 /// The shards `opened`, checked against the first's header `first` (of `first_name`), folded
-/// in block order into the sums of `study`'s ensemble over `N` error states; the shards' run
+/// in block order into the sums of `scenario`'s ensemble over `N` error states; the shards' run
 /// times added up.
 fn fold<R: BufRead, const N: usize>(
     mut opened: Vec<Opened<R>>,
-    study: &Study,
+    scenario: &Scenario,
     first: &InsPartialHeader,
     first_name: &str,
 ) -> Result<(InsSums<N>, f64), PartialError> {
-    let track = Track::of(study);
-    let empty = empty_sums::<N>(study, &track);
+    let track = Track::of(scenario);
+    let empty = empty_sums::<N>(scenario, &track);
     let made = InsPartialHeader::new(&first.config, &empty, Shard::WHOLE, 0..0, 0.0);
     if (made.fixes, made.max_lag) != (first.fixes, first.max_lag) {
         return Err(mismatch(
@@ -279,7 +279,7 @@ fn fold<R: BufRead, const N: usize>(
             ),
         ));
     }
-    let blocks = blocks::partition(study.realizations);
+    let blocks = blocks::partition(scenario.realizations);
     for o in &opened {
         if let Some(why) = differs(&o.header, first, first_name, &blocks) {
             return Err(mismatch(&o.name, why));

@@ -1,4 +1,4 @@
-//! The three-axis study as the configuration describes it: the drive, the true sensors and the
+//! The three-axis scenario as the configuration describes it: the drive, the true sensors and the
 //! sensors the filter assumes, in the navigation layer's types.
 
 use nalgebra::Vector3;
@@ -25,9 +25,9 @@ pub struct GnssModel {
     pub velocity_sigma_m_s: Vector3<f64>,
 }
 
-/// The validated study.
+/// The validated scenario.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Study {
+pub struct Scenario {
     /// The drive's length, s.
     pub duration_s: f64,
     /// Where it starts.
@@ -102,8 +102,8 @@ fn gnss_model(c: &GnssConfig) -> GnssModel {
     }
 }
 
-impl Study {
-    /// The study of a configuration, validated.
+impl Scenario {
+    /// The scenario of a configuration, validated.
     ///
     /// # Errors
     /// [`ConfigError::Invalid`] naming the first field out of its range.
@@ -113,7 +113,7 @@ impl Study {
         let i = &c.initial;
         let (p, v) = (i.position_sigma_m, i.velocity_sigma_m_s);
         let (tilt, yaw) = (i.tilt_sigma_deg.to_radians(), i.yaw_sigma_deg.to_radians());
-        Ok(Study {
+        Ok(Scenario {
             duration_s: c.drive.duration_s,
             start: Geodetic {
                 lat_rad: c.drive.start_lat_deg.to_radians(),

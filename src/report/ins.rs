@@ -9,13 +9,14 @@ use super::figures::figure;
 use super::kind::{Built, Context, Record, SectionKind, SectionView};
 use super::outline::{Figure, Label, Numbers, Table};
 use super::view::FigureView;
+use super::words::count_words;
 use super::{RenderError, ReportInput, rich};
-use crate::checks::{CheckId, Verdict, Verdicts};
+use crate::checks::{CATALOGUE, CheckId, Verdict, Verdicts};
 use crate::format::{count, fixed, sig};
 use crate::ins::names::{MEASUREMENTS, VARIABLES};
 use crate::plot::{self, TraceSeries};
 use crate::stats::binomial_band;
-use crate::study::ins::{Control, InsStudy, SCALE_PPM};
+use crate::study::ins::{Control, InsResults, SCALE_PPM};
 
 const TRACK: Figure = Figure::Named("ins-track");
 const TRACE: Figure = Figure::Named("ins-trace");
@@ -63,6 +64,8 @@ pub struct InsView {
     pub realizations: String,
     /// The drive's length, s.
     pub duration_s: String,
+    /// How many checks the catalogue holds, in words ("seven").
+    pub checks_count: String,
     /// The checks' names, the table's columns.
     pub checks: Vec<String>,
     /// The consistent filter, then the controls.
@@ -120,7 +123,7 @@ fn failed(v: &Verdicts) -> Vec<&'static str> {
 }
 
 /// What the consistent filter and each control show.
-fn findings(s: &InsStudy) -> String {
+fn findings(s: &InsResults) -> String {
     let mut out = String::new();
     let f = failed(&s.verdicts);
     out.push_str(&if f.is_empty() && s.verdicts.all_passed() {
@@ -195,7 +198,7 @@ fn since(first: Option<(&'static str, f64, String)>) -> String {
 ///
 /// # Errors
 /// [`RenderError`] when a figure cannot be drawn.
-pub fn view(s: &InsStudy, numbers: &Numbers) -> Result<InsView, RenderError> {
+pub fn view(s: &InsResults, numbers: &Numbers) -> Result<InsView, RenderError> {
     let col = |i: usize| -> Vec<f64> { s.track.iter().map(|p| p[i]).collect() };
     let track = figure(
         "fig-ins-track",
@@ -268,6 +271,7 @@ pub fn view(s: &InsStudy, numbers: &Numbers) -> Result<InsView, RenderError> {
         biases_table: numbers.table(BIASES),
         realizations: count(s.realizations),
         duration_s: fixed(s.config.drive.duration_s, 0),
+        checks_count: count_words(CATALOGUE.len()),
         checks: CheckId::ALL.iter().map(|c| c.name().to_string()).collect(),
         rows,
         biases,
@@ -289,7 +293,7 @@ pub struct InsRecord {
     pub final_sigma: Vec<(&'static str, f64, f64)>,
 }
 
-fn record(s: &InsStudy) -> InsRecord {
+fn record(s: &InsResults) -> InsRecord {
     let verdicts = |v: &Verdicts| {
         v.checks
             .iter()

@@ -95,3 +95,27 @@ pub(crate) fn per_state(x: [f64; ErrorState::DIM]) -> String {
 pub fn share_words(alpha: f64, checks: usize) -> String {
     percent(alpha / checks as f64)
 }
+
+/// A count as a sentence writes it: in words up to twelve ("seven"), in figures above.
+pub fn count_words(n: usize) -> String {
+    const WORDS: [&str; 13] = [
+        "zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten",
+        "eleven", "twelve",
+    ];
+    WORDS
+        .get(n)
+        .map_or_else(|| count(n as u64), |w| (*w).to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::count_words;
+
+    #[test]
+    fn small_counts_in_words_larger_in_figures() {
+        assert_eq!(count_words(0), "zero");
+        assert_eq!(count_words(7), "seven");
+        assert_eq!(count_words(12), "twelve");
+        assert_eq!(count_words(13), crate::format::count(13));
+    }
+}

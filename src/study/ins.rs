@@ -7,7 +7,7 @@ use crate::config::ins::InsConfig;
 use crate::ins::ensemble::{self, Calibration, RealizationError, Track, filter_realization};
 use crate::ins::error_state::{ACCEL_BIAS, ATTITUDE, GYRO_BIAS, STATES, STATES_WITH_SCALE};
 use crate::ins::gnss::ned_difference_m;
-use crate::ins::setup::Study;
+use crate::ins::setup::Scenario;
 use crate::progress::Progress;
 
 /// Realizations of each ensemble in the report.
@@ -42,9 +42,9 @@ pub struct Trace {
     pub attitude_sigma: Vec<[f64; 3]>,
 }
 
-/// The three-axis study.
+/// The three-axis section's results.
 #[derive(Clone, Debug)]
-pub struct InsStudy {
+pub struct InsResults {
     /// Its configuration (the default three-axis file).
     pub config: InsConfig,
     /// Realizations of each ensemble.
@@ -70,44 +70,44 @@ pub struct InsStudy {
 pub const SCALE_PPM: f64 = 1000.0;
 
 /// `s` with sensors whose scale factors have σ [`SCALE_PPM`] (the filter assuming the same prior).
-fn with_scale_factors(s: &mut Study) {
+fn with_scale_factors(s: &mut Scenario) {
     for imu in [&mut s.truth_imu, &mut s.filter_imu] {
         imu.gyro_scale_sigma = SCALE_PPM * 1e-6;
         imu.accel_scale_sigma = SCALE_PPM * 1e-6;
     }
 }
 
-/// The verdicts and calibration of `realizations` realizations of `study`'s 15-state filter.
+/// The verdicts and calibration of `realizations` realizations of `scenario`'s 15-state filter.
 fn judged(
-    study: &Study,
+    scenario: &Scenario,
     track: &Track,
     realizations: u64,
     progress: &mut dyn Progress,
     label: &str,
 ) -> Result<(Verdicts, Calibration, Vec<f64>), RealizationError> {
-    judged_of::<STATES>(study, track, realizations, progress, label)
+    judged_of::<STATES>(scenario, track, realizations, progress, label)
 }
 
 /// [`judged`] with a filter of `N` error states.
 fn judged_of<const N: usize>(
-    study: &Study,
+    scenario: &Scenario,
     track: &Track,
     realizations: u64,
     progress: &mut dyn Progress,
     label: &str,
 ) -> Result<(Verdicts, Calibration<N>, Vec<f64>), RealizationError> {
     progress.start(label, realizations);
-    let sums = ensemble::sums::<N>(study, track, realizations, |done| progress.advance(done))?;
+    let sums = ensemble::sums::<N>(scenario, track, realizations, |done| progress.advance(done))?;
     progress.finish();
-    let outcome = sums.outcome(study);
-    let verdicts = evaluate(&outcome.stats, &Budget::study(study.false_alarm_rate));
+    let outcome = sums.outcome(scenario);
+    let verdicts = evaluate(&outcome.stats, &Budget::study(scenario.false_alarm_rate));
     Ok((verdicts, outcome.calibration, sums.normalized.times_s))
 }
 
-/// Realization 0 of `study`, every fix.
-fn trace(study: &Study, track: &Track) -> Result<Trace, RealizationError> {
+/// Realization 0 of `scenario`, every fix.
+fn trace(scenario: &Scenario, track: &Track) -> Result<Trace, RealizationError> {
     let mut t = Trace::default();
-    filter_realization::<STATES>(study, track, 0, |v| {
+    filter_realization::<STATES>(scenario, track, 0, |v| {
         let p = &v.ekf.covariance;
         let sigma = |k: usize| p[(k, k)].sqrt();
         let (g, a) = (v.ekf.gyro_bias_rad_s, v.ekf.accel_bias_m_s2);
@@ -133,8 +133,8 @@ fn trace(study: &Study, track: &Track) -> Result<Trace, RealizationError> {
 }
 
 /// The default drive every second: north, east from the start and height, m, at time t.
-fn track_every_second(study: &Study, track: &Track) -> Vec<[f64; 4]> {
-    let per_s = study.imu_rate_hz.round() as usize;
+fn track_every_second(scenario: &Scenario, track: &Track) -> Vec<[f64; 4]> {
+    let per_s = scenario.imu_rate_hz.round() as usize;
     let start = &track.start.position;
     std::iter::once((0, &track.start))
         .chain(track.steps.iter().enumerate().map(|(k, s)| (k + 1, &s.1)))
@@ -142,7 +142,7 @@ fn track_every_second(study: &Study, track: &Track) -> Vec<[f64; 4]> {
         .map(|(k, pva)| {
             let d = ned_difference_m(&pva.position, start);
             [
-                k as f64 / study.imu_rate_hz,
+                k as f64 / scenario.imu_rate_hz,
                 d.x,
                 d.y,
                 pva.position.height_m,
@@ -151,10 +151,10 @@ fn track_every_second(study: &Study, track: &Track) -> Vec<[f64; 4]> {
         .collect()
 }
 
-/// A negative control: what is wrong, and the edit of the study that makes it so.
-pub type ControlEdit = (&'static str, fn(&mut Study));
+/// A negative control: what is wrong, and the edit of the scenario that makes it so.
+pub type ControlEdit = (&'static str, fn(&mut Scenario));
 
-/// The negative controls: each edit of the default study and what it makes wrong.
+/// The negative controls: each edit of the default scenario and what it makes wrong.
 pub const CONTROLS: [ControlEdit; 5] = [
     ("assumes half the gyros' angle random walk", |s| {
         s.filter_imu.gyro_arw_rad_per_sqrt_s /= 2.0;
@@ -185,12 +185,12 @@ pub fn run(
     config: &InsConfig,
     realizations: u64,
     progress: &mut dyn Progress,
-) -> Result<InsStudy, RealizationError> {
-    let study = Study::from_config(config).expect("a valid three-axis configuration");
-    let track = Track::of(&study);
+) -> Result<InsResults, RealizationError> {
+    let scenario = Scenario::from_config(config).expect("a valid three-axis configuration");
+    let track = Track::of(&scenario);
     let (verdicts, calibration, times_s) =
-        judged(&study, &track, realizations, progress, "3-axis")?;
-    let mut s = study.clone();
+        judged(&scenario, &track, realizations, progress, "3-axis")?;
+    let mut s = scenario.clone();
     with_scale_factors(&mut s);
     let (v, _, t) =
         judged_of::<STATES_WITH_SCALE>(&s, &track, realizations, progress, "21 states")?;
@@ -201,7 +201,7 @@ pub fn run(
     };
     let mut controls = Vec::new();
     for (what, edit) in CONTROLS {
-        let mut s = study.clone();
+        let mut s = scenario.clone();
         edit(&mut s);
         let (verdicts, _, times_s) = judged(&s, &track, realizations, progress, "control")?;
         controls.push(Control {
@@ -210,11 +210,11 @@ pub fn run(
             times_s,
         });
     }
-    Ok(InsStudy {
+    Ok(InsResults {
         config: config.clone(),
         realizations,
-        track: track_every_second(&study, &track),
-        trace: trace(&study, &track)?,
+        track: track_every_second(&scenario, &track),
+        trace: trace(&scenario, &track)?,
         verdicts,
         times_s,
         calibration,

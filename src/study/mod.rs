@@ -110,7 +110,7 @@ pub struct Study {
     /// The white noise's identifiability on two drives, run with [`Study::with_noise`].
     pub white_noise: Option<identify::WhiteNoiseDrives>,
     /// The three-axis study, when it was run ([`Study::with_ins`]).
-    pub ins: Option<ins::InsStudy>,
+    pub ins: Option<ins::InsResults>,
 }
 
 impl Study {

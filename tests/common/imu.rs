@@ -1,14 +1,14 @@
 //! Shared helpers of the three-axis calibration's tests: the assumptions that match a simulated
-//! study, and the binomial band of a coverage count.
+//! scenario, and the binomial band of a coverage count.
 
 use accelcal::calibrate::imu::{CONSUMER, Settings};
-use accelcal::ins::setup::Study;
+use accelcal::ins::setup::Scenario;
 use statrs::distribution::{Binomial, DiscreteCDF};
 
-/// The assumptions that match the simulated sensors: the study's own statistics.
-pub fn settings_of(study: &Study) -> Settings {
-    let imu = &study.filter_imu;
-    let gnss = &study.filter_gnss;
+/// The assumptions that match the simulated sensors: the scenario's own statistics.
+pub fn settings_of(scenario: &Scenario) -> Settings {
+    let imu = &scenario.filter_imu;
+    let gnss = &scenario.filter_gnss;
     let tau = |b: accelcal::ins::sensors::BiasProcess| {
         let d = b.decay_per_s();
         (d > 0.0).then(|| 1.0 / d)

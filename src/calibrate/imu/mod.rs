@@ -11,14 +11,14 @@
 //!    when `[filter] innovation_gate = true`, one record per fix.
 //! 4. `smoother`: the Rauch–Tung–Striebel pass backwards over the fixes.
 //! 5. `summary`: the six biases and the attitude at the end with σ's, intervals and whether the
-//!    drive determined them (each sensor's three a `triad`); the NIS test and the innovations' whiteness per component; every
-//!    assumption made.
+//!    drive determined them (each sensor's three a `triad`); the NIS test and the innovations'
+//!    whiteness per component; the gate's rejections (`gate`); every assumption made.
 
 pub mod align;
 pub mod config;
 mod drive;
 pub mod gate;
-pub mod linear;
+pub mod linearized;
 pub mod noise;
 pub mod run;
 pub mod scale;

@@ -5,7 +5,7 @@
 //! statistics that maximise ℓ(θ) = −½ Σ_k (m_k ln 2π + ln det S_k + ν_kᵀS_k⁻¹ν_k) are those the
 //! drive supports (Mehra, IEEE Trans. Automatic Control 15(2), 1970; the same likelihood as the
 //! one-axis `--estimate-noise`, `crate::likelihood`). ℓ is evaluated on the filter linearized
-//! about one run over the IMU steps held in memory ([`super::linear`]: the recursion over the
+//! about one run over the IMU steps held in memory ([`super::linearized`]: the recursion over the
 //! fixes alone, equal to the run's ℓ at its own statistics); the search is repeated about a run
 //! at its maximum until the maximum stops moving (at most [`MAX_RUNS`] runs), and the intervals
 //! come from the model about the last. The σ's and random walks are searched in their
@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use super::Settings;
 use super::config::MAX_TIME_OFFSET_S;
-use super::linear::Linearized;
+use super::linearized::Linearized;
 use super::run::{filter, shifted};
 use crate::error::ConfigError;
 use crate::input::imu_csv::{HeldSteps, ImuSpan};

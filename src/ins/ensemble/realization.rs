@@ -13,7 +13,7 @@ use crate::ins::error_state::{STATES, Square};
 use crate::ins::filter::Ekf;
 use crate::ins::mech::Pva;
 use crate::ins::sensors::Imu;
-use crate::ins::setup::Study;
+use crate::ins::setup::Scenario;
 
 /// What one realization's filter saw at one fix, after its update.
 pub struct FixView<'a, const N: usize = STATES> {
@@ -31,10 +31,10 @@ pub struct FixView<'a, const N: usize = STATES> {
 
 /// Realization `index`'s true IMU (its prior's draws taken from its stream) and its filter,
 /// started from the truth plus a draw of its prior: position, velocity and attitude errors of
-/// the study's initial σ's, the biases' prior from the filter's model.
-pub fn start<const N: usize>(study: &Study, track: &Track, index: u64) -> (Imu, Ekf<N>) {
-    let mut imu = study.imu(index);
-    let s = &study.initial_sigma;
+/// the scenario's initial σ's, the biases' prior from the filter's model.
+pub fn start<const N: usize>(scenario: &Scenario, track: &Track, index: u64) -> (Imu, Ekf<N>) {
+    let mut imu = scenario.imu(index);
+    let s = &scenario.initial_sigma;
     let dr = imu.normals(&Vector3::new(s[0], s[1], s[2]));
     let dv = imu.normals(&Vector3::new(s[3], s[4], s[5]));
     let dpsi = imu.normals(&Vector3::new(s[6], s[7], s[8]));
@@ -45,36 +45,36 @@ pub fn start<const N: usize>(study: &Study, track: &Track, index: u64) -> (Imu, 
     };
     let ekf = Ekf::new(
         start,
-        study.prior_of::<N>(),
-        study.filter_noise(),
-        study.filter_decay(),
-        study.filter_gnss.lever_arm_b_m,
+        scenario.prior_of::<N>(),
+        scenario.filter_noise(),
+        scenario.filter_decay(),
+        scenario.filter_gnss.lever_arm_b_m,
     )
-    .with_earth_rotation(study.filter_earth_rotation_rad_s);
+    .with_earth_rotation(scenario.filter_earth_rotation_rad_s);
     (imu, ekf)
 }
 
-/// Runs realization `index` of `study` over `track` — its filter started from the truth plus a
+/// Runs realization `index` of `scenario` over `track` — its filter started from the truth plus a
 /// draw of its prior — through the driver, calling `on_fix` after every update; returns the
 /// filter and the IMU at the end.
 ///
 /// # Errors
 /// [`RealizationError`] when a covariance stops being positive definite, or `on_fix`'s.
 pub fn filter_realization<const N: usize>(
-    study: &Study,
+    scenario: &Scenario,
     track: &Track,
     index: u64,
     on_fix: impl FnMut(&FixView<N>) -> Result<(), RealizationError>,
 ) -> Result<(Ekf<N>, Imu), RealizationError> {
-    let (imu, mut ekf) = start(study, track, index);
+    let (imu, mut ekf) = start(scenario, track, index);
     let mut sim = SimulatedImu {
-        study,
+        scenario,
         track,
-        drive: study.drive(),
+        drive: scenario.drive(),
         imu,
         steps: 0,
     };
-    let mut gnss = SimulatedGnss::of(study, track);
+    let mut gnss = SimulatedGnss::of(scenario, track);
     let mut observer = Normalizer {
         index,
         prior: None,
@@ -159,12 +159,12 @@ where
 /// # Errors
 /// [`RealizationError`] when a covariance stops being positive definite.
 pub fn realization<const N: usize>(
-    study: &Study,
+    scenario: &Scenario,
     track: &Track,
     index: u64,
 ) -> Result<Normalized<N>, RealizationError> {
-    let mut out = Vec::with_capacity(track.steps.len() / study.imu_steps_per_fix);
-    let (ekf, imu) = filter_realization(study, track, index, |v| {
+    let mut out = Vec::with_capacity(track.steps.len() / scenario.imu_steps_per_fix);
+    let (ekf, imu) = filter_realization(scenario, track, index, |v| {
         let bad = RealizationError::Covariance { index, fix: v.fix };
         out.push(NormalizedFix::of(&v.input, v.fix).map_err(|_| bad)?);
         Ok(())

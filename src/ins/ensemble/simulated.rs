@@ -5,17 +5,17 @@
 use crate::ins::drive::Drive;
 use crate::ins::driver::{ImuSource, ImuStep, Source};
 use crate::ins::gnss::FixUpdate;
-use crate::ins::logs::fix;
 use crate::ins::measurement::Measurement;
 use crate::ins::sensors::Imu;
-use crate::ins::setup::Study;
+use crate::ins::setup::Scenario;
+use crate::ins::simulated_logs::fix;
 
 use super::Track;
 
 /// The realization's IMU over the shared truth.
 pub struct SimulatedImu<'a> {
-    /// The study.
-    pub study: &'a Study,
+    /// The scenario.
+    pub scenario: &'a Scenario,
     /// The truth.
     pub track: &'a Track,
     /// The drive (its motion, for the receiver's antenna).
@@ -47,7 +47,7 @@ impl ImuSource for SimulatedImu<'_> {
         Ok(Some(ImuStep {
             // The row of imu.csv it would be (the header is line 1).
             line: self.steps as u64 + 1,
-            t_s: self.steps as f64 / self.study.imu_rate_hz,
+            t_s: self.steps as f64 / self.scenario.imu_rate_hz,
             increment,
         }))
     }
@@ -67,12 +67,12 @@ pub struct SimulatedGnss {
 }
 
 impl SimulatedGnss {
-    /// The receiver of `study` over `track`.
-    pub fn of(study: &Study, track: &Track) -> Self {
+    /// The receiver of `scenario` over `track`.
+    pub fn of(scenario: &Scenario, track: &Track) -> Self {
         SimulatedGnss {
             given: 0,
-            every: study.imu_steps_per_fix,
-            rate_hz: study.imu_rate_hz,
+            every: scenario.imu_steps_per_fix,
+            rate_hz: scenario.imu_rate_hz,
             steps: track.steps.len(),
         }
     }
@@ -87,11 +87,11 @@ impl<const N: usize> Source<N, SimulatedImu<'_>> for SimulatedGnss {
     fn take(&mut self, imu: &mut SimulatedImu<'_>) -> Box<dyn Measurement<N>> {
         let t = Source::<N, SimulatedImu<'_>>::next_time(self).expect("a fix is due");
         self.given += 1;
-        let (study, pva) = (imu.study, *imu.truth());
-        let mut reading = fix(study, &imu.drive, &mut imu.imu, t, &pva);
+        let (scenario, pva) = (imu.scenario, *imu.truth());
+        let mut reading = fix(scenario, &imu.drive, &mut imu.imu, t, &pva);
         // The filter weighs the fix with the σ's it assumes.
-        reading.position_sigma_m = study.filter_gnss.position_sigma_m;
-        reading.velocity_sigma_m_s = study.filter_gnss.velocity_sigma_m_s;
+        reading.position_sigma_m = scenario.filter_gnss.position_sigma_m;
+        reading.velocity_sigma_m_s = scenario.filter_gnss.velocity_sigma_m_s;
         Box::new(FixUpdate::whole(reading))
     }
 }

@@ -3,7 +3,7 @@
 
 mod ensemble;
 mod error_state;
-mod logs;
 mod mechanization;
 mod propagation;
 mod scale;
+mod simulated_logs;

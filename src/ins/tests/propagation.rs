@@ -4,28 +4,28 @@ use crate::config::ins::InsConfig;
 use crate::ins::ensemble::Track;
 use crate::ins::error_state::Matrix15;
 use crate::ins::filter::{DEFAULT_COVARIANCE_INTERVAL_S, Ekf, Propagation};
-use crate::ins::logs::fix;
-use crate::ins::setup::Study;
+use crate::ins::setup::Scenario;
+use crate::ins::simulated_logs::fix;
 
 /// P before each update of realization `index`, its covariance propagated as `propagation` says.
 fn covariances(
-    study: &Study,
+    scenario: &Scenario,
     track: &Track,
     index: u64,
     propagation: Propagation,
 ) -> Vec<Matrix15> {
-    let drive = study.drive();
-    let (mut imu, ekf) = crate::ins::ensemble::start::<15>(study, track, index);
+    let drive = scenario.drive();
+    let (mut imu, ekf) = crate::ins::ensemble::start::<15>(scenario, track, index);
     let mut ekf = ekf.with_propagation(propagation);
-    let g = &study.filter_gnss;
-    let dt = 1.0 / study.imu_rate_hz;
+    let g = &scenario.filter_gnss;
+    let dt = 1.0 / scenario.imu_rate_hz;
     let mut out = Vec::new();
     for (k, (inc, pva)) in track.steps.iter().enumerate() {
         ekf.propagate(&imu.read(inc));
-        if (k + 1) % study.imu_steps_per_fix != 0 {
+        if (k + 1) % scenario.imu_steps_per_fix != 0 {
             continue;
         }
-        let mut reading = fix(study, &drive, &mut imu, (k + 1) as f64 * dt, pva);
+        let mut reading = fix(scenario, &drive, &mut imu, (k + 1) as f64 * dt, pva);
         reading.position_sigma_m = g.position_sigma_m;
         reading.velocity_sigma_m_s = g.velocity_sigma_m_s;
         out.push(ekf.covariance);
@@ -43,8 +43,8 @@ fn whitened_difference(p: &Matrix15, p_ref: &Matrix15) -> f64 {
 }
 
 /// The largest whitened difference over the fixes of realization 0 of the default drive.
-fn worst(study: &Study, track: &Track, reference: &[Matrix15], interval_s: f64) -> f64 {
-    let fast = covariances(study, track, 0, Propagation::Interval { interval_s });
+fn worst(scenario: &Scenario, track: &Track, reference: &[Matrix15], interval_s: f64) -> f64 {
+    let fast = covariances(scenario, track, 0, Propagation::Interval { interval_s });
     assert_eq!(fast.len(), reference.len());
     fast.iter()
         .zip(reference)
@@ -60,16 +60,16 @@ const BOUND: f64 = 0.1 * std::f64::consts::SQRT_2 / 31.622_776_601_683_793;
 
 #[test]
 fn p_at_every_fix_stays_within_the_bound_of_the_per_step_reference() {
-    let study = Study::from_config(&InsConfig::default()).unwrap();
-    let track = Track::of(&study);
-    let reference = covariances(&study, &track, 0, Propagation::Dense);
+    let scenario = Scenario::from_config(&InsConfig::default()).unwrap();
+    let track = Track::of(&scenario);
+    let reference = covariances(&scenario, &track, 0, Propagation::Dense);
     assert_eq!(reference.len(), 600);
     // Measured: 3.5·10⁻⁴ at 0.1 s, 1.4·10⁻³ at 0.2 s, growing as T² (F's mean drops the
     // Magnus series' commutator term, −(T³/12)[F, Ḟ] per interval, T⁻¹ intervals per fix).
-    let default = worst(&study, &track, &reference, DEFAULT_COVARIANCE_INTERVAL_S);
+    let default = worst(&scenario, &track, &reference, DEFAULT_COVARIANCE_INTERVAL_S);
     assert!(default <= BOUND, "{default:e} beyond {BOUND:e}");
     // Negative control: one propagation per fix (1 s, measured 3.3·10⁻²) exceeds it.
-    let per_fix = worst(&study, &track, &reference, 1.0);
+    let per_fix = worst(&scenario, &track, &reference, 1.0);
     assert!(
         per_fix > BOUND,
         "the bound missed a 1 s interval: {per_fix:e}"
@@ -83,16 +83,16 @@ fn current_at_fixes(gnss_rate_hz: f64, offset: usize) -> (bool, bool) {
     let mut c = InsConfig::default();
     c.drive.duration_s = 20.0;
     c.gnss.gnss_rate_hz = gnss_rate_hz;
-    let study = Study::from_config(&c).unwrap();
-    let track = Track::of(&study);
-    let drive = study.drive();
-    let mut imu = study.imu(0);
-    let g = &study.filter_gnss;
+    let scenario = Scenario::from_config(&c).unwrap();
+    let track = Track::of(&scenario);
+    let drive = scenario.drive();
+    let mut imu = scenario.imu(0);
+    let g = &scenario.filter_gnss;
     let mut ekf = Ekf::new(
         track.start,
-        study.prior(),
-        study.filter_noise(),
-        study.filter_decay(),
+        scenario.prior(),
+        scenario.filter_noise(),
+        scenario.filter_decay(),
         g.lever_arm_b_m,
     );
     let (mut at_fix, mut after) = (true, true);
@@ -101,7 +101,7 @@ fn current_at_fixes(gnss_rate_hz: f64, offset: usize) -> (bool, bool) {
         flushed.flush();
         flushed.covariance == ekf.covariance
     };
-    let per_fix = study.imu_steps_per_fix;
+    let per_fix = scenario.imu_steps_per_fix;
     for (k, (inc, pva)) in track.steps.iter().enumerate() {
         ekf.propagate(&imu.read(inc));
         if (k + 1) % per_fix == offset && k + 1 > per_fix {
@@ -111,8 +111,9 @@ fn current_at_fixes(gnss_rate_hz: f64, offset: usize) -> (bool, bool) {
             continue;
         }
         at_fix &= current(&ekf);
-        let t = (k + 1) as f64 / study.imu_rate_hz;
-        ekf.update(&fix(&study, &drive, &mut imu, t, pva)).unwrap();
+        let t = (k + 1) as f64 / scenario.imu_rate_hz;
+        ekf.update(&fix(&scenario, &drive, &mut imu, t, pva))
+            .unwrap();
     }
     (at_fix, after)
 }

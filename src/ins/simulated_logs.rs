@@ -1,4 +1,4 @@
-//! One simulated realization of the three-axis study written as sensor logs, in the formats of a
+//! One simulated realization of the three-axis scenario written as sensor logs, in the formats of a
 //! real recording (`imu.csv`, `gnss.csv`) and its truth (`truth.csv`).
 //!
 //! - `imu.csv`: `t_s,ax_m_s2,ay_m_s2,az_m_s2,gx_rad_s,gy_rad_s,gz_rad_s`, body axes
@@ -22,7 +22,7 @@ use super::earth::offset;
 use super::gnss::{self, Fix};
 use super::mech::Pva;
 use super::sensors::Imu;
-use super::setup::Study;
+use super::setup::Scenario;
 use super::truth::{self, Truth};
 
 /// The IMU log's header.
@@ -50,8 +50,8 @@ pub struct Written {
 
 /// The fix the receiver reports at `t_s` for the true state `pva`: the antenna through the lever
 /// arm, with the receiver's white noise from the realization's stream.
-pub fn fix(study: &Study, drive: &Drive, imu: &mut Imu, t_s: f64, pva: &Pva) -> Fix {
-    let g = &study.truth_gnss;
+pub fn fix(scenario: &Scenario, drive: &Drive, imu: &mut Imu, t_s: f64, pva: &Pva) -> Fix {
+    let g = &scenario.truth_gnss;
     let (omega, _) = truth::imu_rates(&pva.position, &drive.motion(t_s));
     let (p, v) = gnss::antenna(pva, &g.lever_arm_b_m, &omega);
     Fix {
@@ -63,12 +63,12 @@ pub fn fix(study: &Study, drive: &Drive, imu: &mut Imu, t_s: f64, pva: &Pva) -> 
     }
 }
 
-/// Realization `index` of `study` written into `imu`, `gnss` and `truth`.
+/// Realization `index` of `scenario` written into `imu`, `gnss` and `truth`.
 ///
 /// # Errors
 /// The writers' errors.
 pub fn write_realization(
-    study: &Study,
+    scenario: &Scenario,
     index: u64,
     imu_out: &mut impl Write,
     gnss_out: &mut impl Write,
@@ -76,14 +76,14 @@ pub fn write_realization(
 ) -> io::Result<Written> {
     writeln!(imu_out, "{IMU_HEADER}")?;
     writeln!(gnss_out, "{GNSS_HEADER}")?;
-    let m = &study.truth_imu;
+    let m = &scenario.truth_imu;
     let scaled = m.gyro_scale_sigma > 0.0 || m.accel_scale_sigma > 0.0;
     let scale_columns = if scaled { TRUTH_SCALE_COLUMNS } else { "" };
     writeln!(truth_out, "{TRUTH_HEADER}{scale_columns}")?;
-    let drive = study.drive();
-    let dt = 1.0 / study.imu_rate_hz;
-    let truth = Truth::new(&drive, study.start, dt).until(study.duration_s);
-    let mut imu = study.imu(index);
+    let drive = scenario.drive();
+    let dt = 1.0 / scenario.imu_rate_hz;
+    let truth = Truth::new(&drive, scenario.start, dt).until(scenario.duration_s);
+    let mut imu = scenario.imu(index);
     let start = (imu.gyro_bias_rad_s, imu.accel_bias_m_s2);
     let (mut samples, mut fixes) = (0, 0);
     for (k, (inc, pva)) in truth.enumerate() {
@@ -121,8 +121,8 @@ pub fn write_realization(
         }
         row(truth_out, t, &values)?;
         samples += 1;
-        if (k + 1) % study.imu_steps_per_fix == 0 {
-            let f = fix(study, &drive, &mut imu, t, &pva);
+        if (k + 1) % scenario.imu_steps_per_fix == 0 {
+            let f = fix(scenario, &drive, &mut imu, t, &pva);
             let (p, v) = (
                 &f.position,
                 f.velocity_ned_m_s.unwrap_or_else(Vector3::zeros),

@@ -6,8 +6,8 @@ use nalgebra::Vector3;
 use crate::config::ins::InsConfig;
 use crate::ins::drive::Drive;
 use crate::ins::gnss;
-use crate::ins::logs::{GNSS_HEADER, IMU_HEADER, TRUTH_HEADER, write_realization};
-use crate::ins::setup::Study;
+use crate::ins::setup::Scenario;
+use crate::ins::simulated_logs::{GNSS_HEADER, IMU_HEADER, TRUTH_HEADER, write_realization};
 use crate::ins::truth::{self, Truth};
 use crate::stats::{Tail, chi_squared_quantile};
 
@@ -34,9 +34,9 @@ fn band(dof: usize) -> (f64, f64) {
 fn the_logs_carry_the_configured_noise_over_the_truth() {
     let mut config = InsConfig::default();
     config.drive.duration_s = 120.0;
-    let study = Study::from_config(&config).unwrap();
+    let scenario = Scenario::from_config(&config).unwrap();
     let (mut imu, mut gnss_log, mut truth_log) = (Vec::new(), Vec::new(), Vec::new());
-    let written = write_realization(&study, 3, &mut imu, &mut gnss_log, &mut truth_log).unwrap();
+    let written = write_realization(&scenario, 3, &mut imu, &mut gnss_log, &mut truth_log).unwrap();
     let (imu_header, imu_rows) = rows(&imu);
     let (gnss_header, gnss_rows) = rows(&gnss_log);
     let (truth_header, truth_rows) = rows(&truth_log);
@@ -53,9 +53,9 @@ fn the_logs_carry_the_configured_noise_over_the_truth() {
 
     // IMU: (logged rate − true rate − true bias)·√Δt / ARW (or VRW) is standard normal.
     let drive = Drive::default_drive();
-    let dt = 1.0 / study.imu_rate_hz;
-    let truth = Truth::new(&drive, study.start, dt).until(study.duration_s);
-    let m = &study.truth_imu;
+    let dt = 1.0 / scenario.imu_rate_hz;
+    let truth = Truth::new(&drive, scenario.start, dt).until(scenario.duration_s);
+    let m = &scenario.truth_imu;
     let (mut gyro, mut accel) = (0.0, 0.0);
     let mut states = Vec::new();
     for (k, (inc, pva)) in truth.enumerate() {
@@ -79,10 +79,10 @@ fn the_logs_carry_the_configured_noise_over_the_truth() {
     );
 
     // GNSS: the fix minus the true antenna, in units of its σ.
-    let g = &study.truth_gnss;
+    let g = &scenario.truth_gnss;
     let mut chi2 = 0.0;
     for row in &gnss_rows {
-        let k = (row[0] * study.imu_rate_hz).round() as usize - 1;
+        let k = (row[0] * scenario.imu_rate_hz).round() as usize - 1;
         let (omega, _) = truth::imu_rates(&states[k].position, &drive.motion(row[0]));
         let (p, v) = gnss::antenna(&states[k], &g.lever_arm_b_m, &omega);
         let fix = crate::ins::earth::Geodetic {

@@ -1,9 +1,9 @@
-//! The likelihood linearized about one run of the three-axis filter (`calibrate::imu::linear`)
+//! The likelihood linearized about one run of the three-axis filter (`calibrate::imu::linearized`)
 //! against the likelihood of rerunning the filter: equal at the run's own statistics, close
 //! near them (within a tenth of the χ²₁ threshold an interval's end rests on), on the shipped
 //! comma2k19 minute and on a simulated drive.
 
-use accelcal::calibrate::imu::linear::Linearized;
+use accelcal::calibrate::imu::linearized::Linearized;
 use accelcal::calibrate::imu::noise::log_likelihood;
 use accelcal::calibrate::imu::{CONSUMER, Settings};
 use accelcal::config::ins::InsConfig;
@@ -12,8 +12,8 @@ use accelcal::input::gnss_csv::read_gnss;
 use accelcal::input::imu_csv::{ImuSpan, read_steps};
 use accelcal::input::records::{GnssRow, ImuStep};
 use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
-use accelcal::ins::logs::write_realization;
-use accelcal::ins::setup::Study;
+use accelcal::ins::setup::Scenario;
+use accelcal::ins::simulated_logs::write_realization;
 
 /// The shipped minute, held.
 fn comma() -> (Vec<GnssRow>, Vec<ImuStep>) {
@@ -35,9 +35,9 @@ fn simulated() -> (Vec<GnssRow>, Vec<ImuStep>) {
 fn simulated_with_span() -> (Vec<GnssRow>, Vec<ImuStep>, ImuSpan) {
     let mut config = InsConfig::default();
     config.drive.duration_s = 240.0;
-    let study = Study::from_config(&config).expect("valid");
+    let scenario = Scenario::from_config(&config).expect("valid");
     let (mut imu, mut gnss, mut truth) = (Vec::new(), Vec::new(), Vec::new());
-    write_realization(&study, 3, &mut imu, &mut gnss, &mut truth).expect("in memory");
+    write_realization(&scenario, 3, &mut imu, &mut gnss, &mut truth).expect("in memory");
     let rows = read_gnss(&LogText::new("gnss.csv", gnss)).expect("reads");
     let (steps, span, _) = read_steps(&LogText::new("imu.csv", imu), CONSUMER.axes).expect("reads");
     (rows, steps, span)
