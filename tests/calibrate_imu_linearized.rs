@@ -11,7 +11,7 @@ use accelcal::input::csv::read::LogText;
 use accelcal::input::gnss_csv::read_gnss;
 use accelcal::input::imu_csv::{ImuSpan, read_steps};
 use accelcal::input::records::{GnssRow, ImuStep};
-use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
+use accelcal::ins::error_state::STATES_WITH_SCALE;
 use accelcal::ins::setup::Scenario;
 use accelcal::ins::simulated_logs::write_realization;
 
@@ -76,11 +76,7 @@ const END_FALL: f64 = 1.92;
 /// within `tolerance` at each move of [`moves`], each of which moves the rerun's ℓ by more than
 /// `tolerance` (the control: a model that ignored the statistics would fail).
 fn check((rows, steps): &(Vec<GnssRow>, Vec<ImuStep>), s: &Settings, tolerance: f64) {
-    if s.error_states > STATES {
-        check_of::<STATES_WITH_SCALE>((rows, steps), s, tolerance);
-    } else {
-        check_of::<STATES>((rows, steps), s, tolerance);
-    }
+    accelcal::with_layout!(s.layout(), N => check_of::<N>((rows, steps), s, tolerance));
 }
 
 /// [`check`] with the filter of `N` error states.

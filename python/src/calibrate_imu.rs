@@ -18,7 +18,8 @@ use accelcal::error::ConfigError;
 use accelcal::input::gnss_csv::held_gnss;
 use accelcal::input::imu_csv::{ImuLayout, ImuSpan, held_steps};
 use accelcal::input::records::{GnssRow, ImuStep};
-use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
+use accelcal::report::RenderError;
+use accelcal::report::calibration_imu::render;
 
 use crate::config::Source;
 
@@ -30,19 +31,14 @@ const GNSS_NAME: &str = "gnss";
 /// (plain numbers: any Python thread may use it).
 #[pyclass(frozen, module = "accelcal._accelcal")]
 pub(crate) struct ImuCalibrationResult {
-    run: Run,
+    page: Page,
     summary: Summary,
     estimates_csv: String,
 }
 
-/// The filter's records and their smoothing, with 15 error states or 21 (the scale factors).
-enum Run {
-    Biases(Calibrated, Vec<Smoothed>),
-    Scales(
-        Calibrated<STATES_WITH_SCALE>,
-        Vec<Smoothed<STATES_WITH_SCALE>>,
-    ),
-}
+/// The page of a finished run, from its filter records and their smoothing (of any error
+/// state: [`accelcal::with_layout!`]), its summary and the command line that reproduces it.
+type Page = Box<dyn Fn(&Summary, &str) -> Result<String, RenderError> + Send + Sync>;
 
 #[pymethods]
 impl ImuCalibrationResult {
@@ -60,12 +56,7 @@ impl ImuCalibrationResult {
 
     /// The page `index.html`, with `command` as the line that reproduces it.
     fn html(&self, command: &str) -> PyResult<String> {
-        use accelcal::report::calibration_imu::render;
-        match &self.run {
-            Run::Biases(c, sm) => render(c, &self.summary, sm, command),
-            Run::Scales(c, sm) => render(c, &self.summary, sm, command),
-        }
-        .map_err(crate::bad_input)
+        (self.page)(&self.summary, command).map_err(crate::bad_input)
     }
 }
 
@@ -144,16 +135,14 @@ fn calibrate(
         ),
     };
     let settings = estimate.as_ref().map_or(settings, |e| &e.settings);
-    let (run, mut summary, estimates) = if settings.error_states > STATES {
-        let (c, s, sm, e) = finished::<STATES_WITH_SCALE>(held, settings)?;
-        (Run::Scales(c, sm), s, e)
-    } else {
-        let (c, s, sm, e) = finished::<STATES>(held, settings)?;
-        (Run::Biases(c, sm), s, e)
-    };
+    let (page, mut summary, estimates) = accelcal::with_layout!(settings.layout(), N => {
+        let (c, s, sm, e) = finished::<N>(held, settings)?;
+        let page: Page = Box::new(move |s: &Summary, command: &str| render(&c, s, &sm, command));
+        (page, s, e)
+    });
     summary.noise_estimate = estimate;
     Ok(ImuCalibrationResult {
-        run,
+        page,
         summary,
         estimates_csv: String::from_utf8(estimates).map_err(crate::bad_input)?,
     })

@@ -18,8 +18,8 @@ use accelcal::error::ConfigError;
 use accelcal::input::csv::read::{LogFile, LogSource};
 use accelcal::input::gnss_csv::read_gnss;
 use accelcal::input::imu_csv::read_steps;
-use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
 use accelcal::output::{StagedFiles, check_directory};
+use accelcal::with_layout;
 
 /// The files the three-axis calibration writes.
 const ESTIMATES_FILE: &str = "estimates.csv";
@@ -55,11 +55,7 @@ pub(super) fn run(args: &CalibrateArgs, imu: &Path, gnss: &Path) -> Result<()> {
     if !args.quiet && std::io::stderr().is_terminal() {
         eprintln!("checking the logs, aligning and running the filter…");
     }
-    if settings.error_states > STATES {
-        run_with::<STATES_WITH_SCALE>(args, (imu, gnss), &settings)
-    } else {
-        run_with::<STATES>(args, (imu, gnss), &settings)
-    }
+    with_layout!(settings.layout(), N => run_with::<N>(args, (imu, gnss), &settings))
 }
 
 /// The calibration with a filter of `N` error states, its outputs written.

@@ -16,12 +16,12 @@ use accelcal::error::ConfigError;
 use accelcal::export;
 use accelcal::ins::blocks;
 use accelcal::ins::ensemble::{self as ins_ensemble, InsSums, Track};
-use accelcal::ins::error_state::{STATES, STATES_WITH_SCALE};
-use accelcal::ins::partial::{self, InsPartialHeader, MergedSums};
+use accelcal::ins::partial::{self, InsPartialHeader};
 use accelcal::ins::setup::Scenario;
 use accelcal::ins::simulated_logs::write_realization;
 use accelcal::output::{AtomicFile, ScratchFile, StagedFiles, check_directory};
 use accelcal::study::Progress;
+use accelcal::with_layout;
 
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
@@ -104,20 +104,15 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         .into());
     }
     if let (Some(shard), Some(path)) = (&args.shard, &args.partial) {
-        return if scenario.error_states > STATES {
-            run_shard::<STATES_WITH_SCALE>(&config, &scenario, shard, path, args.model.quiet)
-        } else {
-            run_shard::<STATES>(&config, &scenario, shard, path, args.model.quiet)
-        };
+        let quiet = args.model.quiet;
+        return with_layout!(scenario.layout(), N => {
+            run_shard::<N>(&config, &scenario, shard, path, quiet)
+        });
     }
     if let Some(path) = &args.json {
         accelcal::output::check_file(path)?;
     }
-    if scenario.error_states > STATES {
-        run_whole::<STATES_WITH_SCALE>(args, &config, &scenario)
-    } else {
-        run_whole::<STATES>(args, &config, &scenario)
-    }
+    with_layout!(scenario.layout(), N => run_whole::<N>(args, &config, &scenario))
 }
 
 /// The whole ensemble of `scenario` with an error state of `N`, in one process, and its JSON.
@@ -269,19 +264,14 @@ pub(super) fn run_merge(args: &MergeArgs) -> Result<()> {
     if let Some(path) = &args.json {
         accelcal::output::check_file(path)?;
     }
-    let merged = partial::merge(super::shards::open_partials(&args.files)?)?;
+    let shards = partial::open(super::shards::open_partials(&args.files)?)?;
     let label = format!("three axes (merged from {} shards)", args.files.len());
     let label = (!args.quiet).then_some(label.as_str());
-    let (c, s, t, json) = (
-        &merged.config,
-        &merged.scenario,
-        merged.elapsed_s,
-        args.json.as_deref(),
-    );
-    match &merged.sums {
-        MergedSums::Biases(sums) => write_document(c, s, sums, t, json, label),
-        MergedSums::Scales(sums) => write_document(c, s, sums, t, json, label),
-    }
+    let json = args.json.as_deref();
+    with_layout!(shards.layout(), N => {
+        let m = shards.merge::<N>()?;
+        write_document(&m.config, &m.scenario, &m.sums, m.elapsed_s, json, label)
+    })
 }
 
 /// `simulate --model ins`: one realization's IMU and GNSS logs and its truth.

@@ -11,9 +11,14 @@
 use nalgebra::SVector;
 
 use super::error_state::{
-    ACCEL_BIAS, ACCEL_SCALE, ATTITUDE, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, Square, VELOCITY,
-    has_scale,
+    ACCEL_BIAS, ATTITUDE, GYRO_BIAS, POSITION, STATES, STATES_WITH_SCALE, Square, VELOCITY,
+    offset_of,
 };
+use super::state::Block;
+
+/// Where the scale factors start in the 21-state layout.
+const GYRO_SCALE: usize = offset_of::<STATES_WITH_SCALE>(Block::GyroScale).unwrap();
+const ACCEL_SCALE: usize = offset_of::<STATES_WITH_SCALE>(Block::AccelScale).unwrap();
 
 /// The white-noise densities that drive the error state, each the same on a sensor's three axes
 /// (so that S = G·Q_c·Gᵀ is diagonal: the rotations C_b^n in G cancel).
@@ -130,7 +135,7 @@ pub const DYNAMICS_BLOCKS_WITH_SCALE: [(usize, &[usize]); 5] = [
 /// states): 12 of the 25 blocks, 1 620 multiply-adds against a dense product's 3 375.
 pub fn dynamics_times<const N: usize>(f: &Square<N>, x: &Square<N>) -> Square<N> {
     let mut out = Square::<N>::zeros();
-    let blocks: &[(usize, &[usize])] = if has_scale(N) {
+    let blocks: &[(usize, &[usize])] = if const { offset_of::<N>(Block::GyroScale).is_some() } {
         &DYNAMICS_BLOCKS_WITH_SCALE
     } else {
         &DYNAMICS_BLOCKS

@@ -19,13 +19,14 @@ use crate::ensemble::{EnsembleStats, ResidualLayout};
 
 use super::blocks::{self, CHUNK};
 use super::error_state::{
-    ACCEL_BIAS, ACCEL_SCALE, ATTITUDE, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, VELOCITY, has_scale,
+    ACCEL_BIAS, ATTITUDE, GYRO_BIAS, POSITION, STATES, VELOCITY, holds, start_of,
 };
 use super::filter::{Ekf, FilterError};
 use super::gnss;
 use super::mech::{Increment, Pva};
 use super::sensors::Imu;
 use super::setup::Scenario;
+use super::state::Block;
 use super::truth::Truth;
 use crate::ensemble::Partition;
 use crate::progress::{Cancel, Cancelled};
@@ -169,10 +170,10 @@ pub fn error<const N: usize>(ekf: &Ekf<N>, pva: &Pva, imu: &Imu) -> SVector<f64,
         .copy_from(&(ekf.gyro_bias_rad_s - imu.gyro_bias_rad_s));
     e.fixed_rows_mut::<3>(ACCEL_BIAS)
         .copy_from(&(ekf.accel_bias_m_s2 - imu.accel_bias_m_s2));
-    if has_scale(N) {
-        e.fixed_rows_mut::<3>(GYRO_SCALE)
+    if holds::<N>(Block::GyroScale) {
+        e.fixed_rows_mut::<3>(start_of::<N>(Block::GyroScale))
             .copy_from(&(ekf.gyro_scale - imu.gyro_scale));
-        e.fixed_rows_mut::<3>(ACCEL_SCALE)
+        e.fixed_rows_mut::<3>(start_of::<N>(Block::AccelScale))
             .copy_from(&(ekf.accel_scale - imu.accel_scale));
     }
     e

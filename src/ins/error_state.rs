@@ -21,37 +21,52 @@ use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use super::earth::{self, Geodetic};
 use super::mech::{Pva, skew};
+use super::state::{Block, Layout};
 
-/// The number of error states.
-pub const STATES: usize = 15;
-/// The number of error states with the scale factors.
-pub const STATES_WITH_SCALE: usize = 21;
-/// The first index of δr^n (NED, m).
-pub const POSITION: usize = 0;
+/// The number of error states ([`Layout::CORE`]).
+pub const STATES: usize = Layout::CORE.dim();
+/// The number of error states with the scale factors ([`Layout::WITH_SCALE`]).
+pub const STATES_WITH_SCALE: usize = Layout::WITH_SCALE.dim();
+/// The first index of δr^n (NED, m): [`Block::Position`]'s offset.
+pub const POSITION: usize = core(Block::Position);
 /// The first index of δv^n (NED, m/s).
-pub const VELOCITY: usize = 3;
+pub const VELOCITY: usize = core(Block::Velocity);
 /// The first index of δψ (rad).
-pub const ATTITUDE: usize = 6;
+pub const ATTITUDE: usize = core(Block::Attitude);
 /// The first index of δb_g (body axes, rad/s).
-pub const GYRO_BIAS: usize = 9;
+pub const GYRO_BIAS: usize = core(Block::GyroBias);
 /// The first index of δb_a (body axes, m/s²).
-pub const ACCEL_BIAS: usize = 12;
+pub const ACCEL_BIAS: usize = core(Block::AccelBias);
 
-/// The first index of δs_g (body axes, dimensionless), in the 21-state form.
-pub const GYRO_SCALE: usize = 15;
-/// The first index of δs_a (body axes, dimensionless), in the 21-state form.
-pub const ACCEL_SCALE: usize = 18;
+/// Where a block every layout holds starts (at the same place in each).
+const fn core(block: Block) -> usize {
+    Layout::CORE.offset(block).unwrap()
+}
+
+/// Where `block` starts in an error state of `N`; panics if it does not hold it (ask
+/// [`holds`] first).
+pub const fn start_of<const N: usize>(block: Block) -> usize {
+    match offset_of::<N>(block) {
+        Some(at) => at,
+        None => panic!("the error state does not hold the block"),
+    }
+}
+
+/// Whether an error state of `N` holds `block`.
+pub const fn holds<const N: usize>(block: Block) -> bool {
+    Layout::of::<N>().has(block)
+}
+
+/// Where the optional `block` starts in an error state of `N`, if it holds it.
+pub const fn offset_of<const N: usize>(block: Block) -> Option<usize> {
+    Layout::of::<N>().offset(block)
+}
 
 /// A square matrix over the error state.
 pub type Matrix15 = SMatrix<f64, STATES, STATES>;
 
 /// A square matrix over an error state of `N` (15 or 21).
 pub type Square<const N: usize> = SMatrix<f64, N, N>;
-
-/// Whether an error state of `N` carries the scale factors.
-pub const fn has_scale(n: usize) -> bool {
-    n > STATES
-}
 
 /// The sensed motion F's entries are linear in (each a mean over the steps of a covariance
 /// interval, or one step's value).
@@ -251,9 +266,11 @@ pub fn dynamics_of<const N: usize>(
         ACCEL_BIAS,
         -decay.accel_per_s * Matrix3::identity(),
     );
-    if has_scale(N) {
-        set(VELOCITY, ACCEL_SCALE, -motion.c_f);
-        set(ATTITUDE, GYRO_SCALE, -motion.c_w);
+    if let Some(at) = const { offset_of::<N>(Block::AccelScale) } {
+        set(VELOCITY, at, -motion.c_f);
+    }
+    if let Some(at) = const { offset_of::<N>(Block::GyroScale) } {
+        set(ATTITUDE, at, -motion.c_w);
     }
     f
 }

@@ -13,11 +13,10 @@ use thiserror::Error;
 use crate::state::Variable;
 
 use super::discrete::{self, NoiseDensities};
-use super::error_state::{
-    self, ACCEL_SCALE, BiasDecay, GYRO_SCALE, Motion, STATES, Square, has_scale,
-};
+use super::error_state::{self, BiasDecay, Motion, STATES, Square, holds, start_of};
 use super::gnss::{Fix, FixUpdate};
 use super::mech::{self, Increment, Pva};
+use super::state::Block;
 
 mod correct;
 mod parts;
@@ -223,7 +222,7 @@ impl<const N: usize> Ekf<N> {
     fn compensate(&self, raw: &Increment) -> Increment {
         let dtheta_rad = raw.dtheta_rad - self.gyro_bias_rad_s * raw.dt_s;
         let dvel_m_s = raw.dvel_m_s - self.accel_bias_m_s2 * raw.dt_s;
-        if !has_scale(N) {
+        if !holds::<N>(Block::GyroScale) {
             return Increment {
                 dtheta_rad,
                 dvel_m_s,
@@ -319,7 +318,7 @@ impl<const N: usize> Ekf<N> {
         pending.t_s += dt;
         pending.c_sum += c;
         pending.f_n_sum += c * f_b;
-        if has_scale(N) {
+        if holds::<N>(Block::GyroScale) {
             pending.c_f_sum += c * Matrix3::from_diagonal(f_b);
             pending.c_w_sum += c * Matrix3::from_diagonal(w_b);
         }
@@ -370,9 +369,9 @@ impl<const N: usize> Ekf<N> {
             &mut self.accel_bias_m_s2,
             &dx.fixed_rows::<STATES>(0).into_owned(),
         );
-        if has_scale(N) {
-            self.gyro_scale -= dx.fixed_rows::<3>(GYRO_SCALE);
-            self.accel_scale -= dx.fixed_rows::<3>(ACCEL_SCALE);
+        if holds::<N>(Block::GyroScale) {
+            self.gyro_scale -= dx.fixed_rows::<3>(start_of::<N>(Block::GyroScale));
+            self.accel_scale -= dx.fixed_rows::<3>(start_of::<N>(Block::AccelScale));
         }
     }
 }

@@ -16,10 +16,11 @@
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use super::earth::{self, Geodetic};
-use super::error_state::{ATTITUDE, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, VELOCITY, has_scale};
+use super::error_state::{ATTITUDE, GYRO_BIAS, POSITION, STATES, VELOCITY, holds, start_of};
 use super::measurement::{At, Measurement, Rows};
 use super::mech::{Pva, skew};
 use super::names::MEASUREMENTS;
+use super::state::Block;
 use crate::state::Variable;
 
 /// One GNSS fix: the antenna's position and, when measured, its velocity.
@@ -97,10 +98,10 @@ pub fn observation_of<const N: usize>(
         -skew(&(c * omega_ib_b.cross(lever_b_m))) + skew(&w_in) * skew(&arm_n),
     );
     set(3, GYRO_BIAS, c * skew(lever_b_m));
-    if has_scale(N) {
+    if holds::<N>(Block::GyroScale) {
         set(
             3,
-            GYRO_SCALE,
+            start_of::<N>(Block::GyroScale),
             c * skew(lever_b_m) * Matrix3::from_diagonal(omega_ib_b),
         );
     }
@@ -175,8 +176,11 @@ impl<const N: usize> Measurement<N> for Velocity {
             (ATTITUDE, block(ATTITUDE)),
             (GYRO_BIAS, block(GYRO_BIAS)),
         ];
-        if has_scale(N) {
-            blocks.push((GYRO_SCALE, block(GYRO_SCALE)));
+        if holds::<N>(Block::GyroScale) {
+            blocks.push((
+                start_of::<N>(Block::GyroScale),
+                block(start_of::<N>(Block::GyroScale)),
+            ));
         }
         rows.push3(
             (&(velocity - v), &s.component_mul(s)),

@@ -23,6 +23,7 @@ pub mod partial;
 pub mod sensors;
 pub mod setup;
 pub mod simulated_logs;
+pub mod state;
 pub mod truth;
 
 #[cfg(test)]

@@ -3,8 +3,6 @@
 
 use crate::state::Variable;
 
-use super::error_state::STATES_WITH_SCALE;
-
 const fn v(
     key: &'static str,
     name: &'static str,
@@ -20,8 +18,8 @@ const fn v(
 }
 
 /// The error states: δr, δv (NED), δψ, δb_g, δb_a (body axes), then in the 21-state form δs_g,
-/// δs_a (the first 15 are the 15-state form's).
-pub const VARIABLES: [Variable; STATES_WITH_SCALE] = [
+/// δs_a (the first 15 are the 15-state form's): three per [`super::state::Block`], in its order.
+pub const VARIABLES: [Variable; 21] = [
     v("position_n", "north position error", "δr_N", "m"),
     v("position_e", "east position error", "δr_E", "m"),
     v("position_d", "down position error", "δr_D", "m"),

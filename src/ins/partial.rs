@@ -17,8 +17,9 @@ use serde::{Deserialize, Serialize};
 
 use super::blocks;
 use super::ensemble::{InsSums, MEASURED, Track, empty_sums};
-use super::error_state::{STATES, STATES_WITH_SCALE};
+use super::error_state::STATES;
 use super::setup::Scenario;
+use super::state::Layout;
 use crate::config::ins::InsConfig;
 use crate::ensemble::Partition;
 use crate::ensemble::partial::{
@@ -92,11 +93,8 @@ impl InsPartialHeader {
     pub fn block_bytes(&self) -> usize {
         let products =
             crate::ensemble::ResidualLayout::with_width(self.fixes, MEASURED, self.max_lag).len();
-        let (fix, n) = if states_of(&self.config) > STATES {
-            (fix_len::<STATES_WITH_SCALE>(), STATES_WITH_SCALE)
-        } else {
-            (fix_len::<STATES>(), STATES)
-        };
+        let layout = Layout::with_states(states_of(&self.config)).unwrap_or(Layout::CORE);
+        let (fix, n) = crate::with_layout!(layout, N => (fix_len::<N>(), N));
         16 + 8 * (self.fixes * fix + products + MEASURED * MEASURED + 3 * n)
     }
 }
@@ -168,24 +166,25 @@ fn decode_block<const N: usize>(mut sums: InsSums<N>, count: u64, floats: &[f64]
     sums
 }
 
-/// The merged sums of every shard of one three-axis ensemble.
-pub struct InsMerged {
+/// The merged sums of every shard of one three-axis ensemble over `N` error states.
+pub struct InsMerged<const N: usize> {
     /// The ensemble's configuration.
     pub config: InsConfig,
     /// The scenario it configures.
     pub scenario: Scenario,
     /// The sums of the whole ensemble, folded in block order.
-    pub sums: MergedSums,
+    pub sums: InsSums<N>,
     /// The shards' run times added up, s.
     pub elapsed_s: f64,
 }
 
-/// The merged sums, over the error state the configuration names.
-pub enum MergedSums {
-    /// 15 states.
-    Biases(InsSums),
-    /// 21 states: the scale factors too.
-    Scales(InsSums<STATES_WITH_SCALE>),
+/// The partial files of one three-axis ensemble, their headers read: [`Shards::layout`] says
+/// which error state [`Shards::merge`] folds them over.
+pub struct Shards<R> {
+    opened: Vec<Opened<R>>,
+    first: InsPartialHeader,
+    first_name: String,
+    scenario: Scenario,
 }
 
 /// A three-axis partial file whose header is read.
@@ -203,14 +202,12 @@ fn mismatch(file: &str, why: String) -> PartialError {
     }
 }
 
-/// Reads the three-axis partial files `files` (name and reader, any order), checks that they
-/// are every shard of one ensemble exactly once, and folds their blocks in block order.
+/// Reads the headers of the three-axis partial files `files` (name and reader, any order).
 ///
 /// # Errors
-/// [`PartialError`] naming the file that is unreadable, damaged or edited (its digests),
-/// truncated, of another ensemble or model, or a repeated shard; or a missing shard, listing
-/// which file holds which shard.
-pub fn merge<R: BufRead>(files: Vec<(String, R)>) -> Result<InsMerged, PartialError> {
+/// [`PartialError`] naming the file that is unreadable, damaged or not a three-axis partial, or
+/// whose configuration is not valid.
+pub fn open<R: BufRead>(files: Vec<(String, R)>) -> Result<Shards<R>, PartialError> {
     let mut opened = Vec::with_capacity(files.len());
     for (name, mut r) in files {
         let (json, key) = read_header_line(&mut r, &name)?;
@@ -242,19 +239,47 @@ pub fn merge<R: BufRead>(files: Vec<(String, R)>) -> Result<InsMerged, PartialEr
             format!("the configuration in its header is not valid: {e}"),
         )
     })?;
-    let (sums, elapsed_s) = if scenario.error_states > STATES {
-        let (sums, t) = fold::<R, STATES_WITH_SCALE>(opened, &scenario, &first, &first_name)?;
-        (MergedSums::Scales(sums), t)
-    } else {
-        let (sums, t) = fold::<R, STATES>(opened, &scenario, &first, &first_name)?;
-        (MergedSums::Biases(sums), t)
-    };
-    Ok(InsMerged {
-        config: first.config,
+    Ok(Shards {
+        opened,
+        first,
+        first_name,
         scenario,
-        sums,
-        elapsed_s,
     })
+}
+
+impl<R: BufRead> Shards<R> {
+    /// The error state the ensemble's configuration names.
+    pub fn layout(&self) -> Layout {
+        self.scenario.layout()
+    }
+
+    /// Checks that the files are every shard of one ensemble exactly once and folds their
+    /// blocks in block order, over `N` error states ([`Shards::layout`]'s size:
+    /// [`with_layout!`](crate::with_layout)).
+    ///
+    /// # Errors
+    /// [`PartialError`] naming the file that is damaged or edited (its digests), truncated, of
+    /// another ensemble, or a repeated shard; or a missing shard, listing which file holds
+    /// which shard; or a size `N` other than the configuration's.
+    pub fn merge<const N: usize>(self) -> Result<InsMerged<N>, PartialError> {
+        if N != self.layout().dim() {
+            return Err(mismatch(
+                &self.first_name,
+                format!(
+                    "its configuration names {} error states, not {N}",
+                    self.layout().dim()
+                ),
+            ));
+        }
+        let (sums, elapsed_s) =
+            fold::<R, N>(self.opened, &self.scenario, &self.first, &self.first_name)?;
+        Ok(InsMerged {
+            config: self.first.config,
+            scenario: self.scenario,
+            sums,
+            elapsed_s,
+        })
+    }
 }
 
 /// The shards `opened`, checked against the first's header `first` (of `first_name`), folded

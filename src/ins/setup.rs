@@ -6,10 +6,9 @@ use nalgebra::Vector3;
 use super::discrete::NoiseDensities;
 use super::drive::Drive;
 use super::earth::Geodetic;
-use super::error_state::{
-    ACCEL_BIAS, ACCEL_SCALE, BiasDecay, GYRO_BIAS, GYRO_SCALE, Matrix15, Square, has_scale,
-};
+use super::error_state::{ACCEL_BIAS, BiasDecay, GYRO_BIAS, Matrix15, Square, holds, start_of};
 use super::sensors::{BiasProcess, Imu, ImuModel};
+use super::state::{Block, Layout};
 use crate::config::BiasModelKind;
 use crate::config::ins::{GnssConfig, ImuConfig, InsConfig};
 use crate::error::ConfigError;
@@ -59,6 +58,13 @@ pub struct Scenario {
     pub filter_earth_rotation_rad_s: f64,
     /// The filter's error states: 15, or 21 with the scale factors.
     pub error_states: usize,
+}
+
+impl Scenario {
+    /// The filter's error state: its blocks (validated with the configuration).
+    pub fn layout(&self) -> Layout {
+        Layout::with_states(self.error_states).expect("a validated error-state size")
+    }
 }
 
 /// A sensor triad's bias process from its configured model.
@@ -184,14 +190,20 @@ impl Scenario {
             p[(GYRO_BIAS + i, GYRO_BIAS + i)] = g * g;
             p[(ACCEL_BIAS + i, ACCEL_BIAS + i)] = a * a;
         }
-        if has_scale(N) {
+        if holds::<N>(Block::GyroScale) {
             let (g, a) = (
                 self.filter_imu.gyro_scale_sigma,
                 self.filter_imu.accel_scale_sigma,
             );
             for i in 0..3 {
-                p[(GYRO_SCALE + i, GYRO_SCALE + i)] = g * g;
-                p[(ACCEL_SCALE + i, ACCEL_SCALE + i)] = a * a;
+                p[(
+                    start_of::<N>(Block::GyroScale) + i,
+                    start_of::<N>(Block::GyroScale) + i,
+                )] = g * g;
+                p[(
+                    start_of::<N>(Block::AccelScale) + i,
+                    start_of::<N>(Block::AccelScale) + i,
+                )] = a * a;
             }
         }
         p

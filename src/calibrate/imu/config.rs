@@ -287,7 +287,7 @@ pub fn validate(s: &Settings) -> Result<(), ConfigError> {
         ("gyro_scale_factor_sigma_ppm", s.gyro_scale_factor_sigma_ppm, scale_lo, 1e5, scale_words),
         ("accel_scale_factor_sigma_ppm", s.accel_scale_factor_sigma_ppm, scale_lo, 1e5, scale_words),
     ];
-    if s.error_states != 15 && s.error_states != 21 {
+    if crate::ins::state::Layout::with_states(s.error_states).is_none() {
         return Err(ConfigError::invalid(
             "error_states",
             s.error_states,

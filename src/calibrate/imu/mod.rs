@@ -125,6 +125,12 @@ pub struct Settings {
 }
 
 impl Settings {
+    /// The filter's error state: its blocks (validated with the settings).
+    pub fn layout(&self) -> crate::ins::state::Layout {
+        crate::ins::state::Layout::with_states(self.error_states)
+            .expect("a validated error-state size")
+    }
+
     /// The lever arm as a vector.
     pub fn lever_arm(&self) -> Vector3<f64> {
         Vector3::from(self.gnss_lever_arm_m)

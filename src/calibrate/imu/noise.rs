@@ -22,7 +22,6 @@ use super::run::{filter, shifted};
 use crate::error::ConfigError;
 use crate::input::imu_csv::{HeldSteps, ImuSpan};
 use crate::input::records::{GnssRow, ImuStep};
-use crate::ins::error_state::{STATES, STATES_WITH_SCALE};
 use crate::likelihood::{Fit, climb, maximize};
 use crate::progress::{Cancel, Cancelled};
 
@@ -225,11 +224,7 @@ pub struct NoiseEstimate {
 /// The log-likelihood of the GNSS innovations of the filter with assumptions `s` over the
 /// first `fixes` fixes after the alignment's; −∞ when the filter cannot run or updates fewer.
 pub fn log_likelihood(rows: &[GnssRow], steps: &[ImuStep], s: &Settings, fixes: usize) -> f64 {
-    if s.error_states > STATES {
-        log_likelihood_of::<STATES_WITH_SCALE>(rows, steps, s, fixes)
-    } else {
-        log_likelihood_of::<STATES>(rows, steps, s, fixes)
-    }
+    crate::with_layout!(s.layout(), N => log_likelihood_of::<N>(rows, steps, s, fixes))
 }
 
 /// [`log_likelihood`] of a filter of `N` error states.
@@ -319,11 +314,7 @@ fn search(
     request: (&Settings, &[ImuKey], f64),
     cancel: &Cancel,
 ) -> Option<NoiseEstimate> {
-    if request.0.error_states > STATES {
-        search_of::<STATES_WITH_SCALE>(rows, steps, span, request, cancel)
-    } else {
-        search_of::<STATES>(rows, steps, span, request, cancel)
-    }
+    crate::with_layout!(request.0.layout(), N => search_of::<N>(rows, steps, span, request, cancel))
 }
 
 /// [`search`] on a filter of `N` error states.

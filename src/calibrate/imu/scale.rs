@@ -13,7 +13,8 @@ use super::Settings;
 use super::smoother::Smoothed;
 use super::step::{FixRecord, scale_sigmas};
 use super::triad::{IDENTIFIABLE_SIGMA_RATIO, Triad, triad};
-use crate::ins::error_state::has_scale;
+use crate::ins::error_state::holds;
+use crate::ins::state::Block;
 
 /// One million: a scale factor in ppm.
 const PPM: f64 = 1e6;
@@ -23,7 +24,7 @@ pub fn end_triads<const N: usize>(
     last: Option<&FixRecord<N>>,
     s: &Settings,
 ) -> Option<(Triad, Triad)> {
-    if !has_scale(N) {
+    if !holds::<N>(Block::GyroScale) {
         return None;
     }
     let ppm = |v: [f64; 3]| v.map(|x| x * PPM);
@@ -75,7 +76,7 @@ pub fn warnings(gyro: Option<&Triad>, accel: Option<&Triad>) -> Vec<String> {
 
 /// `estimates.csv`'s smoothed scale-factor columns after the 15-state ones (none without them).
 pub fn header<const N: usize>() -> &'static str {
-    if has_scale(N) {
+    if holds::<N>(Block::GyroScale) {
         ",smoothed_sgx_ppm,smoothed_sgy_ppm,smoothed_sgz_ppm,smoothed_sax_ppm,smoothed_say_ppm,\
 smoothed_saz_ppm,smoothed_sigma_sgx_ppm,smoothed_sigma_sgy_ppm,smoothed_sigma_sgz_ppm,\
 smoothed_sigma_sax_ppm,smoothed_sigma_say_ppm,smoothed_sigma_saz_ppm"
@@ -86,7 +87,7 @@ smoothed_sigma_sax_ppm,smoothed_sigma_say_ppm,smoothed_sigma_saz_ppm"
 
 /// The smoothed scale factors and their σ's of `sm`, ppm, onto `row` (nothing without them).
 pub fn extend_row<const N: usize>(row: &mut Vec<f64>, sm: &Smoothed<N>) {
-    if !has_scale(N) {
+    if !holds::<N>(Block::GyroScale) {
         return;
     }
     row.extend(sm.gyro_scale.iter().map(|x| x * PPM));

@@ -18,9 +18,10 @@
 use nalgebra::{SVector, Vector3};
 
 use super::run::FixRecord;
-use crate::ins::error_state::{ACCEL_SCALE, GYRO_SCALE, STATES, Square, has_scale};
+use crate::ins::error_state::{STATES, Square, holds, start_of};
 use crate::ins::filter::apply_correction;
 use crate::ins::mech::Pva;
+use crate::ins::state::Block;
 
 /// The smoothed solution at one fix.
 #[derive(Clone, Debug, PartialEq)]
@@ -84,9 +85,9 @@ fn smoothed<const N: usize>(
         &e.fixed_rows::<STATES>(0).into_owned(),
     );
     let (mut sg, mut sa) = (r.gyro_scale, r.accel_scale);
-    if has_scale(N) {
-        sg -= e.fixed_rows::<3>(GYRO_SCALE);
-        sa -= e.fixed_rows::<3>(ACCEL_SCALE);
+    if holds::<N>(Block::GyroScale) {
+        sg -= e.fixed_rows::<3>(start_of::<N>(Block::GyroScale));
+        sa -= e.fixed_rows::<3>(start_of::<N>(Block::AccelScale));
     }
     Smoothed {
         pva,

@@ -8,12 +8,12 @@ use super::align::{self, Alignment};
 use crate::input::records::GnssRow;
 use crate::ins::discrete::NoiseDensities;
 use crate::ins::error_state::{
-    ACCEL_BIAS, ACCEL_SCALE, ATTITUDE, BiasDecay, GYRO_BIAS, GYRO_SCALE, POSITION, STATES, Square,
-    has_scale,
+    ACCEL_BIAS, ATTITUDE, BiasDecay, GYRO_BIAS, POSITION, STATES, Square, holds, start_of,
 };
 use crate::ins::filter::{Ekf, LinearView, NOISE_GROUPS};
 use crate::ins::gnss::Fix;
 use crate::ins::mech::{Increment, Pva};
+use crate::ins::state::Block;
 
 /// The innovation components' names, in the record's order.
 pub const COMPONENTS: [&str; 6] = [
@@ -152,10 +152,15 @@ pub(super) fn initial_covariance<const N: usize>(
     for i in 0..3 {
         p0[(POSITION + i, POSITION + i)] = fix.position_sigma_m[i].powi(2);
         p0[(GYRO_BIAS + i, GYRO_BIAS + i)] = s.gyro_bias_sigma_rad_s.powi(2);
-        if has_scale(N) {
-            p0[(GYRO_SCALE + i, GYRO_SCALE + i)] = (s.gyro_scale_factor_sigma_ppm * 1e-6).powi(2);
-            p0[(ACCEL_SCALE + i, ACCEL_SCALE + i)] =
-                (s.accel_scale_factor_sigma_ppm * 1e-6).powi(2);
+        if holds::<N>(Block::GyroScale) {
+            p0[(
+                start_of::<N>(Block::GyroScale) + i,
+                start_of::<N>(Block::GyroScale) + i,
+            )] = (s.gyro_scale_factor_sigma_ppm * 1e-6).powi(2);
+            p0[(
+                start_of::<N>(Block::AccelScale) + i,
+                start_of::<N>(Block::AccelScale) + i,
+            )] = (s.accel_scale_factor_sigma_ppm * 1e-6).powi(2);
         }
     }
     p0
@@ -234,11 +239,25 @@ pub fn bias_sigmas<const N: usize>(p: &Square<N>) -> ([f64; 3], [f64; 3]) {
 
 /// The σ of each gyro and accelerometer scale factor in `p` (NaN without the scale states).
 pub fn scale_sigmas<const N: usize>(p: &Square<N>) -> ([f64; 3], [f64; 3]) {
-    if !has_scale(N) {
+    if !holds::<N>(Block::GyroScale) {
         return ([f64::NAN; 3], [f64::NAN; 3]);
     }
     (
-        [0, 1, 2].map(|i| p[(GYRO_SCALE + i, GYRO_SCALE + i)].max(0.0).sqrt()),
-        [0, 1, 2].map(|i| p[(ACCEL_SCALE + i, ACCEL_SCALE + i)].max(0.0).sqrt()),
+        [0, 1, 2].map(|i| {
+            p[(
+                start_of::<N>(Block::GyroScale) + i,
+                start_of::<N>(Block::GyroScale) + i,
+            )]
+                .max(0.0)
+                .sqrt()
+        }),
+        [0, 1, 2].map(|i| {
+            p[(
+                start_of::<N>(Block::AccelScale) + i,
+                start_of::<N>(Block::AccelScale) + i,
+            )]
+                .max(0.0)
+                .sqrt()
+        }),
     )
 }

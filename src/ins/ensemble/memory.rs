@@ -2,17 +2,12 @@
 
 use super::{CHUNK, MEASURED, layout};
 use crate::ensemble::normalized::NormalizedFix;
-use crate::ins::error_state::{STATES, STATES_WITH_SCALE};
 use crate::ins::setup::Scenario;
 
 /// The memory an ensemble of `scenario` holds, bytes: a chunk of realizations' normalized fixes,
 /// and twice the sums per fix and the residual products (a block's and the total).
 pub fn memory_bytes(scenario: &Scenario) -> f64 {
-    if scenario.error_states > STATES {
-        memory_bytes_of::<STATES_WITH_SCALE>(scenario)
-    } else {
-        memory_bytes_of::<STATES>(scenario)
-    }
+    crate::with_layout!(scenario.layout(), N => memory_bytes_of::<N>(scenario))
 }
 
 /// [`memory_bytes`] for an error state of `N`.

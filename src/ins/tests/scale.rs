@@ -7,12 +7,15 @@ use nalgebra::{Matrix3, SMatrix, Vector3};
 use crate::ins::discrete;
 use crate::ins::earth::{self, Geodetic};
 use crate::ins::error_state::{
-    self, ACCEL_SCALE, ATTITUDE, BiasDecay, GYRO_SCALE, Motion, STATES, STATES_WITH_SCALE, Square,
-    VELOCITY,
+    self, ATTITUDE, BiasDecay, Motion, STATES, STATES_WITH_SCALE, Square, VELOCITY,
 };
 use crate::ins::gnss;
 use crate::ins::mech::{Pva, skew};
+use crate::ins::state::Block;
 
+/// Where the scale factors start in the 21-state layout.
+const GYRO_SCALE: usize = error_state::start_of::<STATES_WITH_SCALE>(Block::GyroScale);
+const ACCEL_SCALE: usize = error_state::start_of::<STATES_WITH_SCALE>(Block::AccelScale);
 type Matrix21 = Square<STATES_WITH_SCALE>;
 
 /// A moving, turning, climbing vehicle: its solution, the true specific force and rate, the
