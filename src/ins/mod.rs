@@ -14,6 +14,7 @@ pub mod driver;
 pub mod earth;
 pub mod ensemble;
 pub mod error_state;
+pub mod extra;
 pub mod filter;
 pub mod gnss;
 pub mod measurement;
@@ -24,6 +25,8 @@ pub mod sensors;
 pub mod setup;
 pub mod simulated_logs;
 pub mod state;
+#[cfg(feature = "throwaway-measurement")]
+pub mod throwaway;
 pub mod truth;
 
 #[cfg(test)]

@@ -11,6 +11,7 @@ use crate::input::imu_csv::StepSource;
 use crate::input::records::{GnssRow, ImuStep};
 use crate::ins::driver::{Due, ImuSource, Observer, Source, Update};
 use crate::ins::error_state::Square;
+use crate::ins::extra::{Context, GNSS};
 use crate::ins::filter::Ekf;
 use crate::ins::gnss::FixUpdate;
 use crate::ins::measurement::Measurement;
@@ -22,6 +23,12 @@ pub(super) struct LogSteps<'a> {
     pub(super) first: Option<ImuStep>,
     /// The rest.
     pub(super) source: &'a mut dyn StepSource,
+}
+
+impl Context for LogSteps<'_> {
+    fn truth(&self) -> Option<&crate::ins::mech::Pva> {
+        None
+    }
 }
 
 impl ImuSource for LogSteps<'_> {
@@ -92,7 +99,11 @@ impl<'a, const N: usize> Recorder<'a, N> {
 impl<const N: usize, C: ?Sized> Observer<N, C> for Recorder<'_, N> {
     type Error = LogError;
 
-    fn before(&mut self, f: &mut Ekf<N>, _: &C, _: &Due) -> Result<(), LogError> {
+    fn before(&mut self, f: &mut Ekf<N>, _: &C, due: &Due) -> Result<(), LogError> {
+        if due.source != GNSS {
+            // Another source's update: carried inside the transition to the next fix.
+            return Ok(());
+        }
         let prior_covariance = f.covariance;
         let transition = f.take_transition().unwrap_or_else(Square::<N>::identity);
         let linear = f.take_noise_parts().map(|noise_parts| {
@@ -106,6 +117,9 @@ impl<const N: usize, C: ?Sized> Observer<N, C> for Recorder<'_, N> {
     }
 
     fn after(&mut self, f: &Ekf<N>, _: &C, due: &Due, update: Update<N>) -> Result<(), LogError> {
+        if due.source != GNSS {
+            return Ok(());
+        }
         let (Update::Tested(nu), Some((prior_covariance, transition, linear))) =
             (update, self.before.take())
         else {

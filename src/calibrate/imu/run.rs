@@ -189,11 +189,21 @@ fn run_filter<const N: usize>(
         first: Some(held),
         source,
     };
-    Driver::new(vec![&mut fixes as &mut dyn Source<N, LogSteps>])
-        .with_gate(gate_of(s))
-        .starting_at(rh.t_s)
-        .run(&mut ekf, &mut steps, &mut recorder)
-        .map_err(drive_error)?;
+    let last_s = rows.last().map_or(rh.t_s, |r| r.t_s);
+    let mut extra = crate::ins::extra::sources::<N, LogSteps>(rh.t_s, last_s);
+    {
+        let mut list = vec![&mut fixes as &mut dyn Source<N, LogSteps>];
+        list.extend(
+            extra
+                .iter_mut()
+                .map(|s| &mut **s as &mut dyn Source<N, LogSteps>),
+        );
+        Driver::new(list)
+            .with_gate(gate_of(s))
+            .starting_at(rh.t_s)
+            .run(&mut ekf, &mut steps, &mut recorder)
+            .map_err(drive_error)?;
+    }
     Ok(Filtered {
         plan,
         alignment,

@@ -10,6 +10,7 @@ use crate::ensemble::normalized::{FixInput, NormalizedFix, StageInput};
 use crate::ins::driver::{DriveError, Driver, Due, Observer, Source, Update};
 use crate::ins::earth::offset;
 use crate::ins::error_state::{STATES, Square};
+use crate::ins::extra::GNSS;
 use crate::ins::filter::Ekf;
 use crate::ins::mech::Pva;
 use crate::ins::sensors::Imu;
@@ -80,7 +81,14 @@ pub fn filter_realization<const N: usize>(
         prior: None,
         on_fix,
     };
-    Driver::new(vec![&mut gnss as &mut dyn Source<N, SimulatedImu>])
+    let mut extra = crate::ins::extra::sources::<N, SimulatedImu>(0.0, scenario.duration_s);
+    let mut list = vec![&mut gnss as &mut dyn Source<N, SimulatedImu>];
+    list.extend(
+        extra
+            .iter_mut()
+            .map(|s| &mut **s as &mut dyn Source<N, SimulatedImu>),
+    );
+    Driver::new(list)
         .run(&mut ekf, &mut sim, &mut observer)
         .map_err(|e| match e {
             DriveError::Filter(source) => RealizationError::Filter { index, source },
@@ -106,7 +114,15 @@ where
 {
     type Error = RealizationError;
 
-    fn before(&mut self, ekf: &mut Ekf<N>, sim: &SimulatedImu, _: &Due) -> Result<(), Self::Error> {
+    fn before(
+        &mut self,
+        ekf: &mut Ekf<N>,
+        sim: &SimulatedImu,
+        due: &Due,
+    ) -> Result<(), Self::Error> {
+        if due.source != GNSS {
+            return Ok(());
+        }
         self.prior = Some((error(ekf, sim.truth(), &sim.imu), ekf.covariance));
         Ok(())
     }
@@ -118,6 +134,10 @@ where
         due: &Due,
         update: Update<N>,
     ) -> Result<(), Self::Error> {
+        if due.source != GNSS {
+            // Judged through the fixes that follow: the sums are per GNSS fix.
+            return Ok(());
+        }
         let (index, fix) = (self.index, due.index);
         let (Update::Tested(innovation), Some((e_prior, p_prior))) = (update, self.prior.take())
         else {

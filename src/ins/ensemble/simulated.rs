@@ -26,6 +26,12 @@ pub struct SimulatedImu<'a> {
     pub steps: usize,
 }
 
+impl crate::ins::extra::Context for SimulatedImu<'_> {
+    fn truth(&self) -> Option<&crate::ins::mech::Pva> {
+        Some(SimulatedImu::truth(self))
+    }
+}
+
 impl SimulatedImu<'_> {
     /// The true state at the end of the last step read.
     pub fn truth(&self) -> &crate::ins::mech::Pva {
