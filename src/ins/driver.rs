@@ -27,6 +27,12 @@ pub trait ImuSource {
     fn next_step(&mut self) -> Result<Option<ImuStep>, Self::Error>;
 }
 
+/// What a measurement source may read of the IMU source it runs beside.
+pub trait Context {
+    /// The true navigation state at the last step, when the drive is simulated.
+    fn truth(&self) -> Option<&super::mech::Pva>;
+}
+
 /// A source of timed measurements, in time order, made with the IMU source `C` at hand (a
 /// simulation reads the truth and draws the receiver's noise from the realization's stream).
 pub trait Source<const N: usize, C: ?Sized> {

@@ -5,9 +5,8 @@
 
 use nalgebra::RowSVector;
 
-use super::driver::Source;
+use super::driver::{Context, Source};
 use super::error_state::VELOCITY;
-use super::extra::Context;
 use super::measurement::{At, Measurement, Rows};
 use super::names::VARIABLES;
 

@@ -26,7 +26,7 @@ pub struct SimulatedImu<'a> {
     pub steps: usize,
 }
 
-impl crate::ins::extra::Context for SimulatedImu<'_> {
+impl crate::ins::driver::Context for SimulatedImu<'_> {
     fn truth(&self) -> Option<&crate::ins::mech::Pva> {
         Some(SimulatedImu::truth(self))
     }
