@@ -21,6 +21,7 @@ pub mod imu_channels_csv;
 pub mod imu_csv;
 pub mod mcap;
 pub mod messages;
+pub mod read_ahead;
 pub mod recording;
 pub mod records;
 pub mod rosbag1;

@@ -13,6 +13,7 @@ use super::step::{part, start, velocity_sigmas};
 use crate::input::csv::read::LogSource;
 use crate::input::gnss_csv::read_gnss;
 use crate::input::imu_csv::{HeldSteps, ImuLayout, ImuReader, ImuSpan, StepSource};
+use crate::input::read_ahead::consume_beside;
 use crate::input::records::{GnssRow, ImuStep};
 use crate::input::{LogError, LogProblem};
 use crate::ins::driver::{DriveError, Driver, ImuSource, Source};
@@ -255,7 +256,8 @@ pub fn calibrate_of<const N: usize>(
     let rows = shifted(&read_gnss(gnss)?, s.gnss_time_offset_s);
     let mut reader = ImuReader::open(imu, s.axes)?;
     let layout = reader.layout();
-    let run = filter(&rows, &mut reader, s, gnss.name());
+    let name = gnss.name();
+    let run = consume_beside(&mut reader, |steps| filter(&rows, steps, s, name));
     let span = reader.finish()?;
     assemble(&rows, run?, (span, layout), s, gnss.name())
 }
