@@ -16,7 +16,7 @@
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use super::earth::{self, Geodetic};
-use super::error_state::{ATTITUDE, GYRO_BIAS, POSITION, STATES, VELOCITY, holds, start_of};
+use super::error_state::{ATTITUDE, GYRO_BIAS, POSITION, STATES, VELOCITY, offset_of};
 use super::measurement::{At, Measurement, Rows};
 use super::mech::{Pva, skew};
 use super::names::MEASUREMENTS;
@@ -81,31 +81,65 @@ pub fn observation_of<const N: usize>(
     lever_b_m: &Vector3<f64>,
     omega_ib_b: &Vector3<f64>,
 ) -> SMatrix<f64, 6, N> {
+    let mut h = SMatrix::<f64, 6, N>::zeros();
     let c = *pva.attitude.to_rotation_matrix().matrix();
+    let (position, velocity) = (
+        position_blocks(&c, lever_b_m),
+        velocity_blocks::<N>(pva, &c, lever_b_m, omega_ib_b),
+    );
+    for (row, blocks) in [(0, &position[..]), (3, velocity.as_slice())] {
+        for (col, m) in blocks {
+            h.fixed_view_mut::<3, 3>(row, *col).copy_from(m);
+        }
+    }
+    h
+}
+
+/// The antenna position's nonzero 3×3 blocks of H, each at its first column (`c` = C_b^n).
+fn position_blocks(c: &Matrix3<f64>, lever_b_m: &Vector3<f64>) -> [(usize, Matrix3<f64>); 2] {
+    let arm_n = c * lever_b_m;
+    [(POSITION, Matrix3::identity()), (ATTITUDE, -skew(&arm_n))]
+}
+
+/// The antenna velocity's nonzero 3×3 blocks of H over an error state of `N`.
+fn velocity_blocks<const N: usize>(
+    pva: &Pva,
+    c: &Matrix3<f64>,
+    lever_b_m: &Vector3<f64>,
+    omega_ib_b: &Vector3<f64>,
+) -> Blocks {
     let arm_n = c * lever_b_m;
     let w_in = earth::earth_rate_ned(pva.position.lat_rad)
         + earth::transport_rate_ned(&pva.position, &pva.velocity_ned_m_s);
-    let mut h = SMatrix::<f64, 6, N>::zeros();
-    let mut set = |row: usize, col: usize, m: Matrix3<f64>| {
-        h.fixed_view_mut::<3, 3>(row, col).copy_from(&m);
-    };
-    set(0, POSITION, Matrix3::identity());
-    set(0, ATTITUDE, -skew(&arm_n));
-    set(3, VELOCITY, Matrix3::identity());
-    set(
-        3,
+    let mut blocks = Blocks::default();
+    blocks.push((VELOCITY, Matrix3::identity()));
+    blocks.push((
         ATTITUDE,
         -skew(&(c * omega_ib_b.cross(lever_b_m))) + skew(&w_in) * skew(&arm_n),
-    );
-    set(3, GYRO_BIAS, c * skew(lever_b_m));
-    if holds::<N>(Block::GyroScale) {
-        set(
-            3,
-            start_of::<N>(Block::GyroScale),
-            c * skew(lever_b_m) * Matrix3::from_diagonal(omega_ib_b),
-        );
+    ));
+    blocks.push((GYRO_BIAS, c * skew(lever_b_m)));
+    if let Some(at) = const { offset_of::<N>(Block::GyroScale) } {
+        blocks.push((at, c * skew(lever_b_m) * Matrix3::from_diagonal(omega_ib_b)));
     }
-    h
+    blocks
+}
+
+/// At most four 3×3 blocks of a row of H, each at its first column.
+#[derive(Default)]
+struct Blocks {
+    items: [(usize, Matrix3<f64>); 4],
+    len: usize,
+}
+
+impl Blocks {
+    fn push(&mut self, block: (usize, Matrix3<f64>)) {
+        self.items[self.len] = block;
+        self.len += 1;
+    }
+
+    fn as_slice(&self) -> &[(usize, Matrix3<f64>)] {
+        &self.items[..self.len]
+    }
 }
 
 /// The position components' names.
@@ -137,10 +171,9 @@ impl<const N: usize> Measurement<N> for Position {
         let z = ned_difference_m(&position, &self.0.position);
         let s = &self.0.position_sigma_m;
         let c = *at.pva.attitude.to_rotation_matrix().matrix();
-        let arm_n = c * at.lever_arm_b_m;
         rows.push3(
             (&z, &s.component_mul(s)),
-            &[(POSITION, Matrix3::identity()), (ATTITUDE, -skew(&arm_n))],
+            &position_blocks(&c, &at.lever_arm_b_m),
             position_names(),
             [true; 3],
         );
@@ -169,22 +202,11 @@ impl<const N: usize> Measurement<N> for Velocity {
         let omega = &at.rate_ib_b_rad_s;
         let (_, velocity) = antenna(at.pva, &at.lever_arm_b_m, omega);
         let s = &self.fix.velocity_sigma_m_s;
-        let h = observation_of::<N>(at.pva, &at.lever_arm_b_m, omega);
-        let block = |col: usize| h.fixed_view::<3, 3>(3, col).into_owned();
-        let mut blocks = vec![
-            (VELOCITY, block(VELOCITY)),
-            (ATTITUDE, block(ATTITUDE)),
-            (GYRO_BIAS, block(GYRO_BIAS)),
-        ];
-        if holds::<N>(Block::GyroScale) {
-            blocks.push((
-                start_of::<N>(Block::GyroScale),
-                block(start_of::<N>(Block::GyroScale)),
-            ));
-        }
+        let c = *at.pva.attitude.to_rotation_matrix().matrix();
+        let blocks = velocity_blocks::<N>(at.pva, &c, &at.lever_arm_b_m, omega);
         rows.push3(
             (&(velocity - v), &s.component_mul(s)),
-            &blocks,
+            blocks.as_slice(),
             velocity_names(),
             self.measured,
         );
