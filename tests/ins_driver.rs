@@ -122,13 +122,7 @@ fn run(
     watch_s: f64,
 ) -> (Ekf, Seen) {
     let (imu, mut ekf) = start::<STATES>(scenario, track, index);
-    let mut sim = SimulatedImu {
-        scenario,
-        track,
-        drive: scenario.drive(),
-        imu,
-        steps: 0,
-    };
+    let mut sim = SimulatedImu::new(scenario, track, imu);
     let inner = SimulatedGnss::of(scenario, track);
     let mut seen = Seen {
         watch_s,

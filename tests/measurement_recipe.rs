@@ -48,13 +48,7 @@ fn the_throwaway_measurement_runs_beside_gnss_in_a_simulated_drive() {
     let scenario = Scenario::from_config(&c).expect("a valid scenario");
     let track = Track::of(&scenario);
     let (imu, mut ekf) = start::<STATES>(&scenario, &track, 0);
-    let mut sim = SimulatedImu {
-        scenario: &scenario,
-        track: &track,
-        drive: scenario.drive(),
-        imu,
-        steps: 0,
-    };
+    let mut sim = SimulatedImu::new(&scenario, &track, imu);
     let mut gnss = SimulatedGnss::of(&scenario, &track);
     let mut extra = sources::<STATES, SimulatedImu>(0.0, scenario.duration_s);
     assert_eq!(extra.len(), 1, "the throwaway is in the list");

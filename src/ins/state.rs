@@ -72,34 +72,20 @@ impl Block {
     }
 }
 
-/// The blocks every layout holds first: the 15-state filter's.
-const CORE: [Block; 5] = [
-    Block::Position,
-    Block::Velocity,
-    Block::Attitude,
-    Block::GyroBias,
-    Block::AccelBias,
-];
-
 /// The error state's blocks in order, each starting where the one before ends.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Layout {
     blocks: &'static [Block],
 }
 
-/// The supported layouts, one per size: the 15 core states, and with the six scale factors 21.
+/// The supported layouts, one per size: the 15 core states (the first five blocks), and with
+/// the six scale factors 21 (every block).
 pub const LAYOUTS: [Layout; 2] = [
-    Layout { blocks: &CORE },
     Layout {
-        blocks: &[
-            Block::Position,
-            Block::Velocity,
-            Block::Attitude,
-            Block::GyroBias,
-            Block::AccelBias,
-            Block::GyroScale,
-            Block::AccelScale,
-        ],
+        blocks: Block::ALL.split_at(5).0,
+    },
+    Layout {
+        blocks: &Block::ALL,
     },
 ];
 

@@ -68,13 +68,7 @@ pub fn filter_realization<const N: usize>(
     on_fix: impl FnMut(&FixView<N>) -> Result<(), RealizationError>,
 ) -> Result<(Ekf<N>, Imu), RealizationError> {
     let (imu, mut ekf) = start(scenario, track, index);
-    let mut sim = SimulatedImu {
-        scenario,
-        track,
-        drive: scenario.drive(),
-        imu,
-        steps: 0,
-    };
+    let mut sim = SimulatedImu::new(scenario, track, imu);
     let mut gnss = SimulatedGnss::of(scenario, track);
     let mut observer = Normalizer {
         index,

@@ -32,7 +32,18 @@ impl crate::ins::driver::Context for SimulatedImu<'_> {
     }
 }
 
-impl SimulatedImu<'_> {
+impl<'a> SimulatedImu<'a> {
+    /// Realization sensors `imu` over `track`, the truth of `scenario`, before its first step.
+    pub fn new(scenario: &'a Scenario, track: &'a Track, imu: Imu) -> Self {
+        SimulatedImu {
+            scenario,
+            track,
+            drive: scenario.drive(),
+            imu,
+            steps: 0,
+        }
+    }
+
     /// The true state at the end of the last step read.
     pub fn truth(&self) -> &crate::ins::mech::Pva {
         self.steps
