@@ -54,7 +54,7 @@ impl StepSource for Ahead {
 }
 
 /// `consume` run on the steps of `source`, read on this thread while `consume` runs on another.
-/// When `consume` returns before the log's end, the reading stops within [`DEPTH`] chunks.
+/// When `consume` returns before the log's end, the reading stops within `DEPTH` (4) chunks.
 pub fn consume_beside<T: Send>(
     source: &mut dyn StepSource,
     consume: impl FnOnce(&mut dyn StepSource) -> T + Send,
