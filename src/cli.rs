@@ -62,6 +62,9 @@ pub enum ModelKind {
     /// The three-axis strapdown INS/GNSS study.
     #[value(name = "ins")]
     Ins,
+    /// The three-axis study with the IMU in a car: its mounting, the non-holonomic constraint.
+    #[value(name = "car")]
+    Car,
 }
 
 /// Options shared by every command that runs the model.

@@ -50,7 +50,7 @@ fn the_throwaway_measurement_runs_beside_gnss_in_a_simulated_drive() {
     let (imu, mut ekf) = start::<STATES>(&scenario, &track, 0);
     let mut sim = SimulatedImu::new(&scenario, &track, imu);
     let mut gnss = SimulatedGnss::of(&scenario, &track);
-    let mut extra = sources::<STATES, SimulatedImu>(0.0, scenario.duration_s);
+    let mut extra = sources::<STATES, SimulatedImu>(0.0, scenario.duration_s, &scenario.aids());
     assert_eq!(extra.len(), 1, "the throwaway is in the list");
     let mut list = vec![&mut gnss as &mut dyn Source<STATES, SimulatedImu>];
     list.extend(

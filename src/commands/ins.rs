@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use crate::cli::{EnsembleArgs, MergeArgs, ModelArgs, SimulateArgs};
+use crate::cli::{EnsembleArgs, MergeArgs, ModelArgs, ModelKind, SimulateArgs};
 use accelcal::checks::{Budget, evaluate};
 use accelcal::config::ConfigText;
 use accelcal::config::ins::InsConfig;
@@ -34,12 +34,16 @@ const GNSS_FILE: &str = "gnss.csv";
 const TRUTH_FILE: &str = "truth.csv";
 
 /// The three-axis scenario named by `args` (`--config`, `--seed`), validated.
-pub(super) fn load_scenario(args: &ModelArgs) -> Result<Scenario, ConfigError> {
-    load(args, None).map(|(_, s)| s)
+pub(super) fn load_scenario(args: &ModelArgs, kind: ModelKind) -> Result<Scenario, ConfigError> {
+    load(args, kind, None).map(|(_, s)| s)
 }
 
 /// The configuration and scenario named by `args`, `realizations` overriding the file's.
-fn load(args: &ModelArgs, realizations: Option<u64>) -> Result<(InsConfig, Scenario), ConfigError> {
+fn load(
+    args: &ModelArgs,
+    kind: ModelKind,
+    realizations: Option<u64>,
+) -> Result<(InsConfig, Scenario), ConfigError> {
     let text = args.config.as_deref().map(ConfigText::read).transpose()?;
     let locate = |e: ConfigError| match &text {
         Some(t) => t.locate(e),
@@ -49,6 +53,24 @@ fn load(args: &ModelArgs, realizations: Option<u64>) -> Result<(InsConfig, Scena
         Some(t) => InsConfig::from_toml_str(&t.text).map_err(locate)?,
         None => InsConfig::default(),
     };
+    // `--model car` makes a file without a model key a car's; a file that says "ins" is not one.
+    if kind == ModelKind::Car {
+        match config.model.as_deref() {
+            None => config.model = Some("car".into()),
+            Some("car") => {}
+            Some(m) => {
+                return Err(locate(ConfigError::invalid(
+                    "model",
+                    m,
+                    "\"car\" (or left out) with --model car",
+                )));
+            }
+        }
+    }
+    // The output's copy of the configuration shows the vehicle it ran.
+    if config.is_car() && config.vehicle.is_none() {
+        config.vehicle = Some(Default::default());
+    }
     if let Some(s) = args.seed {
         config.ensemble.seed = s;
     }
@@ -87,7 +109,7 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         )
         .into());
     }
-    let (config, scenario) = load(&args.model, args.realizations)?;
+    let (config, scenario) = load(&args.model, args.kind, args.realizations)?;
     let bytes = ins_ensemble::memory_bytes(&scenario);
     if bytes > MAX_ENSEMBLE_BYTES {
         let fixes = scenario.duration_s * scenario.imu_rate_hz / scenario.imu_steps_per_fix as f64;
@@ -300,7 +322,7 @@ pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
         )
         .into());
     };
-    let scenario = load_scenario(&args.model)?;
+    let scenario = load_scenario(&args.model, args.kind)?;
     let names = [IMU_FILE, GNSS_FILE, TRUTH_FILE];
     check_directory(dir, &names)?;
     let mut staged = StagedFiles::create(dir, &names)?;
@@ -314,10 +336,13 @@ pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
     staged.commit()?;
     let deg_h = |x: f64| (x * 3600.0).to_degrees();
     let (g, a) = (written.gyro_bias_rad_s, written.accel_bias_m_s2);
+    let mounted = written.mounting_rpy_deg.map_or(String::new(), |[r, p, y]| {
+        format!(", mounted at roll {r:.2}°, pitch {p:.2}°, yaw {y:.2}° in the car")
+    });
     super::say(&format!(
         "realization {} (three axes, {} s at {} Hz): gyro biases {:.2}, {:.2}, {:.2} °/h, \
-         accelerometer biases {:.3}, {:.3}, {:.3} mg at the start; {} IMU samples and {} fixes \
-         written to {} ({IMU_FILE}, {GNSS_FILE}, {TRUTH_FILE})\n",
+         accelerometer biases {:.3}, {:.3}, {:.3} mg at the start{mounted}; {} IMU samples and \
+         {} fixes written to {} ({IMU_FILE}, {GNSS_FILE}, {TRUTH_FILE})\n",
         args.realization,
         scenario.duration_s,
         scenario.imu_rate_hz,

@@ -108,9 +108,10 @@ pub fn run(cli: Cli) -> Result<()> {
             _ => logs::run_calibrate(&args),
         },
         Some(Command::Allan(args)) => allan::run_allan(&args),
-        Some(Command::Config(args)) => say(match args.model {
-            ModelKind::Accelerometer => DEFAULT_TOML,
-            ModelKind::Ins => accelcal::config::ins::DEFAULT_INS_TOML,
+        Some(Command::Config(args)) => say(&match args.model {
+            ModelKind::Accelerometer => DEFAULT_TOML.to_string(),
+            ModelKind::Ins => accelcal::config::ins::DEFAULT_INS_TOML.to_string(),
+            ModelKind::Car => accelcal::config::ins::default_car_toml(),
         }),
     }
 }

@@ -9,7 +9,8 @@ use crate::checks::{ResidualPair, Verdicts};
 use crate::config::ins::InsConfig;
 use crate::ensemble::Statistics;
 use crate::ins::ensemble::{Calibration, Outcome};
-use crate::ins::names::{MEASUREMENTS, VARIABLES};
+use crate::ins::names::MEASUREMENTS;
+use crate::ins::state::Layout;
 use crate::stats::binomial_band;
 
 /// One error state at the end of the drive.
@@ -72,7 +73,7 @@ pub struct FixRecord {
 pub struct InsEnsembleFile<'a> {
     /// The version that wrote it.
     pub accelcal_version: &'static str,
-    /// Always "ins".
+    /// "ins", or "car" for an IMU in a vehicle.
     pub model: &'static str,
     /// The configuration.
     pub config: &'a InsConfig,
@@ -86,8 +87,8 @@ pub struct InsEnsembleFile<'a> {
 
 fn states<const N: usize>(c: &Calibration<N>, alpha: f64) -> Vec<StateRecord> {
     let band = binomial_band(c.realizations, 0.95, alpha);
-    VARIABLES[..N]
-        .iter()
+    Layout::of::<N>()
+        .variables()
         .enumerate()
         .map(|(k, v)| StateRecord {
             state: v.key,
@@ -111,9 +112,10 @@ pub fn document<'a, const N: usize>(
     let stats = &outcome.stats;
     let times: Vec<f64> = stats.fixes.iter().map(|f| f.time_s).collect();
     let n = times.len();
+    let names = Layout::of::<N>().variable_list();
     InsEnsembleFile {
         accelcal_version: env!("CARGO_PKG_VERSION"),
-        model: "ins",
+        model: if config.is_car() { "car" } else { "ins" },
         config,
         summary: InsSummary {
             realizations: stats.realizations,
@@ -123,7 +125,7 @@ pub fn document<'a, const N: usize>(
             checks: verdicts
                 .checks
                 .iter()
-                .map(|c| CheckRecord::with_names(c, &times, &VARIABLES[..N], &MEASUREMENTS))
+                .map(|c| CheckRecord::with_names(c, &times, &names, &MEASUREMENTS))
                 .collect(),
             residual_pairs: ResidualPairs {
                 all_pairs: stats.residual_layout.max_lag().is_none(),

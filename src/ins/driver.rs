@@ -31,6 +31,9 @@ pub trait ImuSource {
 pub trait Context {
     /// The true navigation state at the last step, when the drive is simulated.
     fn truth(&self) -> Option<&super::mech::Pva>;
+    /// A draw of N(0, 1) for a simulated measurement's noise from the realization's stream; 0
+    /// on a recording (its measurement is what was recorded).
+    fn normal(&mut self) -> f64;
 }
 
 /// A source of timed measurements, in time order, made with the IMU source `C` at hand (a

@@ -11,7 +11,7 @@
 
 use std::ops::Range;
 
-use nalgebra::SVector;
+use nalgebra::{SVector, UnitQuaternion};
 use rayon::prelude::*;
 
 use crate::ensemble::normalized::{NormalizedFix, NormalizedSums};
@@ -156,9 +156,11 @@ impl Track {
     }
 }
 
-/// The error of `ekf` against the true state, biases (and scale factors), in the error state's
+/// The error of `ekf` against the true state (`vehicle`: the drive's, the IMU's own unless it is
+/// mounted in a vehicle), biases (and scale factors, mounting), in the error state's
 /// coordinates.
-pub fn error<const N: usize>(ekf: &Ekf<N>, pva: &Pva, imu: &Imu) -> SVector<f64, N> {
+pub fn error<const N: usize>(ekf: &Ekf<N>, vehicle: &Pva, imu: &Imu) -> SVector<f64, N> {
+    let pva = &imu.pva_of(vehicle);
     let mut e = SVector::<f64, N>::zeros();
     e.fixed_rows_mut::<3>(POSITION)
         .copy_from(&gnss::ned_difference_m(&ekf.pva.position, &pva.position));
@@ -175,6 +177,11 @@ pub fn error<const N: usize>(ekf: &Ekf<N>, pva: &Pva, imu: &Imu) -> SVector<f64,
             .copy_from(&(ekf.gyro_scale - imu.gyro_scale));
         e.fixed_rows_mut::<3>(start_of::<N>(Block::AccelScale))
             .copy_from(&(ekf.accel_scale - imu.accel_scale));
+    }
+    if holds::<N>(Block::Mounting) {
+        let truth = imu.mounting.unwrap_or_else(UnitQuaternion::identity);
+        e.fixed_rows_mut::<3>(start_of::<N>(Block::Mounting))
+            .copy_from(&(ekf.mounting * truth.inverse()).scaled_axis());
     }
     e
 }

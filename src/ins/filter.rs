@@ -7,7 +7,7 @@
 //! The update is the Joseph form P⁺ = (I − KH)P(I − KH)ᵀ + KRKᵀ with the gain from a Cholesky
 //! factor of the innovation covariance S = HPHᵀ + R (no explicit inverse).
 
-use nalgebra::{DMatrix, DVector, Matrix3, SVector, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, SVector, UnitQuaternion, Vector3};
 use thiserror::Error;
 
 use crate::state::Variable;
@@ -121,6 +121,9 @@ pub struct Ekf<const N: usize = STATES> {
     pub gyro_scale: Vector3<f64>,
     /// The accelerometer scale factor estimates (dimensionless), likewise.
     pub accel_scale: Vector3<f64>,
+    /// The IMU's mounting in the vehicle, q_b^v (C_b^v: IMU axes to the vehicle's
+    /// forward-right-down); corrected with the mounting block, else held as given.
+    pub mounting: UnitQuaternion<f64>,
     /// The error state's covariance P: current after each update and after the step that ends a
     /// covariance interval. With [`Propagation::Interval`] the intervals divide the time between
     /// the last two fixes, so with evenly spaced fixes P is current at each; [`Ekf::flush`]
@@ -169,6 +172,7 @@ impl<const N: usize> Ekf<N> {
             accel_bias_m_s2: Vector3::zeros(),
             gyro_scale: Vector3::zeros(),
             accel_scale: Vector3::zeros(),
+            mounting: UnitQuaternion::identity(),
             covariance: p0,
             noise,
             decay,
@@ -198,6 +202,14 @@ impl<const N: usize> Ekf<N> {
     /// the identity; `None` unless tracked.
     pub fn take_transition(&mut self) -> Option<Square<N>> {
         self.transition.replace(Square::<N>::identity())
+    }
+
+    /// The same filter with the IMU mounted in the vehicle by `mounting` (q_b^v), its estimate
+    /// or its given value.
+    #[must_use]
+    pub fn with_mounting(mut self, mounting: UnitQuaternion<f64>) -> Self {
+        self.mounting = mounting;
+        self
     }
 
     /// The same filter propagating its covariance as `propagation` says.
@@ -372,6 +384,13 @@ impl<const N: usize> Ekf<N> {
         if holds::<N>(Block::GyroScale) {
             self.gyro_scale -= dx.fixed_rows::<3>(start_of::<N>(Block::GyroScale));
             self.accel_scale -= dx.fixed_rows::<3>(start_of::<N>(Block::AccelScale));
+        }
+        if holds::<N>(Block::Mounting) {
+            // Ĉ_b^v = exp([δμ×])C_b^v, so C_b^v = exp(−[δμ×])Ĉ_b^v, as the attitude.
+            let mu = dx
+                .fixed_rows::<3>(start_of::<N>(Block::Mounting))
+                .into_owned();
+            self.mounting = UnitQuaternion::from_scaled_axis(-mu) * self.mounting;
         }
     }
 }

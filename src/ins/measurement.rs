@@ -9,7 +9,7 @@
 //! on their count to a fixed-size Joseph form. Several measurements at one time are stacked into
 //! one update ([`Stacked`]): a GNSS fix is its position and its velocity together.
 
-use nalgebra::{Matrix3, RowSVector, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, RowSVector, SMatrix, SVector, UnitQuaternion, Vector3};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 use super::error_state::STATES;
@@ -29,6 +29,8 @@ pub struct At<'a> {
     /// The compensated angular rate of the last IMU step, body axes, rad/s (zero before the
     /// first step).
     pub rate_ib_b_rad_s: Vector3<f64>,
+    /// The IMU's mounting in the vehicle, q_b^v (identity for a free body).
+    pub mounting: UnitQuaternion<f64>,
 }
 
 /// A measurement's rows at the filter's solution: the innovation z = ẑ − z̃ (the solution's

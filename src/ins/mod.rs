@@ -20,6 +20,7 @@ pub mod gnss;
 pub mod measurement;
 pub mod mech;
 pub mod names;
+pub mod nhc;
 pub mod partial;
 pub mod sensors;
 pub mod setup;

@@ -18,8 +18,9 @@ const fn v(
 }
 
 /// The error states: δr, δv (NED), δψ, δb_g, δb_a (body axes), then in the 21-state form δs_g,
-/// δs_a (the first 15 are the 15-state form's): three per [`super::state::Block`], in its order.
-pub const VARIABLES: [Variable; 21] = [
+/// δs_a (the first 15 are the 15-state form's), and a car's δμ (vehicle axes): three per
+/// [`super::state::Block`], in its order.
+pub const VARIABLES: [Variable; 24] = [
     v("position_n", "north position error", "δr_N", "m"),
     v("position_e", "east position error", "δr_E", "m"),
     v("position_d", "down position error", "δr_D", "m"),
@@ -71,6 +72,9 @@ pub const VARIABLES: [Variable; 21] = [
         "δs_az",
         "1",
     ),
+    v("mounting_x", "mounting angle error about x", "δμ_x", "rad"),
+    v("mounting_y", "mounting angle error about y", "δμ_y", "rad"),
+    v("mounting_z", "mounting angle error about z", "δμ_z", "rad"),
 ];
 
 /// The GNSS measurement's rows: position and velocity, NED.

@@ -17,7 +17,6 @@ use serde::{Deserialize, Serialize};
 
 use super::blocks;
 use super::ensemble::{InsSums, MEASURED, Track, empty_sums};
-use super::error_state::STATES;
 use super::setup::Scenario;
 use super::state::Layout;
 use crate::config::ins::InsConfig;
@@ -63,7 +62,7 @@ const fn fix_len<const N: usize>() -> usize {
 
 /// The error states of the filter `config` configures.
 fn states_of(config: &InsConfig) -> usize {
-    config.filter.error_states.map_or(STATES, |n| n as usize)
+    config.error_states()
 }
 
 impl InsPartialHeader {

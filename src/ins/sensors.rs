@@ -10,10 +10,16 @@
 //! noise of the true increment x (Groves §4.4.2, the scale-factor error; cross-coupling left
 //! out). The scale factors come from a stream of their own, so a study without them draws the
 //! same numbers as before they existed.
+//!
+//! A car's IMU is mounted in the vehicle by a rotation C_b^v: the drive's truth is the vehicle's,
+//! and the IMU reads its increments in its own axes, x^b = C_v^b·x^v (a constant rotation: the
+//! increments rotate as the rates do). The rotation is the configured one times small angles
+//! ε ~ N(0, σ²) per axis in the vehicle's axes, exp(\[ε×\])·C_nominal, drawn once per
+//! realization from a stream of its own.
 
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 
-use super::mech::Increment;
+use super::mech::{Increment, Pva};
 use crate::random::{Stream, splitmix64};
 
 /// Key of the random streams of three-axis realizations.
@@ -21,6 +27,19 @@ const STREAM_KEY: u64 = 0x696e_735f_7265_616c;
 
 /// Key of the scale factors' streams.
 const SCALE_KEY: u64 = 0x696e_735f_7363_616c;
+
+/// Key of the mounting angles' streams.
+const MOUNTING_KEY: u64 = 0x696e_735f_6d6f_756e;
+
+/// How the IMU sits in a vehicle: the configured rotation and the σ of the small angles about
+/// it, drawn once per realization.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mounting {
+    /// The configured q_b^v (IMU axes to the vehicle's forward-right-down).
+    pub nominal: UnitQuaternion<f64>,
+    /// The small angles' σ per axis, rad.
+    pub sigma_rad: f64,
+}
 
 /// How one sensor triad's bias moves.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -106,6 +125,8 @@ pub struct ImuModel {
     pub gyro_scale_sigma: f64,
     /// The accelerometer scale factors' σ (dimensionless).
     pub accel_scale_sigma: f64,
+    /// The IMU's mounting in a vehicle; `None`: the drive's truth is the IMU's own.
+    pub mounting: Option<Mounting>,
 }
 
 /// What one step of a given length draws with: the white noises' σ's and the biases' (φ, σ_η),
@@ -150,6 +171,8 @@ pub struct Imu {
     pub gyro_scale: Vector3<f64>,
     /// The accelerometer scale factors (dimensionless).
     pub accel_scale: Vector3<f64>,
+    /// The true q_b^v when mounted in a vehicle.
+    pub mounting: Option<UnitQuaternion<f64>>,
 }
 
 impl Imu {
@@ -165,6 +188,11 @@ impl Imu {
         let mut draw = |sigma: f64| Vector3::from_fn(|_, _| sigma * scale.normal());
         let gyro_scale = draw(model.gyro_scale_sigma);
         let accel_scale = draw(model.accel_scale_sigma);
+        let mounting = model.mounting.map(|m| {
+            let mut small = Stream::new(splitmix64(seed ^ MOUNTING_KEY), index);
+            let e = Vector3::from_fn(|_, _| m.sigma_rad * small.normal());
+            UnitQuaternion::from_scaled_axis(e) * m.nominal
+        });
         Imu {
             model,
             stream,
@@ -173,11 +201,42 @@ impl Imu {
             accel_bias_m_s2,
             gyro_scale,
             accel_scale,
+            mounting,
         }
     }
 
-    /// What the IMU outputs for the true increments `truth` (its biases then step on).
-    pub fn read(&mut self, truth: &Increment) -> Increment {
+    /// The IMU's true navigation state when the vehicle's is `vehicle`: the same position and
+    /// velocity, the attitude C_b^n = C_v^n·C_b^v (the vehicle's itself without a mounting).
+    pub fn pva_of(&self, vehicle: &Pva) -> Pva {
+        match self.mounting {
+            Some(q_bv) => Pva {
+                attitude: vehicle.attitude * q_bv,
+                ..*vehicle
+            },
+            None => *vehicle,
+        }
+    }
+
+    /// A vector of the vehicle's axes in the IMU's, C_v^b·x (itself without a mounting).
+    pub fn to_body(&self, x: &Vector3<f64>) -> Vector3<f64> {
+        self.mounting.map_or(*x, |q| q.inverse_transform_vector(x))
+    }
+
+    /// What the IMU outputs for the true increments `truth` (the vehicle's, when mounted in
+    /// one); its biases then step on.
+    pub fn read(&mut self, vehicle: &Increment) -> Increment {
+        let rotated;
+        let truth = match self.mounting {
+            Some(_) => {
+                rotated = Increment {
+                    dtheta_rad: self.to_body(&vehicle.dtheta_rad),
+                    dvel_m_s: self.to_body(&vehicle.dvel_m_s),
+                    dt_s: vehicle.dt_s,
+                };
+                &rotated
+            }
+            None => vehicle,
+        };
         let dt = truth.dt_s;
         let k = match self.scales {
             Some(k) if k.dt_s == dt => k,
@@ -204,6 +263,11 @@ impl Imu {
             dvel_m_s: dvel,
             dt_s: dt,
         }
+    }
+
+    /// A draw of N(0, 1) from this realization's stream.
+    pub fn normal(&mut self) -> f64 {
+        self.stream.normal()
     }
 
     /// A draw of N(0, σ²) per component from this realization's stream (for the GNSS noise and

@@ -1,16 +1,16 @@
 //! The three-axis scenario as the configuration describes it: the drive, the true sensors and the
 //! sensors the filter assumes, in the navigation layer's types.
 
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 
 use super::discrete::NoiseDensities;
 use super::drive::Drive;
 use super::earth::Geodetic;
 use super::error_state::{ACCEL_BIAS, BiasDecay, GYRO_BIAS, Matrix15, Square, holds, start_of};
-use super::sensors::{BiasProcess, Imu, ImuModel};
+use super::sensors::{BiasProcess, Imu, ImuModel, Mounting};
 use super::state::{Block, Layout};
 use crate::config::BiasModelKind;
-use crate::config::ins::{GnssConfig, ImuConfig, InsConfig};
+use crate::config::ins::{GnssConfig, ImuConfig, InsConfig, VehicleConfig};
 use crate::error::ConfigError;
 
 /// A GNSS receiver: its antenna and white noise.
@@ -22,6 +22,29 @@ pub struct GnssModel {
     pub position_sigma_m: Vector3<f64>,
     /// Velocity σ per component, m/s.
     pub velocity_sigma_m_s: Vector3<f64>,
+}
+
+/// A car: the mounting its filter assumes and the non-holonomic constraint.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Vehicle {
+    /// The mounting the filter assumes, q_b^v (the truth's is in [`ImuModel::mounting`]).
+    pub filter_mounting: UnitQuaternion<f64>,
+    /// The filter's prior σ of the mounting's small angles, rad.
+    pub mounting_sigma_rad: f64,
+    /// The true slip σ of the lateral and vertical velocity, m/s.
+    pub nhc_sigma_m_s: f64,
+    /// The slip σ the filter assumes, m/s.
+    pub filter_nhc_sigma_m_s: f64,
+    /// The constraint's rate, Hz.
+    pub nhc_rate_hz: f64,
+    /// The speed above which the constraint is applied, m/s.
+    pub nhc_min_speed_m_s: f64,
+}
+
+/// q_b^v of a configured roll, pitch and yaw (ZYX), degrees.
+fn rotation_of(rpy_deg: [f64; 3]) -> UnitQuaternion<f64> {
+    let [r, p, y] = rpy_deg.map(f64::to_radians);
+    super::attitude_from_euler(r, p, y)
 }
 
 /// The validated scenario.
@@ -56,8 +79,10 @@ pub struct Scenario {
     /// The Earth's rotation rate the filter's mechanization uses, rad/s: the true one, or 0 in
     /// the negative control of a filter that leaves it out.
     pub filter_earth_rotation_rad_s: f64,
-    /// The filter's error states: 15, or 21 with the scale factors.
+    /// The filter's error states: 15, 21 with the scale factors, or 18 with a car's mounting.
     pub error_states: usize,
+    /// The car, when the IMU is mounted in one.
+    pub vehicle: Option<Vehicle>,
 }
 
 impl Scenario {
@@ -79,8 +104,12 @@ fn bias(kind: BiasModelKind, sigma: f64, tau_s: f64, k: f64) -> BiasProcess {
     }
 }
 
-fn imu_model(c: &ImuConfig) -> ImuModel {
+fn imu_model(c: &ImuConfig, vehicle: Option<&VehicleConfig>) -> ImuModel {
     ImuModel {
+        mounting: vehicle.map(|v| Mounting {
+            nominal: rotation_of(v.mounting_rpy_deg),
+            sigma_rad: v.mounting_sigma_deg.to_radians(),
+        }),
         gyro_arw_rad_per_sqrt_s: c.gyro_arw_rad_per_sqrt_s,
         accel_vrw_m_s_per_sqrt_s: c.accel_vrw_m_s_per_sqrt_s,
         gyro_bias: bias(
@@ -128,9 +157,9 @@ impl Scenario {
             },
             imu_rate_hz: c.imu.imu_rate_hz,
             imu_steps_per_fix: (c.imu.imu_rate_hz / c.gnss.gnss_rate_hz).round() as usize,
-            truth_imu: imu_model(&c.imu),
+            truth_imu: imu_model(&c.imu, c.vehicle().as_ref()),
             truth_gnss: gnss_model(&c.gnss),
-            filter_imu: imu_model(&assumed.imu),
+            filter_imu: imu_model(&assumed.imu, None),
             filter_gnss: gnss_model(&assumed.gnss),
             initial_sigma: [p, p, p, v, v, v, tilt, tilt, yaw],
             seed: c.ensemble.seed,
@@ -138,7 +167,15 @@ impl Scenario {
             false_alarm_rate: c.checks.false_alarm_rate,
             residual_max_lag: c.checks.residual_max_lag.map(|l| l as usize),
             filter_earth_rotation_rad_s: super::earth::ROTATION_RATE_RAD_S,
-            error_states: c.filter.error_states.unwrap_or(15) as usize,
+            error_states: c.error_states(),
+            vehicle: c.vehicle().zip(c.assumed_vehicle()).map(|(v, f)| Vehicle {
+                filter_mounting: rotation_of(f.mounting_rpy_deg),
+                mounting_sigma_rad: f.mounting_sigma_deg.to_radians(),
+                nhc_sigma_m_s: v.nhc_sigma_m_s,
+                filter_nhc_sigma_m_s: f.nhc_sigma_m_s,
+                nhc_rate_hz: v.nhc_rate_hz,
+                nhc_min_speed_m_s: v.nhc_min_speed_m_s,
+            }),
         })
     }
 
@@ -150,6 +187,24 @@ impl Scenario {
     /// The true IMU of realization `index`.
     pub fn imu(&self, index: u64) -> Imu {
         Imu::new(self.truth_imu, self.seed, index)
+    }
+
+    /// The IMU's mounting in the vehicle the filter assumes, q_b^v (identity without one).
+    pub fn filter_mounting(&self) -> UnitQuaternion<f64> {
+        self.vehicle
+            .map_or_else(UnitQuaternion::identity, |v| v.filter_mounting)
+    }
+
+    /// The aids beside GNSS: a car's constraint.
+    pub fn aids(&self) -> super::extra::Aids {
+        super::extra::Aids {
+            nhc: self.vehicle.map(|v| super::nhc::Nhc {
+                sigma_m_s: v.filter_nhc_sigma_m_s,
+                true_sigma_m_s: v.nhc_sigma_m_s,
+                rate_hz: v.nhc_rate_hz,
+                min_speed_m_s: v.nhc_min_speed_m_s,
+            }),
+        }
     }
 
     /// The noise densities the filter assumes.
@@ -204,6 +259,13 @@ impl Scenario {
                     start_of::<N>(Block::AccelScale) + i,
                     start_of::<N>(Block::AccelScale) + i,
                 )] = a * a;
+            }
+        }
+        if holds::<N>(Block::Mounting) {
+            let m = self.vehicle.map_or(0.0, |v| v.mounting_sigma_rad);
+            for i in 0..3 {
+                let k = start_of::<N>(Block::Mounting) + i;
+                p[(k, k)] = m * m;
             }
         }
         p

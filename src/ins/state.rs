@@ -1,6 +1,7 @@
 //! The error state as named blocks (OpenVINS's `ov_type::Type`: a variable is a typed block with
 //! its place in the covariance): the navigation errors δr^n, δv^n, δψ, the bias errors δb_g, δb_a,
-//! and the optional blocks, today the scale-factor errors δs_g, δs_a. A [`Layout`] is the blocks a
+//! and the optional blocks: the scale-factor errors δs_g, δs_a and the IMU's mounting-angle
+//! errors δμ in the vehicle. A [`Layout`] is the blocks a
 //! configuration asks for, each at its offset; [`with_layout!`](crate::with_layout) is the one
 //! dispatch from a layout to the filter's size `N`, a compile-time constant.
 //!
@@ -33,11 +34,14 @@ pub enum Block {
     GyroScale,
     /// δs_a: the accelerometer scale factor error, body axes (optional).
     AccelScale,
+    /// δμ: the error of the IMU's mounting in the vehicle, vehicle axes, rad
+    /// (Ĉ_b^v = (I + \[δμ×\])C_b^v; optional: a car's, seen through its constraints).
+    Mounting,
 }
 
 impl Block {
     /// Every block, in the order a layout holds them.
-    pub const ALL: [Block; 7] = [
+    pub const ALL: [Block; 8] = [
         Block::Position,
         Block::Velocity,
         Block::Attitude,
@@ -45,6 +49,7 @@ impl Block {
         Block::AccelBias,
         Block::GyroScale,
         Block::AccelScale,
+        Block::Mounting,
     ];
 
     /// The block's number of components.
@@ -68,6 +73,7 @@ impl Block {
             Block::AccelBias => "accel_bias",
             Block::GyroScale => "gyro_scale",
             Block::AccelScale => "accel_scale",
+            Block::Mounting => "mounting",
         }
     }
 }
@@ -78,14 +84,24 @@ pub struct Layout {
     blocks: &'static [Block],
 }
 
-/// The supported layouts, one per size: the 15 core states (the first five blocks), and with
-/// the six scale factors 21 (every block).
-pub const LAYOUTS: [Layout; 2] = [
+/// The supported layouts, one per size: the 15 core states (the first five blocks), with the
+/// six scale factors 21, and a car's 18: the core and the mounting angles.
+pub const LAYOUTS: [Layout; 3] = [
     Layout {
         blocks: Block::ALL.split_at(5).0,
     },
     Layout {
-        blocks: &Block::ALL,
+        blocks: Block::ALL.split_at(7).0,
+    },
+    Layout {
+        blocks: &[
+            Block::Position,
+            Block::Velocity,
+            Block::Attitude,
+            Block::GyroBias,
+            Block::AccelBias,
+            Block::Mounting,
+        ],
     },
 ];
 
@@ -94,6 +110,8 @@ impl Layout {
     pub const CORE: Layout = LAYOUTS[0];
     /// The 21-state layout: the scale factors too.
     pub const WITH_SCALE: Layout = LAYOUTS[1];
+    /// The 18-state layout of a car: the core and the IMU's mounting angles.
+    pub const CAR: Layout = LAYOUTS[2];
 
     /// The layout of `states` error states (`filter.error_states`), if one is supported.
     pub const fn with_states(states: usize) -> Option<Layout> {
@@ -155,6 +173,11 @@ impl Layout {
     pub fn variables(self) -> impl Iterator<Item = &'static Variable> {
         self.blocks.iter().flat_map(|b| b.variables().iter())
     }
+
+    /// [`Layout::variables`] gathered, for what takes the names as one slice.
+    pub fn variable_list(self) -> Vec<Variable> {
+        self.variables().copied().collect()
+    }
 }
 
 /// Runs `$body` with `$n` the error state's size of `$layout` as a `const usize`: the one place
@@ -171,6 +194,9 @@ macro_rules! with_layout {
         let layout: $crate::ins::state::Layout = $layout;
         if layout == $crate::ins::state::Layout::WITH_SCALE {
             const $n: usize = $crate::ins::state::Layout::WITH_SCALE.dim();
+            $body
+        } else if layout == $crate::ins::state::Layout::CAR {
+            const $n: usize = $crate::ins::state::Layout::CAR.dim();
             $body
         } else {
             debug_assert_eq!(layout, $crate::ins::state::Layout::CORE);
@@ -203,7 +229,9 @@ mod tests {
         }
         assert_eq!(Layout::CORE.dim(), 15);
         assert_eq!(Layout::WITH_SCALE.dim(), 21);
-        assert_eq!(Layout::with_states(18), None);
+        assert_eq!(Layout::CAR.dim(), 18);
+        assert_eq!(Layout::CAR.offset(Block::Mounting), Some(15));
+        assert_eq!(Layout::with_states(24), None);
         assert!(!Layout::CORE.has(Block::GyroScale));
         assert_eq!(Layout::WITH_SCALE.offset(Block::AccelScale), Some(18));
     }

@@ -29,6 +29,10 @@ impl Context for LogSteps<'_> {
     fn truth(&self) -> Option<&crate::ins::mech::Pva> {
         None
     }
+
+    fn normal(&mut self) -> f64 {
+        0.0
+    }
 }
 
 impl ImuSource for LogSteps<'_> {

@@ -191,7 +191,7 @@ fn run_filter<const N: usize>(
         source,
     };
     let last_s = rows.last().map_or(rh.t_s, |r| r.t_s);
-    let mut extra = crate::ins::extra::sources::<N, LogSteps>(rh.t_s, last_s);
+    let mut extra = crate::ins::extra::sources::<N, LogSteps>(rh.t_s, last_s, &Default::default());
     {
         let mut list = vec![&mut fixes as &mut dyn Source<N, LogSteps>];
         list.extend(

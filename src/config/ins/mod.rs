@@ -13,9 +13,26 @@ use crate::error::{ConfigError, Position};
 #[cfg(test)]
 mod tests;
 mod validate;
+mod vehicle;
+
+pub use vehicle::VehicleConfig;
 
 /// The annotated default file (`accelcal config --model ins`).
 pub const DEFAULT_INS_TOML: &str = include_str!("default.toml");
+
+/// The annotated default file of a car (`accelcal config --model car`): the three-axis file
+/// with `model = "car"` and its `[vehicle]` section.
+pub fn default_car_toml() -> String {
+    let body = &DEFAULT_INS_TOML[DEFAULT_INS_TOML.find("model = ").unwrap_or(0)..];
+    let body = body.replacen("model = \"ins\"", "model = \"car\"", 1);
+    let head = "# accelcal's three-axis study of an IMU in a car (`accelcal config --model car`): \
+                a strapdown IMU\n# mounted in a vehicle (the [vehicle] section at the end) and \
+                a GNSS receiver on a simulated\n# drive, an error-state Kalman filter of 18 \
+                states (the mounting angles too), a Monte Carlo ensemble.\n# Every key is \
+                optional: a missing key takes the value written here. Units are in the \
+                names.\n";
+    format!("{head}{body}{}", include_str!("vehicle.toml"))
+}
 
 /// The longest drive: the default drive's length, s.
 pub const LONGEST_DRIVE_S: f64 = 600.0;
@@ -35,7 +52,8 @@ pub enum Axes {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct InsConfig {
-    /// Must be "ins" when present (the file says which model it configures).
+    /// "ins", or "car" for an IMU in a vehicle, when present (the file says which model it
+    /// configures).
     pub model: Option<String>,
     /// The drive.
     pub drive: DriveConfig,
@@ -51,6 +69,9 @@ pub struct InsConfig {
     pub ensemble: InsEnsembleConfig,
     /// The statistical verdicts on it.
     pub checks: InsChecksConfig,
+    /// A car's vehicle (`model = "car"`; its defaults when the section is left out).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vehicle: Option<VehicleConfig>,
 }
 
 /// The drive: the default drive's first `duration_s` seconds from a start on the ellipsoid.
@@ -202,8 +223,15 @@ pub struct InsFilterConfig {
     pub gnss_lever_arm_m: Option<[f64; 3]>,
     pub gnss_position_sigma_m: Option<[f64; 3]>,
     pub gnss_velocity_sigma_m_s: Option<f64>,
-    /// The filter's error states: 15, or 21 with the six scale factors.
+    /// The filter's error states: 15, 21 with the six scale factors, or a car's 18 with the
+    /// mounting angles.
     pub error_states: Option<u32>,
+    /// The mounting a car's filter assumes (`vehicle.mounting_rpy_deg`'s meaning).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mounting_rpy_deg: Option<[f64; 3]>,
+    /// The slip σ a car's filter assumes, m/s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nhc_sigma_m_s: Option<f64>,
 }
 
 /// The Monte Carlo ensemble.

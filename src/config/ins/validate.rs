@@ -12,13 +12,15 @@ impl InsConfig {
     pub fn validate(&self) -> Result<(), ConfigError> {
         if let Some(m) = &self.model
             && m != "ins"
+            && m != "car"
         {
             return Err(ConfigError::invalid(
                 "model",
                 m,
-                "\"ins\" in a three-axis file",
+                "\"ins\" or \"car\" in a three-axis file",
             ));
         }
+        self.vehicle_fields()?;
         let (d, i) = (&self.drive, &self.initial);
         let ranges: [(&'static str, f64, f64, f64, &str); 9] = [
             ("drive.duration_s", d.duration_s, 1.0, LONGEST_DRIVE_S, "s"),
@@ -82,7 +84,7 @@ impl InsConfig {
         let assumed = self.assumed();
         imu_fields(true, &assumed.imu)?;
         gnss_fields(true, &assumed.gnss)?;
-        self.error_states(&assumed.imu)?;
+        self.check_error_states(&assumed.imu)?;
         self.checks()
     }
 
@@ -106,10 +108,28 @@ impl InsConfig {
         Ok(())
     }
 
-    /// The filter's error states: 15, or 21 with a prior σ for each scale factor group.
-    fn error_states(&self, assumed: &ImuConfig) -> Result<(), ConfigError> {
+    /// A car's filter estimating its mounting needs a prior σ above 0.
+    fn check_mounting_prior(&self) -> Result<(), ConfigError> {
+        let sigma = self.vehicle().unwrap_or_default().mounting_sigma_deg;
+        if sigma > 0.0 {
+            return Ok(());
+        }
+        Err(ConfigError::invalid(
+            "vehicle.mounting_sigma_deg",
+            show(sigma),
+            "above 0 degrees when the filter estimates the mounting (a car's \
+             filter.error_states = 18, its default); 0 with filter.error_states = 15",
+        ))
+    }
+
+    /// The filter's error states: 15, 21 with a prior σ for each scale factor group, or a
+    /// car's 18 with the mounting angles.
+    fn check_error_states(&self, assumed: &ImuConfig) -> Result<(), ConfigError> {
         match self.filter.error_states {
-            None | Some(15) => Ok(()),
+            Some(15) => Ok(()),
+            None if !self.is_car() => Ok(()),
+            None => self.check_mounting_prior(),
+            Some(18) if self.is_car() => self.check_mounting_prior(),
             Some(21) => {
                 for (field, sigma) in [
                     (
@@ -135,7 +155,8 @@ impl InsConfig {
             Some(n) => Err(ConfigError::invalid(
                 "filter.error_states",
                 n,
-                "15, or 21 with the six scale factors",
+                "15, 21 with the six scale factors, or 18 with a car's mounting angles \
+                 (model = \"car\")",
             )),
         }
     }
@@ -171,7 +192,7 @@ impl InsConfig {
 }
 
 /// `value` within [lo, hi] (and finite), else the error naming `field`.
-fn within(
+pub(super) fn within(
     field: &'static str,
     value: f64,
     lo: f64,

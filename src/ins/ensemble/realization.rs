@@ -39,10 +39,11 @@ pub fn start<const N: usize>(scenario: &Scenario, track: &Track, index: u64) -> 
     let dr = imu.normals(&Vector3::new(s[0], s[1], s[2]));
     let dv = imu.normals(&Vector3::new(s[3], s[4], s[5]));
     let dpsi = imu.normals(&Vector3::new(s[6], s[7], s[8]));
+    let truth = imu.pva_of(&track.start);
     let start = Pva {
-        position: offset(&track.start.position, &dr),
-        velocity_ned_m_s: track.start.velocity_ned_m_s + dv,
-        attitude: UnitQuaternion::from_scaled_axis(dpsi) * track.start.attitude,
+        position: offset(&truth.position, &dr),
+        velocity_ned_m_s: truth.velocity_ned_m_s + dv,
+        attitude: UnitQuaternion::from_scaled_axis(dpsi) * truth.attitude,
     };
     let ekf = Ekf::new(
         start,
@@ -51,7 +52,8 @@ pub fn start<const N: usize>(scenario: &Scenario, track: &Track, index: u64) -> 
         scenario.filter_decay(),
         scenario.filter_gnss.lever_arm_b_m,
     )
-    .with_earth_rotation(scenario.filter_earth_rotation_rad_s);
+    .with_earth_rotation(scenario.filter_earth_rotation_rad_s)
+    .with_mounting(scenario.filter_mounting());
     (imu, ekf)
 }
 
@@ -75,7 +77,8 @@ pub fn filter_realization<const N: usize>(
         prior: None,
         on_fix,
     };
-    let mut extra = crate::ins::extra::sources::<N, SimulatedImu>(0.0, scenario.duration_s);
+    let mut extra =
+        crate::ins::extra::sources::<N, SimulatedImu>(0.0, scenario.duration_s, &scenario.aids());
     let mut list = vec![&mut gnss as &mut dyn Source<N, SimulatedImu>];
     list.extend(
         extra

@@ -30,6 +30,10 @@ impl crate::ins::driver::Context for SimulatedImu<'_> {
     fn truth(&self) -> Option<&crate::ins::mech::Pva> {
         Some(SimulatedImu::truth(self))
     }
+
+    fn normal(&mut self) -> f64 {
+        self.imu.normal()
+    }
 }
 
 impl<'a> SimulatedImu<'a> {

@@ -32,13 +32,17 @@ impl<const N: usize> Ekf<N> {
         gate: Option<&Gate>,
     ) -> Result<Innovation<N>, FilterError> {
         self.flush();
-        self.fix_period_steps = Some(self.steps_since_update);
+        // Two updates at one time leave the period between the earlier ones.
+        if self.steps_since_update > 0 {
+            self.fix_period_steps = Some(self.steps_since_update);
+        }
         self.steps_since_update = 0;
         let mut rows = Rows::<N>::default();
         let at = At {
             pva: &self.pva,
             lever_arm_b_m: self.lever_arm_b_m,
             rate_ib_b_rad_s: self.rate_ib_b_rad_s(),
+            mounting: self.mounting,
         };
         m.rows(&at, &mut rows);
         let t_s = m.t_s();
