@@ -159,6 +159,53 @@ fn config_sets_the_keys_it_names() {
     }
 }
 
+/// A receiver that starts before the IMU log and runs on after it: those fixes are left out with
+/// a warning and counted, and the calibration is the one without them.
+#[test]
+fn fixes_outside_the_imu_log_are_left_out_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let gnss = std::fs::read_to_string(example("gnss.csv")).unwrap();
+    let mut lines: Vec<&str> = gnss.lines().collect();
+    let (first, last) = (lines[1].to_string(), lines[lines.len() - 1].to_string());
+    let moved = |line: &str, t: &str| line.replacen(line.split(',').next().unwrap(), t, 1);
+    let (early, late) = (moved(&first, "-3.4"), moved(&last, "75.0"));
+    lines.insert(1, &early);
+    lines.push(&late);
+    let extended = lines.join("\n") + "\n";
+    std::fs::write(dir.path().join("gnss.csv"), extended).unwrap();
+    let out = calibrate(
+        dir.path(),
+        &example("imu.csv"),
+        &dir.path().join("gnss.csv"),
+        &[],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("warning: fixes outside the IMU log are left out: 1 before")
+            && err.contains("1 after"),
+        "{err}"
+    );
+    let with = read_json(&dir.path().join("out/summary.json"));
+    assert_eq!(with["fixes_outside_log"]["before"], 1);
+    assert_eq!(with["fixes_outside_log"]["after"], 1);
+    let plain = tempfile::tempdir().unwrap();
+    let out = calibrate(plain.path(), &example("imu.csv"), &example("gnss.csv"), &[]);
+    assert_eq!(out.status.code(), Some(0));
+    let without = read_json(&plain.path().join("out/summary.json"));
+    assert_eq!(without["fixes_outside_log"]["before"], 0);
+    assert_eq!(with["fixes"], without["fixes"].as_u64().unwrap() + 2);
+    for key in [
+        "gyro_bias_rad_s",
+        "accel_bias_m_s2",
+        "attitude_deg",
+        "nis",
+        "fixes_used",
+    ] {
+        assert_eq!(with[key], without[key], "{key}");
+    }
+}
+
 /// Bad recordings: each refused with exit code 2 naming the file, the line and the field, and
 /// the summary.json already in the output directory left as it was.
 #[test]
@@ -184,13 +231,6 @@ fn bad_recordings_are_refused_with_file_line_and_field() {
         .map(|l| l.rsplit_once(',').unwrap().0.to_string() + "\n")
         .collect();
     let both = edit(&imu, 1, &|l| l.replace("ax_m_s2", "dvx_m_s"));
-    let late_fix = {
-        let last = gnss.lines().last().unwrap().replacen("59.5695", "75.0", 1);
-        format!(
-            "{gnss}{}\n",
-            last.replacen(last.split(',').next().unwrap(), "75.0", 1)
-        )
-    };
     let cases: Vec<(&str, String, String, &str)> = vec![
         ("imu.csv", drop_gz, gnss.clone(), "gz_rad_s"),
         ("imu.csv", both, gnss.clone(), "dvx_m_s"),
@@ -206,7 +246,6 @@ fn bad_recordings_are_refused_with_file_line_and_field() {
             edit(&gnss, 7, &set_field(1, "95.0")),
             "lat_deg",
         ),
-        ("gnss.csv", imu.clone(), late_fix, "outside"),
         (
             "imu.csv",
             edit(&imu, 9, &set_field(0, "0.001")),

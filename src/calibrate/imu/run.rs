@@ -10,12 +10,12 @@ use super::align::{self, AlignSettings, Alignment, Plan, Sources};
 use super::drive::{LogFixes, LogSteps, Recorder};
 pub use super::step::{FixRecord, bias_sigmas, euler_sigmas};
 use super::step::{part, start, velocity_sigmas};
+use crate::input::LogError;
 use crate::input::csv::read::LogSource;
 use crate::input::gnss_csv::read_gnss;
 use crate::input::imu_csv::{HeldSteps, ImuLayout, ImuReader, ImuSpan, StepSource};
 use crate::input::read_ahead::consume_beside;
 use crate::input::records::{GnssRow, ImuStep};
-use crate::input::{LogError, LogProblem};
 use crate::ins::driver::{DriveError, Driver, ImuSource, Source};
 use crate::ins::error_state::STATES;
 use crate::ins::filter::{Ekf, FilterError, LinearView};
@@ -61,6 +61,70 @@ pub struct Calibrated<const N: usize = STATES> {
     pub records: Vec<FixRecord<N>>,
     /// Fixes whose vertical velocity was missing (the component left out).
     pub missing_velocity: [usize; 3],
+    /// Fixes left out for lying more than half a median step outside the IMU log.
+    pub outside_log: OutsideLog,
+}
+
+/// The fixes more than half a median step before the IMU log's first sample or after its last,
+/// left out: a receiver that starts before the IMU (or runs on after it) is a recording's small
+/// imperfection, not a fault.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct OutsideLog {
+    /// Fixes before the first sample.
+    pub before: usize,
+    /// Fixes after the last sample.
+    pub after: usize,
+    /// The first fix's time and the last's (as written), s.
+    pub fixes_s: (f64, f64),
+    /// The IMU log's first and last time stamps, s.
+    pub log_s: (f64, f64),
+}
+
+impl OutsideLog {
+    /// The fixes of `rows` (their times before the receiver's offset `offset_s` moved them)
+    /// outside `span`.
+    fn of(rows: &[GnssRow], span: &ImuSpan, offset_s: f64) -> Self {
+        let tolerance = 0.5 * span.median_step_s;
+        let times = || rows.iter().map(|r| r.t_s - offset_s);
+        OutsideLog {
+            before: times().filter(|t| *t < span.first_s - tolerance).count(),
+            after: times().filter(|t| *t > span.last_s + tolerance).count(),
+            fixes_s: (
+                times().next().unwrap_or(f64::NAN),
+                times().last().unwrap_or(f64::NAN),
+            ),
+            log_s: (span.first_s, span.last_s),
+        }
+    }
+
+    /// The warning, when any fix was left out.
+    pub fn warning(&self) -> Option<String> {
+        if self.before + self.after == 0 {
+            return None;
+        }
+        let short = |t: f64| format!("{t:.3}");
+        let mut parts = Vec::new();
+        if self.before > 0 {
+            parts.push(format!(
+                "{} before its first sample (the fixes start at {} s, the IMU log at {} s)",
+                self.before,
+                short(self.fixes_s.0),
+                short(self.log_s.0)
+            ));
+        }
+        if self.after > 0 {
+            parts.push(format!(
+                "{} after its last (the fixes end at {} s, the IMU log at {} s)",
+                self.after,
+                short(self.fixes_s.1),
+                short(self.log_s.1)
+            ));
+        }
+        Some(format!(
+            "fixes outside the IMU log are left out: {}",
+            parts.join(", and ")
+        ))
+    }
 }
 
 /// The filter run over the steps: its records and where it ended.
@@ -287,8 +351,8 @@ fn assemble<const N: usize>(
     s: &Settings,
     gnss: &str,
 ) -> Result<Calibrated<N>, ImuCalibrateError> {
-    check_span(rows, &span, gnss, s.gnss_time_offset_s)?;
-    // A time offset can carry the last fixes past the log's end: those are left out.
+    let outside_log = OutsideLog::of(rows, &span, s.gnss_time_offset_s);
+    // The fixes past the log's end (as written, or carried there by a time offset) are left out.
     let tolerance = 0.5 * span.median_step_s;
     let within = rows.partition_point(|r| r.t_s <= span.last_s + tolerance);
     finish(within, &mut run, s, rows)?;
@@ -302,6 +366,7 @@ fn assemble<const N: usize>(
         start_s: rows[run.plan.start].t_s,
         records: run.records,
         missing_velocity: run.missing,
+        outside_log,
     })
 }
 
@@ -353,31 +418,5 @@ fn no_heading(gnss: &str, s: &Settings) -> ImuCalibrateError {
              heading",
             s.heading_speed_m_s, s.alignment_window_s
         ),
-    }
-}
-
-/// Every fix of the log as written (its times before the receiver's offset `offset_s` moved
-/// them) within half a median step of the IMU log's span.
-///
-/// # Errors
-/// [`LogProblem::FixOutsideSpan`] naming the first fix outside.
-fn check_span(rows: &[GnssRow], span: &ImuSpan, gnss: &str, offset_s: f64) -> Result<(), LogError> {
-    let tolerance = 0.5 * span.median_step_s;
-    let outside = rows
-        .iter()
-        .map(|r| r.t_s - offset_s)
-        .zip(rows)
-        .find(|(t, _)| *t < span.first_s - tolerance || *t > span.last_s + tolerance);
-    match outside {
-        Some((t_s, r)) => {
-            let problem = LogProblem::FixOutsideSpan {
-                t_s,
-                first_s: span.first_s,
-                last_s: span.last_s,
-                tolerance_s: tolerance,
-            };
-            Err(LogError::at(gnss, r.line, problem))
-        }
-        None => Ok(()),
     }
 }

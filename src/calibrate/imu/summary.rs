@@ -73,6 +73,15 @@ pub struct ComponentWhiteness {
     pub test: Whiteness,
 }
 
+/// The fixes left out for lying outside the IMU log.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FixesOutsideLog {
+    /// Before its first sample.
+    pub before: usize,
+    /// After its last.
+    pub after: usize,
+}
+
 /// `summary.json` of a three-axis calibration.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
@@ -92,6 +101,8 @@ pub struct Summary {
     pub fixes: usize,
     /// Fixes the filter used (after the alignment's).
     pub fixes_used: usize,
+    /// Fixes left out for lying outside the IMU log: before its first sample, after its last.
+    pub fixes_outside_log: FixesOutsideLog,
     /// The alignment.
     pub alignment: AlignmentRecord,
     /// The gyro biases at the end, rad/s.
@@ -157,7 +168,7 @@ pub fn summary<const N: usize>(c: &Calibrated<N>, s: &Settings, imu_file: &str) 
     let (gyro_scale, accel_scale) = super::scale::end_triads(last, s).unzip();
     let (nis, whiteness, rejected_by) = tests(c, s);
     let alignment = alignment_record(c);
-    let mut warnings = Vec::new();
+    let mut warnings: Vec<String> = c.outside_log.warning().into_iter().collect();
     if !attitude.yaw_identifiable {
         warnings.push(format!(
             "the yaw is not determined beyond the alignment's course: its σ at the end, {:.2}°, \
@@ -188,6 +199,10 @@ pub fn summary<const N: usize>(c: &Calibrated<N>, s: &Settings, imu_file: &str) 
         imu_rate_hz: 1.0 / c.span.median_step_s,
         fixes: c.fixes,
         fixes_used: c.records.iter().filter(|r| r.accepted).count(),
+        fixes_outside_log: FixesOutsideLog {
+            before: c.outside_log.before,
+            after: c.outside_log.after,
+        },
         alignment,
         gyro_bias_rad_s: gyro,
         accel_bias_m_s2: accel,
