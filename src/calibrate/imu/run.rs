@@ -91,7 +91,7 @@ impl OutsideLog {
             after: times().filter(|t| *t > span.last_s + tolerance).count(),
             fixes_s: (
                 times().next().unwrap_or(f64::NAN),
-                times().last().unwrap_or(f64::NAN),
+                times().next_back().unwrap_or(f64::NAN),
             ),
             log_s: (span.first_s, span.last_s),
         }
