@@ -263,9 +263,11 @@ fn ros1_bag(path: &Path, rows: usize, seed: u64) {
 /// Peak memory does not follow the log's length: from 1.1·10⁶ to 4.4·10⁶ rows a CSV file, the same
 /// bytes on a pipe (copied once to a temporary file, read twice from it) and a ROS 1 bag of as
 /// many messages (six channels, read a chunk at a time; 0.39 and 1.56 GB on disk for the test's
-/// time) each grow by less than 8 MB, where holding one channel's samples and their stamps (16
-/// bytes a row) and its phase (8) would add 79 MB. The negative control, the one-column form on the same pipe (it holds the log),
-/// grows by more than that: the measurement sees a log held whole.
+/// time) each grow by less than a quarter of the 79 MB that holding one channel's samples and
+/// their stamps (16 bytes a row) and its phase (8) would add: 20 MB, above the bag's run-to-run
+/// spread (its peak at the shorter length measured 56.0 and 63.2 MB in two runs of one build).
+/// The negative control, the one-column form on the same pipe (it holds the log), grows by more
+/// than the 79 MB: the measurement sees a log held whole.
 #[test]
 fn peak_memory_does_not_follow_the_length() {
     let dir = tempfile::tempdir().unwrap();
@@ -293,14 +295,14 @@ fn peak_memory_does_not_follow_the_length() {
         );
         peaks.push([file_peak, pipe_peak, bag_peak, whole_peak]);
     }
+    let held = 3.0 * LONG as f64 * 24.0;
     for (j, what) in ["file", "pipe", "ROS 1 bag"].into_iter().enumerate() {
         let grown = peaks[1][j] as f64 - peaks[0][j] as f64;
         assert!(
-            grown < 8e6,
+            grown < held / 4.0,
             "the {what}'s peak grew by {grown} B: {peaks:?}"
         );
     }
-    let held = 3.0 * LONG as f64 * 24.0;
     assert!(
         peaks[1][3] as f64 - peaks[0][3] as f64 > held,
         "the one-column form on a pipe should grow by at least {held} B: {peaks:?}"
