@@ -90,11 +90,14 @@ impl<const N: usize> Measurement<N> for Constraint {
         let v_v = c_nv * v_n;
         let z = v_v - Vector3::new(0.0, self.measured_m_s[0], self.measured_m_s[1]);
         let r = Vector3::repeat(self.nhc.sigma_m_s * self.nhc.sigma_m_s);
-        let mut blocks = vec![(VELOCITY, c_nv), (ATTITUDE, c_nv * skew(&v_n))];
-        if let Some(at) = const { offset_of::<N>(Block::Mounting) } {
-            blocks.push((at, -skew(&Vector3::new(v_v.x, 0.0, 0.0))));
-        }
-        rows.push3((&z, &r), &blocks, &COMPONENTS, [false, true, true]);
+        let mounting = const { offset_of::<N>(Block::Mounting) };
+        let blocks = [
+            (VELOCITY, c_nv),
+            (ATTITUDE, c_nv * skew(&v_n)),
+            (mounting.unwrap_or(0), -skew(&Vector3::new(v_v.x, 0.0, 0.0))),
+        ];
+        let used = if mounting.is_some() { 3 } else { 2 };
+        rows.push3((&z, &r), &blocks[..used], &COMPONENTS, [false, true, true]);
     }
 }
 
