@@ -99,6 +99,12 @@ fn as_gyro(mut v: Value) -> Value {
     for (from, to) in fit_renames {
         let x = fit.remove(from).unwrap();
         fit.insert(to.to_string(), x);
+        // The selected model names its terms by the same keys.
+        for key in fit["model"].as_array_mut().unwrap() {
+            if key == from {
+                *key = serde_json::Value::from(to);
+            }
+        }
     }
     v
 }

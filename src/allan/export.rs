@@ -54,6 +54,23 @@ pub struct FitRecord {
     pub tau_s: Vec<f64>,
     /// A term is a value when it stands this many standard errors above zero.
     pub resolution_sigmas: f64,
+    /// The keys of the terms the selected model holds ([`super::select`]); a term above and not
+    /// here is absent: unresolved, its bound that of the model with it added.
+    pub model: Vec<&'static str>,
+    /// How the model was chosen.
+    pub selection: SelectionRecord,
+}
+
+/// `fit.selection` of `allan.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SelectionRecord {
+    /// The rule, in words.
+    pub rule: &'static str,
+    /// The nested test's false-entry rate.
+    pub entry_alpha: f64,
+    /// A term enters when the drop of T over the goodness test's scale exceeds this χ²₁
+    /// quantile at `entry_alpha`.
+    pub entry_critical: f64,
 }
 
 /// `fit.goodness` of `allan.json`.
@@ -190,6 +207,12 @@ impl AllanRecord {
                 features: a.features.iter().map(FeatureRecord::from).collect(),
                 tau_s: a.fit.points.iter().map(|p| p.tau_s).collect(),
                 resolution_sigmas: super::fit::RESOLUTION_SIGMAS,
+                model: a.fit.model.iter().map(|t| t.key()).collect(),
+                selection: SelectionRecord {
+                    rule: super::select::RULE,
+                    entry_alpha: super::select::ENTRY_ALPHA,
+                    entry_critical: super::select::entry_critical(),
+                },
             },
             gauss_markov: GaussMarkovRecord::from(&a.gauss_markov),
         }

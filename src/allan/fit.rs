@@ -21,7 +21,7 @@
 //! (Satterthwaite), which keeps the skew of a term that few long-τ estimates determine; the
 //! term's interval is its square root. A term whose estimate is not [`RESOLUTION_SIGMAS`]
 //! standard errors above zero is unresolved: it has an upper bound and no value. The bound is
-//! never below what a point's lower whisker demands of the term given the other fitted terms.
+//! never below what the whiskers of the τ that show it demand, given the others ([`whisker_floor`]).
 
 use nalgebra::{DMatrix, DVector};
 
@@ -135,6 +135,8 @@ pub struct TermEstimate {
 pub struct Fit {
     /// Every fitted term, in the order of [`Term::ALL`].
     pub terms: Vec<TermEstimate>,
+    /// The selected model's terms ([`super::select`]); the rest of `terms` are absent, bounded.
+    pub model: Vec<Term>,
     /// The points fitted.
     pub points: Vec<FitPoint>,
     /// The interval's confidence.
@@ -219,12 +221,18 @@ pub fn term_interval(theta: f64, var: f64, confidence: f64) -> (Option<f64>, Opt
     }
 }
 
-/// The least squared bound of `terms[t]` that every point's lower whisker allows, given the
-/// other terms at `theta`.
+/// A point shows a term where its share c_t(τ)/σ̂²(τ) is at least this part of the largest.
+pub const SHOWING_SHARE: f64 = 0.5;
+
+/// The least squared bound of `terms[t]` that the lower whiskers of the points where the term
+/// would show allow, given the other terms at `theta`.
 ///
 /// # Formula
 /// θ_t ≥ max_i (L_i² − Σ_{j≠t} θ_j c_j(τ_i)) / c_t(τ_i), L_i the lower end of σ̂(τ_i)'s χ²
-/// interval at `confidence` (NIST SP 1065, eq. 45).
+/// interval at `confidence` (NIST SP 1065, eq. 45), over the points i whose share
+/// c_t(τ_i)/σ̂²(τ_i) is at least [`SHOWING_SHARE`] of the largest (the longest τ for K and R, the
+/// shortest for Q, the curve's floor for B): elsewhere a point's chance excess over the others,
+/// divided by the term's tiny column there, would demand a K far above what the longest τ allows.
 pub fn whisker_floor(
     points: &[FitPoint],
     terms: &[Term],
@@ -232,8 +240,11 @@ pub fn whisker_floor(
     t: usize,
     confidence: f64,
 ) -> f64 {
+    let share = |p: &FitPoint| terms[t].coefficient(p.tau_s) / p.avar;
+    let largest = points.iter().map(share).fold(0.0, f64::max);
     points
         .iter()
+        .filter(|p| share(p) >= SHOWING_SHARE * largest)
         .map(|p| {
             let lower = chi_squared_interval(p.avar.sqrt(), p.edf, confidence).0;
             let others: f64 = (0..terms.len())
@@ -429,6 +440,7 @@ fn estimate(
     let (goodness, goodness_naive) = goodness_tests(points, samples, &a, &sol, &w, &c);
     Some(Fit {
         terms: estimates,
+        model: terms.to_vec(),
         points: points.to_vec(),
         confidence,
         goodness,

@@ -39,6 +39,7 @@ pub mod noise_id;
 pub mod noise_stream;
 pub mod reading;
 pub mod section;
+pub mod select;
 pub mod simulate;
 pub mod spill;
 pub mod stream;
@@ -99,7 +100,8 @@ pub struct AllanPoint {
     pub noise: Option<NoiseId>,
     /// Whether `noise` was identified at this τ itself.
     pub identified_here: bool,
-    /// Equivalent degrees of freedom for that noise.
+    /// Equivalent degrees of freedom for the α of this τ in the non-increasing sequence nearest
+    /// the identified ones ([`noise_id::non_increasing`]).
     pub edf: Option<f64>,
     /// The χ² interval of σ̂(τ), m/s².
     pub interval: Option<(f64, f64)>,
@@ -216,15 +218,35 @@ fn with_intervals(
             interval: None,
         })
         .collect();
-    let mut last = None;
-    for p in &mut out {
+    // The EDF's α: the non-increasing sequence nearest the identified α̂, each weighted by its
+    // count of block means (r₁'s variance is about 1/L). A sum of power laws has a log spectrum
+    // convex in log f, so its local exponent never rises with τ: a rise is the identification's
+    // chance error (from 30 block means r₁ has a standard deviation of 0.18, and a white noise
+    // read as flicker phase claims 16 times its EDF), pooled with its neighbours.
+    let identified: Vec<usize> = (0..out.len()).filter(|&i| out[i].noise.is_some()).collect();
+    let (estimates, counts): (Vec<f64>, Vec<f64>) = identified
+        .iter()
+        .map(|&i| {
+            let p = &out[i];
+            (
+                p.noise.map_or(0.0, |id| id.alpha_estimate),
+                (n / p.m) as f64,
+            )
+        })
+        .unzip();
+    let monotone = noise_id::non_increasing(&estimates, &counts);
+    let (mut last, mut last_alpha) = (None, None);
+    for (i, p) in out.iter_mut().enumerate() {
         if p.noise.is_none() {
             p.noise = last;
         }
         last = p.noise.or(last);
-        let Some(id) = p.noise else { continue };
+        if let Ok(k) = identified.binary_search(&i) {
+            last_alpha = Some(monotone[k].round_ties_even() as i32);
+        }
+        let Some(alpha) = last_alpha else { continue };
         // Greenhall's EDF covers α from −2 (random walk) to +2 (white phase).
-        let alpha = id.alpha.clamp(-2, 2);
+        let alpha = alpha.clamp(-2, 2);
         p.edf = edf::greenhall_edf(alpha, 2, p.m as f64, (n + 1) as f64, true);
         p.interval = p
             .edf
@@ -332,10 +354,10 @@ fn analyse_points(
         })
         .collect();
     let terms = fitted_terms(&points);
-    let fit =
-        fit::fit(&fit_points, samples, tau0_s, &terms, confidence).ok_or(AllanError::Constant)?;
+    let fit = select::fit_selected(&fit_points, samples, tau0_s, &terms, confidence)
+        .ok_or(AllanError::Constant)?;
     let gauss_markov =
-        gauss_markov_fit::fit_gauss_markov(&fit_points, samples, tau0_s, &terms, confidence);
+        gauss_markov_fit::fit_gauss_markov(&fit_points, samples, tau0_s, &fit.model, confidence);
     let departures = reading::departures(&points, &fit);
     let features = reading::features(&points, &departures, &fit);
     let (reading, terms) = if fit.goodness.rejected {

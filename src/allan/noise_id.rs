@@ -93,6 +93,30 @@ pub fn block_means(x: &[f64], m: usize) -> Vec<f64> {
         .collect()
 }
 
+/// The non-increasing sequence nearest `values` in weighted least squares (pool adjacent
+/// violators; Barlow, Bartholomew, Bremner & Brunk, *Statistical Inference under Order
+/// Restrictions*, 1972): a run that rises is replaced by its weighted mean.
+pub fn non_increasing(values: &[f64], weights: &[f64]) -> Vec<f64> {
+    // Blocks of (weighted mean, weight, length), each mean below the one before.
+    let mut blocks: Vec<(f64, f64, usize)> = Vec::with_capacity(values.len());
+    for (&v, &w) in values.iter().zip(weights) {
+        let mut block = (v, w, 1);
+        while let Some(&(m, wm, l)) = blocks.last() {
+            if m >= block.0 {
+                break;
+            }
+            blocks.pop();
+            let weight = wm + block.1;
+            block = ((m * wm + block.0 * block.1) / weight, weight, l + block.2);
+        }
+        blocks.push(block);
+    }
+    blocks
+        .into_iter()
+        .flat_map(|(m, _, l)| std::iter::repeat_n(m, l))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -115,5 +139,21 @@ mod tests {
         assert_eq!(identify(&walk).unwrap().alpha, -2);
         assert_eq!(identify(&phase).unwrap().alpha, 2);
         assert!(identify(&white[..29]).is_none());
+    }
+
+    #[test]
+    fn a_rise_is_pooled_and_a_fall_kept() {
+        assert_eq!(
+            non_increasing(&[2.0, 0.0, -1.0], &[1.0; 3]),
+            [2.0, 0.0, -1.0]
+        );
+        // 0 then a chance 1 with a third of the weight: both become 0.25.
+        assert_eq!(
+            non_increasing(&[0.0, 1.0, -2.0], &[3.0, 1.0, 1.0]),
+            [0.25, 0.25, -2.0]
+        );
+        // A late rise pools back over every run it breaks: (0 − 1 + 0 + 2)/4.
+        let v = non_increasing(&[0.0, -1.0, 0.0, 2.0], &[1.0; 4]);
+        assert_eq!(v, [0.25; 4]);
     }
 }

@@ -40,8 +40,14 @@ pub fn channel_record(channel: Channel, a: &Analysis) -> Value {
         if let Some(Value::Object(fit)) = record.get_mut("fit") {
             for term in Term::ALL {
                 let from = Sensor::Accelerometer.term_key(term);
+                let to = Sensor::Gyroscope.term_key(term);
                 if let Some(value) = fit.remove(from) {
-                    fit.insert(Sensor::Gyroscope.term_key(term).to_string(), value);
+                    fit.insert(to.to_string(), value);
+                }
+                if let Some(Value::Array(model)) = fit.get_mut("model") {
+                    for key in model.iter_mut().filter(|k| k.as_str() == Some(from)) {
+                        *key = Value::from(to);
+                    }
                 }
             }
         }
