@@ -223,27 +223,19 @@ fn with_intervals(
     // convex in log f, so its local exponent never rises with τ: a rise is the identification's
     // chance error (from 30 block means r₁ has a standard deviation of 0.18, and a white noise
     // read as flicker phase claims 16 times its EDF), pooled with its neighbours.
-    let identified: Vec<usize> = (0..out.len()).filter(|&i| out[i].noise.is_some()).collect();
-    let (estimates, counts): (Vec<f64>, Vec<f64>) = identified
+    let (estimates, counts): (Vec<f64>, Vec<f64>) = out
         .iter()
-        .map(|&i| {
-            let p = &out[i];
-            (
-                p.noise.map_or(0.0, |id| id.alpha_estimate),
-                (n / p.m) as f64,
-            )
-        })
+        .filter_map(|p| p.noise.map(|id| (id.alpha_estimate, (n / p.m) as f64)))
         .unzip();
-    let monotone = noise_id::non_increasing(&estimates, &counts);
+    let mut monotone = noise_id::non_increasing(&estimates, &counts).into_iter();
     let (mut last, mut last_alpha) = (None, None);
-    for (i, p) in out.iter_mut().enumerate() {
-        if p.noise.is_none() {
+    for p in &mut out {
+        if p.identified_here {
+            last_alpha = monotone.next().map(|a| a.round_ties_even() as i32);
+        } else {
             p.noise = last;
         }
-        last = p.noise.or(last);
-        if let Ok(k) = identified.binary_search(&i) {
-            last_alpha = Some(monotone[k].round_ties_even() as i32);
-        }
+        last = p.noise;
         let Some(alpha) = last_alpha else { continue };
         // Greenhall's EDF covers α from −2 (random walk) to +2 (white phase).
         let alpha = alpha.clamp(-2, 2);

@@ -41,9 +41,6 @@ pub const RULE: &str = "forward selection: from the white noise N (with the quan
     together with its rivals, the terms that fit no worse than that drop from it; a term left \
     out is bounded by the fit of the model with it added";
 
-/// At most this many entries (one per candidate term).
-const STEPS: usize = 5;
-
 /// The terms the model always holds.
 const BASE: [Term; 2] = [Term::Quantization, Term::VelocityRandomWalk];
 
@@ -66,16 +63,16 @@ fn drop(smaller: &Fit, larger: &Fit) -> f64 {
     (smaller.goodness.statistic - larger.goodness.statistic) / larger.goodness.scale
 }
 
-/// The model chosen from `candidates` (every term that may be fitted) by forward selection
-/// on the nested test ([module](self)), and its fit; `None` when even
-/// the base model's fit is singular.
-pub fn select(
+/// The model chosen from `candidates` (every term that may be fitted) by forward selection on
+/// the nested test ([module](self)): its fit (`model` the terms chosen), and the fit of it with
+/// each candidate left out added; `None` when even the base model's fit is singular.
+fn select(
     points: &[FitPoint],
     samples: usize,
     tau0_s: f64,
     candidates: &[Term],
     confidence: f64,
-) -> Option<(Vec<Term>, Fit)> {
+) -> Option<(Fit, Vec<(Term, Fit)>)> {
     let critical = entry_critical();
     let fit_of = |model: &[Term]| fit(points, samples, tau0_s, &ordered(model), confidence);
     let mut model: Vec<Term> = BASE
@@ -83,7 +80,8 @@ pub fn select(
         .filter(|t| candidates.contains(t))
         .collect();
     let mut current = fit_of(&model)?;
-    for _ in 0..STEPS {
+    // Each pass adds at least the best term, so the loop ends within the candidates' count.
+    loop {
         let mut tried: Vec<(Term, Fit)> = candidates
             .iter()
             .filter(|t| !model.contains(t))
@@ -94,49 +92,27 @@ pub fn select(
             })
             .collect();
         tried.sort_by(|a, b| a.1.goodness.statistic.total_cmp(&b.1.goodness.statistic));
-        let Some((_, best)) = tried.first() else {
-            break;
+        let best = match tried.first() {
+            Some((_, best)) if drop(&current, best) > critical => best,
+            _ => return Some((current, tried)),
         };
-        if drop(&current, best) <= critical {
-            break;
-        }
         // The best term and its rivals, those the data cannot tell from it, enter together.
-        let rivals: Vec<Term> = tried
+        let rivals = tried.iter().filter(|(_, f)| drop(f, best) <= critical);
+        let with: Vec<Term> = model
             .iter()
-            .filter(|(_, f)| drop(f, best) <= critical)
-            .map(|(t, _)| *t)
+            .copied()
+            .chain(rivals.map(|(t, _)| *t))
             .collect();
-        let with: Vec<Term> = model.iter().chain(&rivals).copied().collect();
-        let Some(f) = fit_of(&with) else { break };
-        (model, current) = (with, f);
+        match fit_of(&with) {
+            Some(f) => (model, current) = (with, f),
+            None => return Some((current, tried)),
+        }
     }
-    Some((ordered(&model), current))
-}
-
-/// The estimate of `term`, left out of `model`, as an unresolved term: the upper bound of the
-/// model's fit with `term` added (θ̂ kept at zero: the term is not in the model).
-fn absent_term(
-    points: &[FitPoint],
-    samples: usize,
-    tau0_s: f64,
-    model: &[Term],
-    term: Term,
-    confidence: f64,
-) -> Option<TermEstimate> {
-    let mut with = model.to_vec();
-    with.push(term);
-    let f = fit(points, samples, tau0_s, &ordered(&with), confidence)?;
-    let t = *f.term(term)?;
-    Some(TermEstimate {
-        value: None,
-        lower: None,
-        squared: 0.0,
-        ..t
-    })
 }
 
 /// The fit of the model [`select`] chooses from `candidates`, with every candidate left out as
-/// an unresolved term bounded by [`absent_term`]; `None` when the base model's fit is singular.
+/// an unresolved term: its upper bound that of the model's fit with it added (θ̂ kept at zero:
+/// the term is not in the model); `None` when the base model's fit is singular.
 pub fn fit_selected(
     points: &[FitPoint],
     samples: usize,
@@ -144,14 +120,18 @@ pub fn fit_selected(
     candidates: &[Term],
     confidence: f64,
 ) -> Option<Fit> {
-    let (model, mut f) = select(points, samples, tau0_s, candidates, confidence)?;
-    for &t in candidates.iter().filter(|t| !model.contains(t)) {
-        if let Some(e) = absent_term(points, samples, tau0_s, &model, t, confidence) {
-            f.terms.push(e);
+    let (mut f, absent) = select(points, samples, tau0_s, candidates, confidence)?;
+    for (term, with) in &absent {
+        if let Some(&t) = with.term(*term) {
+            f.terms.push(TermEstimate {
+                value: None,
+                lower: None,
+                squared: 0.0,
+                ..t
+            });
         }
     }
     f.terms
         .sort_by_key(|t| Term::ALL.iter().position(|&u| u == t.term));
-    f.model = model;
     Some(f)
 }
