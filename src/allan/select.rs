@@ -110,9 +110,10 @@ fn select(
     }
 }
 
-/// The fit of the model [`select`] chooses from `candidates`, with every candidate left out as
-/// an unresolved term: its upper bound that of the model's fit with it added (θ̂ kept at zero:
-/// the term is not in the model); `None` when the base model's fit is singular.
+/// The fit of the model the forward selection (`select`) chooses from `candidates`, with every
+/// candidate left out as an unresolved term: its upper bound that of the model's fit with it
+/// added (θ̂ kept at zero: the term is not in the model); `None` when the base model's fit is
+/// singular.
 pub fn fit_selected(
     points: &[FitPoint],
     samples: usize,
