@@ -124,9 +124,10 @@ impl Default for ReportArgs {
 pub struct EnsembleArgs {
     #[command(flatten)]
     pub model: ModelArgs,
-    /// Which study: the one-axis accelerometer (default) or the three-axis INS/GNSS filter.
-    #[arg(long = "model", value_enum, default_value_t = ModelKind::Accelerometer)]
-    pub kind: ModelKind,
+    /// Which study: the one-axis accelerometer or the three-axis INS/GNSS filter (default: the
+    /// configuration file's `model`, the one-axis study without one).
+    #[arg(long = "model", value_enum)]
+    pub kind: Option<ModelKind>,
     #[command(flatten)]
     pub case: CaseArgs,
     /// Number of realizations, overriding ensemble.realizations.
@@ -214,9 +215,10 @@ pub struct SimulateArgs {
     /// (with --model ins: imu.csv, gnss.csv and truth.csv).
     #[arg(long, value_name = "DIR")]
     pub logs: Option<PathBuf>,
-    /// Which study: the one-axis accelerometer, or the three-axis INS/GNSS drive (its logs only).
-    #[arg(long = "model", value_enum, default_value_t = ModelKind::Accelerometer)]
-    pub kind: ModelKind,
+    /// Which study: the one-axis accelerometer, or the three-axis INS/GNSS drive (its logs only;
+    /// default: the configuration file's `model`, the one-axis study without one).
+    #[arg(long = "model", value_enum)]
+    pub kind: Option<ModelKind>,
 }
 
 /// The values `--truth` accepts, each with its help; parsed into a [`TruthModel`].

@@ -1,7 +1,10 @@
-//! Seeded fuzzing of the five surfaces a user can hand the tool: the one-axis sensor logs
-//! (through `calibrate --accel --gps`), the three-axis recordings (through `calibrate --imu
-//! --gnss`: the shipped comma2k19 minute's first 4 s), the configuration (through `ensemble`, `simulate`, `sensitivity` and `report`,
-//! at tiny sizes), the shard partials (through `merge`) and the command line.
+//! Seeded fuzzing of the surfaces a user can hand the tool: the one-axis sensor logs (through
+//! `calibrate --accel --gps`), the three-axis recordings (through `calibrate --imu --gnss`: the
+//! shipped comma2k19 minute's first 4 s; and their longitudes written another way, which must
+//! calibrate to the same numbers), the IMU containers (MCAP, ROS 1 bags, through `allan
+//! --imu`), the one-axis and three-axis configurations (through `ensemble`, `simulate`,
+//! `sensitivity` and `report`, at tiny sizes; `three_axis.rs`), the shard partials (through
+//! `merge`) and the command line.
 //!
 //! Every input is a mutation of a valid one by a generator seeded per case, so a finding is
 //! reproduced by its surface and case number (printed, and its inputs kept under the target
@@ -15,6 +18,8 @@
 //! reason (reported, not failed, unless `ACCELCAL_FUZZ_STRICT=1`); the list is empty.
 
 mod common;
+#[path = "fuzz/three_axis.rs"]
+mod three_axis;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -377,17 +382,21 @@ enum Surface {
     Imu,
     Bag,
     Config,
+    ThreeAxisConfig,
+    Meridian,
     Partials,
     CommandLine,
 }
 
-const SURFACES: [(Surface, usize); 6] = [
+const SURFACES: [(Surface, usize); 8] = [
     (Surface::Logs, 200),
     (Surface::Imu, 100),
     (Surface::Bag, 80),
-    (Surface::Config, 240),
+    (Surface::Config, 200),
+    (Surface::ThreeAxisConfig, 60),
+    (Surface::Meridian, 10),
     (Surface::Partials, 160),
-    (Surface::CommandLine, 220),
+    (Surface::CommandLine, 190),
 ];
 
 /// A finding: which input, what went wrong, and where its inputs are kept.
@@ -419,6 +428,10 @@ struct Base {
     /// A static IMU as MCAP files of ROS 2 `Imu` messages, chunked (with CRCs) and not, and as
     /// ROS 1 bags with plain, lz4 and bz2 chunks.
     bags: [Vec<u8>; 5],
+    /// The three-axis files of `config --model ins` and `--model car`, sized to seconds.
+    three_axis: [String; 2],
+    /// The summary of the unmutated three-axis recording's calibration.
+    imu_summary: serde_json::Value,
 }
 
 fn base(dir: &Path) -> Base {
@@ -455,7 +468,22 @@ fn base(dir: &Path) -> Base {
         "one.json",
     ]);
     let read = |p: &str| std::fs::read(dir.join(p)).unwrap();
+    std::fs::write(dir.join("imu.csv"), first_seconds("imu.csv")).unwrap();
+    std::fs::write(dir.join("gnss.csv"), first_seconds("gnss.csv")).unwrap();
+    ok(&[
+        "calibrate",
+        "-q",
+        "--imu",
+        "imu.csv",
+        "--gnss",
+        "gnss.csv",
+        "--out",
+        "cal3",
+    ]);
+    let summary = std::fs::read_to_string(dir.join("cal3/summary.json")).unwrap();
     Base {
+        three_axis: ["ins", "car"].map(|m| three_axis::tiny_three_axis(dir, m)),
+        imu_summary: serde_json::from_str(&summary).unwrap(),
         dir: dir.to_path_buf(),
         accel: read("logs/accelerometer.csv"),
         gps: read("logs/gps.csv"),
@@ -804,6 +832,27 @@ fn case_imu(rng: &mut Rng, base: &Base, dir: &Path) -> (Vec<String>, Vec<&'stati
     (args, vec!["cal3/summary.json", "cal3/estimates.csv"])
 }
 
+/// One meridian case: the unmutated recording with its longitudes written another way.
+fn case_meridian(rng: &mut Rng, base: &Base, dir: &Path) -> (Vec<String>, Vec<&'static str>) {
+    std::fs::write(dir.join("imu.csv"), &base.imu).unwrap();
+    let gnss = three_axis::same_meridians(rng, &base.gnss);
+    std::fs::write(dir.join("gnss.csv"), gnss).unwrap();
+    let args = [
+        "calibrate",
+        "-q",
+        "--imu",
+        "imu.csv",
+        "--gnss",
+        "gnss.csv",
+        "--out",
+        "cal3",
+    ];
+    (
+        args.map(String::from).to_vec(),
+        vec!["cal3/summary.json", "cal3/estimates.csv"],
+    )
+}
+
 /// A change of a log's layout: its header's rate columns renamed to increments (a valid
 /// layout whose numbers are now wrong by the step), one column renamed to another of either
 /// layout, a column dropped or added on every line, or two rows swapped.
@@ -1126,6 +1175,8 @@ fn run_case(
         Surface::Imu => case_imu(rng, base, dir),
         Surface::Bag => case_bag(rng, base, dir),
         Surface::Config => case_config(rng, dir, &tally.reports),
+        Surface::ThreeAxisConfig => three_axis::case_three_axis_config(rng, &base.three_axis, dir),
+        Surface::Meridian => case_meridian(rng, base, dir),
         Surface::Partials => case_partials(rng, base, dir),
         Surface::CommandLine => case_command_line(rng),
     };
@@ -1137,6 +1188,18 @@ fn run_case(
         let changed = clobbered(dir, &outputs);
         if !changed.is_empty() {
             what = Some(format!("a failing run changed {changed:?}"));
+        }
+    }
+    if what.is_none() && surface == Surface::Meridian {
+        let summary = std::fs::read_to_string(dir.join("cal3/summary.json")).unwrap_or_default();
+        let d = serde_json::from_str(&summary).map_or(f64::INFINITY, |s| {
+            three_axis::bias_difference(&s, &base.imu_summary)
+        });
+        // The same drive: the same biases but for the longitudes' rounding (10⁻¹⁰°, 10 µm).
+        if ended.code != Some(0) || d.is_nan() || d >= 1e-6 {
+            what = Some(format!(
+                "the same meridians calibrate otherwise (biases {d:.1e} apart)"
+            ));
         }
     }
     if what.is_none() && surface == Surface::Partials && ended.code == Some(0) {

@@ -109,7 +109,8 @@ pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
         )
         .into());
     }
-    let (config, scenario) = load(&args.model, args.kind, args.realizations)?;
+    let kind = args.kind.unwrap_or(ModelKind::Ins);
+    let (config, scenario) = load(&args.model, kind, args.realizations)?;
     let bytes = ins_ensemble::memory_bytes(&scenario);
     if bytes > MAX_ENSEMBLE_BYTES {
         let fixes = scenario.duration_s * scenario.imu_rate_hz / scenario.imu_steps_per_fix as f64;
@@ -322,7 +323,7 @@ pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
         )
         .into());
     };
-    let scenario = load_scenario(&args.model, args.kind)?;
+    let scenario = load_scenario(&args.model, args.kind.unwrap_or(ModelKind::Ins))?;
     let names = [IMU_FILE, GNSS_FILE, TRUTH_FILE];
     check_directory(dir, &names)?;
     let mut staged = StagedFiles::create(dir, &names)?;

@@ -26,7 +26,10 @@ use accelcal::{export, realization, report, simulation};
 use anyhow::{Context, Result};
 
 pub(super) fn run_simulate(args: &SimulateArgs) -> Result<()> {
-    if args.kind != crate::cli::ModelKind::Accelerometer {
+    if args
+        .kind
+        .is_some_and(|k| k != crate::cli::ModelKind::Accelerometer)
+    {
         return super::ins::run_simulate(args);
     }
     let model = load_model(&args.model, &args.case, None)?;

@@ -99,8 +99,14 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => monte_carlo::run_report(&ReportArgs::default()),
         Some(Command::Report(args)) => monte_carlo::run_report(&args),
-        Some(Command::Ensemble(args)) => monte_carlo::run_ensemble(&args),
-        Some(Command::Simulate(args)) => logs::run_simulate(&args),
+        Some(Command::Ensemble(mut args)) => {
+            args.kind = Some(model_kind(args.kind, &args.model)?);
+            monte_carlo::run_ensemble(&args)
+        }
+        Some(Command::Simulate(mut args)) => {
+            args.kind = Some(model_kind(args.kind, &args.model)?);
+            logs::run_simulate(&args)
+        }
         Some(Command::Sensitivity(args)) => monte_carlo::run_sensitivity(&args),
         Some(Command::Merge(args)) => monte_carlo::run_merge(&args),
         Some(Command::Calibrate(args)) => match (&args.imu, &args.gnss) {
@@ -113,6 +119,50 @@ pub fn run(cli: Cli) -> Result<()> {
             ModelKind::Ins => accelcal::config::ins::DEFAULT_INS_TOML.to_string(),
             ModelKind::Car => accelcal::config::ins::default_car_toml(),
         }),
+    }
+}
+
+/// The study `--model` names (`flag`), or without it the one the configuration file's
+/// top-level `model` key names ("ins", "car"; the one-axis study's file has none).
+///
+/// # Errors
+/// [`ConfigError::Invalid`] for a `model` that names no study, or a three-axis file run with
+/// `--model accelerometer`. A file that is not a regular file (a pipe, read once) or not
+/// TOML is not looked into here: its reader says what is wrong.
+fn model_kind(flag: Option<ModelKind>, args: &ModelArgs) -> Result<ModelKind, ConfigError> {
+    let Some(path) = args.config.as_deref().filter(|p| p.is_file()) else {
+        return Ok(flag.unwrap_or(ModelKind::Accelerometer));
+    };
+    let text = ConfigText::read(path)?;
+    let Some(model) = text
+        .text
+        .parse::<toml::Table>()
+        .ok()
+        .and_then(|t| t.get("model").cloned())
+    else {
+        return Ok(flag.unwrap_or(ModelKind::Accelerometer));
+    };
+    let named = match model.as_str() {
+        Some("ins") => Some(ModelKind::Ins),
+        Some("car") => Some(ModelKind::Car),
+        _ => None,
+    };
+    let invalid = |expected: &str| {
+        let value = model
+            .as_str()
+            .map_or_else(|| model.to_string(), |s| format!("\"{s}\""));
+        Err(text.locate(ConfigError::invalid("model", value, expected)))
+    };
+    match (flag, named) {
+        (_, None) => {
+            invalid("\"ins\" or \"car\" (a three-axis file), or left out (the one-axis file)")
+        }
+        (Some(ModelKind::Accelerometer), Some(_)) => invalid(
+            "left out with --model accelerometer (the one-axis file has no `model`); leave \
+             --model out to run the file's own",
+        ),
+        (Some(kind), Some(_)) => Ok(kind),
+        (None, Some(kind)) => Ok(kind),
     }
 }
 

@@ -75,7 +75,10 @@ fn reproduce_command(args: &ReportArgs) -> String {
 }
 
 pub(super) fn run_ensemble(args: &EnsembleArgs) -> Result<()> {
-    if args.kind != crate::cli::ModelKind::Accelerometer {
+    if args
+        .kind
+        .is_some_and(|k| k != crate::cli::ModelKind::Accelerometer)
+    {
         return super::ins::run_ensemble(args);
     }
     let model = load_model(&args.model, &args.case, args.realizations)?;

@@ -248,7 +248,7 @@ fn row_of(line: u64, r: [f64; 4], o: [Option<f64>; 9]) -> GnssRow {
         t_s: r[0],
         position: Geodetic {
             lat_rad: r[1].to_radians(),
-            lon_rad: r[2].to_radians(),
+            lon_rad: super::records::wrap_longitude(r[2].to_radians()),
             height_m: r[3],
         },
         velocity_ned_m_s: [o[0], o[1], o[2]],

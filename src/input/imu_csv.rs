@@ -27,6 +27,13 @@ pub const INCREMENT_COLUMNS: [&str; 7] = [
     "t_s", "dvx_m_s", "dvy_m_s", "dvz_m_s", "dthx_rad", "dthy_rad", "dthz_rad",
 ];
 
+/// The largest specific force a row may hold, m/s² (about 10⁵ g, beyond any shock-rated
+/// accelerometer): a larger one is a damaged field, and its square would leave the filter's
+/// double precision.
+pub const MAX_SPECIFIC_FORCE_M_S2: f64 = 1e6;
+/// The largest angular rate a row may hold, rad/s (about 1 600 turns a second).
+pub const MAX_ANGULAR_RATE_RAD_S: f64 = 1e4;
+
 /// What an IMU log's rows hold.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -207,6 +214,7 @@ impl Rows {
             ImuLayout::Rates => dt_s,
             ImuLayout::Increments => 1.0,
         };
+        self.in_range(v, dt_s)?;
         let f = Vector3::new(v[1], v[2], v[3]).component_mul(&sign) * scale;
         let w = Vector3::new(v[4], v[5], v[6]).component_mul(&sign) * scale;
         Ok(Some(ImuStep {
@@ -218,6 +226,44 @@ impl Rows {
                 dt_s,
             },
         }))
+    }
+
+    /// [`LogProblem::OutOfRange`] for the first of row `v`'s six values whose rate (the value,
+    /// or the increment over the step `dt_s`) exceeds [`MAX_SPECIFIC_FORCE_M_S2`] or
+    /// [`MAX_ANGULAR_RATE_RAD_S`].
+    fn in_range(&self, v: &[f64; 7], dt_s: f64) -> Result<(), LogProblem> {
+        let columns = match self.layout {
+            ImuLayout::Rates => RATE_COLUMNS,
+            ImuLayout::Increments => INCREMENT_COLUMNS,
+        };
+        for k in 1..7 {
+            let (limit, unit) = if k <= 3 {
+                (MAX_SPECIFIC_FORCE_M_S2, "m/s²")
+            } else {
+                (MAX_ANGULAR_RATE_RAD_S, "rad/s")
+            };
+            let rate = match self.layout {
+                ImuLayout::Rates => v[k],
+                ImuLayout::Increments => v[k] / dt_s,
+            };
+            if rate.abs() > limit {
+                let range = match self.layout {
+                    ImuLayout::Rates => format!("|{}| ≤ {limit:e} {unit}", columns[k]),
+                    ImuLayout::Increments => format!(
+                        "|{}| ≤ {limit:e} {unit} times the step of {} s",
+                        columns[k],
+                        crate::format::short(dt_s)
+                    ),
+                };
+                let (column, value) = (columns[k], v[k]);
+                return Err(LogProblem::OutOfRange {
+                    column,
+                    value,
+                    range,
+                });
+            }
+        }
+        Ok(())
     }
 
     /// [`ImuReader::finish`] of the log named `file`.

@@ -237,7 +237,10 @@ pub enum LogProblem {
         expected: String,
     },
     /// A value outside the range its column accepts.
-    #[error("`{column}` = {value} is outside its accepted range: expected {range}")]
+    #[error(
+        "`{column}` = {} is outside its accepted range: expected {range}",
+        crate::format::short(*.value)
+    )]
     OutOfRange {
         /// The column.
         column: &'static str,

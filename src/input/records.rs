@@ -169,12 +169,23 @@ impl GnssRow {
     }
 }
 
+/// A longitude wrapped into (−π, π], rad: a longitude past the antimeridian (or written in
+/// [0, 2π)) is the same meridian.
+pub fn wrap_longitude(lon_rad: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    if lon_rad > -PI && lon_rad <= PI {
+        return lon_rad;
+    }
+    let w = lon_rad.rem_euclid(TAU);
+    if w > PI { w - TAU } else { w }
+}
+
 /// A position on the ellipsoid: geodetic latitude and longitude, ellipsoidal height.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Geodetic {
     /// Geodetic latitude L, rad, in [−π/2, π/2].
     pub lat_rad: f64,
-    /// Longitude λ, rad, east positive.
+    /// Longitude λ, rad, east positive, in (−π, π] ([`wrap_longitude`]).
     pub lon_rad: f64,
     /// Height above the ellipsoid h, m.
     pub height_m: f64,

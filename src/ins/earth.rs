@@ -9,7 +9,7 @@
 use nalgebra::{UnitQuaternion, Vector3};
 
 // The position the GNSS readers hand on: defined with them, below this layer.
-pub use crate::input::records::Geodetic;
+pub use crate::input::records::{Geodetic, wrap_longitude};
 
 /// Semi-major axis a, m (TR8350.2 table 3.1).
 pub const SEMI_MAJOR_AXIS_M: f64 = 6_378_137.0;
@@ -105,13 +105,18 @@ fn transport_rate_of(rn_h: f64, re_h: f64, tan: f64, v_ned: &Vector3<f64>) -> Ve
     Vector3::new(v_ned.y / re_h, -v_ned.x / rn_h, -v_ned.y * tan / re_h)
 }
 
+/// λ_a − λ_b wrapped into (−π, π], rad: the shorter way round between two meridians.
+pub fn longitude_difference(a_rad: f64, b_rad: f64) -> f64 {
+    wrap_longitude(a_rad - b_rad)
+}
+
 /// `p` moved by `d_ned_m` metres north, east and down (first order in d/R: the lever arm, a
 /// fix's noise, a prior's draw).
 pub fn offset(p: &Geodetic, d_ned_m: &Vector3<f64>) -> Geodetic {
     let (rn, re) = radii_m(p.lat_rad);
     Geodetic {
         lat_rad: p.lat_rad + d_ned_m.x / (rn + p.height_m),
-        lon_rad: p.lon_rad + d_ned_m.y / ((re + p.height_m) * p.lat_rad.cos()),
+        lon_rad: wrap_longitude(p.lon_rad + d_ned_m.y / ((re + p.height_m) * p.lat_rad.cos())),
         height_m: p.height_m - d_ned_m.z,
     }
 }

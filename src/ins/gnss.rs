@@ -55,12 +55,13 @@ pub fn antenna(
     (position, velocity)
 }
 
-/// `a − b` in NED metres at `a`: ((L_a − L_b)(R_N + h), (λ_a − λ_b)(R_E + h)cos L, −(h_a − h_b)).
+/// `a − b` in NED metres at `a`: ((L_a − L_b)(R_N + h), (λ_a − λ_b)(R_E + h)cos L, −(h_a − h_b)),
+/// λ_a − λ_b the shorter way round.
 pub fn ned_difference_m(a: &Geodetic, b: &Geodetic) -> Vector3<f64> {
     let (rn, re) = earth::radii_m(a.lat_rad);
     Vector3::new(
         (a.lat_rad - b.lat_rad) * (rn + a.height_m),
-        (a.lon_rad - b.lon_rad) * (re + a.height_m) * a.lat_rad.cos(),
+        earth::longitude_difference(a.lon_rad, b.lon_rad) * (re + a.height_m) * a.lat_rad.cos(),
         -(a.height_m - b.height_m),
     )
 }

@@ -166,7 +166,7 @@ fn advance(p: &Geodetic, e: &Local, v: &Vector3<f64>, dt: f64) -> Geodetic {
     let r = e.geodetic_rate(v) * dt;
     Geodetic {
         lat_rad: p.lat_rad + r.x,
-        lon_rad: p.lon_rad + r.y,
+        lon_rad: earth::wrap_longitude(p.lon_rad + r.y),
         height_m: p.height_m + r.z,
     }
 }

@@ -139,7 +139,11 @@ impl<'a> Truth<'a> {
         let k2 = rate(&moved(p0, k1 * (h / 2.0)), t0 + h / 2.0);
         let k3 = rate(&moved(p0, k2 * (h / 2.0)), t0 + h / 2.0);
         let k4 = rate(&moved(p0, k3 * h), t1);
-        moved(p0, (k1 + 2.0 * k2 + 2.0 * k3 + k4) * (h / 6.0))
+        let p1 = moved(p0, (k1 + 2.0 * k2 + 2.0 * k3 + k4) * (h / 6.0));
+        Geodetic {
+            lon_rad: earth::wrap_longitude(p1.lon_rad),
+            ..p1
+        }
     }
 }
 

@@ -73,7 +73,8 @@ fn track<const N: usize>(c: &Calibrated<N>, t: &[f64]) -> Result<FigureView, Ren
         for f in &c.records {
             let p = f.pva.position;
             north.push((p.lat_rad - p0.lat_rad) * (rn + p0.height_m));
-            east.push((p.lon_rad - p0.lon_rad) * (re + p0.height_m) * p0.lat_rad.cos());
+            let d_lon = crate::ins::earth::longitude_difference(p.lon_rad, p0.lon_rad);
+            east.push(d_lon * (re + p0.height_m) * p0.lat_rad.cos());
             height.push(p.height_m);
         }
     }

@@ -98,7 +98,8 @@ fn wrap(a: f64) -> f64 {
 pub fn level(f: &Vector3<f64>, w: &Vector3<f64>) -> (f64, f64) {
     let (f, w) = (f.normalize(), w.normalize());
     let rho2 = f.y * f.y + f.z * f.z;
-    let y = w.y.clamp(-rho2.sqrt(), rho2.sqrt());
+    // max/min, not clamp: a NaN (f or w zero) carries through to the caller's check.
+    let y = w.y.max(-rho2.sqrt()).min(rho2.sqrt());
     let z = (rho2 - y * y).max(0.0).sqrt().copysign(w.z);
     let pitch = wrap(z.atan2(f.x) - w.z.atan2(w.x));
     let roll = wrap(z.atan2(y) - f.z.atan2(f.y));

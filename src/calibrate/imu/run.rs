@@ -196,6 +196,26 @@ pub fn filter_tracked<const N: usize>(
     run_filter(rows, source, s, gnss_name, true)
 }
 
+/// [`ImuCalibrateError::Alignment`] when the mean specific force `f` over the alignment's
+/// window `(t_a, t_h)` is zero or not finite: roll and pitch come from its direction.
+fn levelable(
+    f: &Vector3<f64>,
+    (t_a, t_h): (f64, f64),
+    gnss: &str,
+) -> Result<(), ImuCalibrateError> {
+    if f.norm() > 0.0 && f.norm().is_finite() {
+        return Ok(());
+    }
+    Err(ImuCalibrateError::Alignment {
+        file: gnss.to_string(),
+        reason: format!(
+            "the mean specific force from {t_a} s to {t_h} s is {:?} m/s²: roll and pitch need \
+             the accelerometers' gravity",
+            f.as_slice()
+        ),
+    })
+}
+
 /// [`filter`], tracking what a linearized likelihood needs when `tracked`.
 fn run_filter<const N: usize>(
     rows: &[GnssRow],
@@ -238,6 +258,7 @@ fn run_filter<const N: usize>(
         }
     };
     let mean_f_b = sum_dv / (rh.t_s - ra.t_s);
+    levelable(&mean_f_b, (ra.t_s, rh.t_s), gnss_name)?;
     let alignment = align::align(ra, rh, &mean_f_b, &alignment_sources(rh, s));
     let mut ekf = start::<N>(rh, &alignment, s, tracked);
     let start_view = tracked.then(|| ekf.linear_view());
@@ -322,6 +343,10 @@ pub fn calibrate_of<const N: usize>(
     let layout = reader.layout();
     let name = gnss.name();
     let run = consume_beside(&mut reader, |steps| filter(&rows, steps, s, name));
+    // A row the reader refused ended the run: its line is the error, not the rows short of it.
+    if let Err(e @ ImuCalibrateError::Log(_)) = run {
+        return Err(e);
+    }
     let span = reader.finish()?;
     assemble(&rows, run?, (span, layout), s, gnss.name())
 }

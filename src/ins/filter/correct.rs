@@ -19,7 +19,9 @@ pub fn apply_correction(
     let (rn, re) = crate::ins::earth::radii_m(p.lat_rad);
     let dr = dx.fixed_rows::<3>(POSITION);
     p.lat_rad -= dr[0] / (rn + p.height_m);
-    p.lon_rad -= dr[1] / ((re + p.height_m) * p.lat_rad.cos());
+    p.lon_rad = crate::ins::earth::wrap_longitude(
+        p.lon_rad - dr[1] / ((re + p.height_m) * p.lat_rad.cos()),
+    );
     p.height_m += dr[2];
     pva.velocity_ned_m_s -= dx.fixed_rows::<3>(VELOCITY);
     // Ĉ = exp([δψ×])C, so C = exp(−[δψ×])Ĉ.
