@@ -1,8 +1,8 @@
 //! The containers and streams `allan --imu` and `allan --accel` read, at their edges: a
 //! declared size beyond what the file can hold (a ROS 1 bag's bz2 chunk, an MCAP chunk's
 //! record), a device or a stream of binary data, an MCAP file whose summary counts more
-//! messages than could be read, a schema spelt as ROS 1 spells it, and a recording through a
-//! pipe. Each ends within seconds, with
+//! messages than could be read, a schema spelt as ROS 1 spells it, a recording through a pipe,
+//! and samples whose Allan variance leaves double precision. Each ends within seconds, with
 //! exit code 2 and a message naming the file, or with 0 and the analysis (and a warning where
 //! the file disagrees with itself); the memory of a run is measured where `/usr/bin/time` is.
 
@@ -573,4 +573,81 @@ fn a_recording_through_a_pipe_is_read_as_the_recording_it_is() {
     let args = ["allan", "--imu", "/dev/stdin", "--out", "o3"];
     let e = run(d, &args, Some(vec![0u8; 1 << 22]), 30);
     assert_refused(&e, &["/dev/stdin", "first bytes (00 00"], 2.5, "zeros");
+}
+
+/// Writes a CSV log of `columns` with 2 000 rows at 100 Hz, each value `value(row, column)`.
+fn write_csv(path: &Path, columns: &[&str], value: impl Fn(usize, usize) -> f64) {
+    let mut text = format!("t_s,{}\n", columns.join(","));
+    for k in 0..2000 {
+        text.push_str(&format!("{}", k as f64 * 0.01));
+        for c in 0..columns.len() {
+            text.push_str(&format!(",{:e}", value(k, c)));
+        }
+        text.push('\n');
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+const SIX: [&str; 6] = [
+    "ax_m_s2", "ay_m_s2", "az_m_s2", "gx_rad_s", "gy_rad_s", "gz_rad_s",
+];
+
+#[test]
+fn samples_beyond_double_precision_are_refused_once_and_not_called_constant() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let noise: Vec<f64> = {
+        let mut rng = Rng(41);
+        (0..2000 * 6).map(|_| rng.noise()).collect()
+    };
+    let noise = &noise;
+    let scaled = |scale: f64| move |k: usize, c: usize| scale * (1.0 + 1e-3 * noise[6 * k + c]);
+    write_csv(&d.join("big.csv"), &["accel_m_s2"], scaled(1e156));
+    write_csv(&d.join("big6.csv"), &SIX, scaled(1e156));
+    write_csv(&d.join("tiny6.csv"), &SIX, scaled(1e-160));
+    let once = |e: &Ended, words: &str, what: &str| {
+        assert_eq!(e.stderr.matches(words).count(), 1, "{what}: {}", e.stderr);
+        assert!(!e.stderr.contains("same number"), "{what}: {}", e.stderr);
+    };
+    for (flag, file) in [("--accel", "big.csv"), ("--imu", "big6.csv")] {
+        let e = run(d, &["allan", flag, file, "--out", "out"], None, 30);
+        let words = [file, "outside the range", "between 1e-30 and 1e30"];
+        assert_refused(&e, &words, 10.0, file);
+        once(&e, "outside the range", file);
+    }
+    let e = run(
+        d,
+        &["allan", "--imu", "tiny6.csv", "--out", "out"],
+        None,
+        30,
+    );
+    assert_refused(
+        &e,
+        &["tiny6.csv", "column ax_m_s2", "underflows"],
+        10.0,
+        "tiny",
+    );
+    once(&e, "underflows", "tiny");
+    // A constant channel is still one, said once.
+    write_csv(&d.join("constant.csv"), &SIX, |k, c| {
+        if c == 1 {
+            0.5
+        } else {
+            1.0 + 1e-3 * noise[6 * k + c]
+        }
+    });
+    let e = run(
+        d,
+        &["allan", "--imu", "constant.csv", "--out", "out"],
+        None,
+        30,
+    );
+    let words = [
+        "constant.csv",
+        "column ay_m_s2",
+        "every sample is the same number",
+    ];
+    assert_refused(&e, &words, 10.0, "constant");
+    assert_eq!(e.stderr.matches("same number").count(), 1, "{}", e.stderr);
+    assert!(!d.join("out").exists());
 }
