@@ -54,6 +54,11 @@ pub use gauss_markov_fit::GaussMarkov;
 pub use noise_id::NoiseId;
 pub use reading::{Departure, Feature, Reading};
 
+/// The nonzero Allan deviations σ̂(τ) the analysis accepts, in the log's units: the fit sums
+/// squares of the variances and their model terms, which leave double precision (10^±308) for
+/// deviations beyond about 10^±37; the bounds keep a margin of seven orders.
+pub const ADEV_RANGE: (f64, f64) = (1e-30, 1e30);
+
 /// The interval confidence when none is given: one standard deviation of a normal.
 pub const DEFAULT_CONFIDENCE: f64 = 0.683;
 
@@ -75,6 +80,30 @@ pub enum AllanError {
     /// Every sample is the same number.
     #[error("every sample is the same number: the Allan deviation is zero at every τ")]
     Constant,
+    /// The samples differ, by too little for their second differences' squares in double
+    /// precision.
+    #[error(
+        "the samples differ, but by so little that the Allan variance underflows double \
+         precision (it is zero at every τ): expected every nonzero σ̂(τ) between {:e} and {:e} \
+         in the log's units (rescale the log)",
+        ADEV_RANGE.0,
+        ADEV_RANGE.1
+    )]
+    Underflow,
+    /// A deviation outside [`ADEV_RANGE`]: the fit's sums of squares leave double precision.
+    #[error(
+        "σ̂(τ) = {adev:e} at τ = {tau_s} s is outside the range the analysis computes in double \
+         precision: expected every nonzero σ̂(τ) between {:e} and {:e} in the log's units \
+         (rescale the log)",
+        ADEV_RANGE.0,
+        ADEV_RANGE.1
+    )]
+    OutOfRange {
+        /// The deviation, in the log's units (infinite or NaN when it overflowed).
+        adev: f64,
+        /// Its τ, s.
+        tau_s: f64,
+    },
     /// The confidence is outside (0, 1).
     #[error("the confidence is {0}; expected a number strictly between 0 and 1")]
     Confidence(f64),
@@ -292,6 +321,10 @@ pub fn analyse_cancellable(
             needed: MIN_SAMPLES,
         });
     }
+    // Distinctness is compared, not read off a variance that may underflow.
+    if y.iter().all(|&v| v == y[0]) {
+        return Err(AllanError::Constant);
+    }
     let x = deviation::phase(y);
     cancel.check()?;
     let points = points(&x, tau0_s, confidence, cancel)?;
@@ -300,7 +333,9 @@ pub fn analyse_cancellable(
 
 /// Analyses the rate samples of a log read once ([`stream::AllanStream`]): `grid` holds each
 /// octave τ's (m, σ̂², the noise of its block means) for `samples` samples τ₀ = `tau0_s` apart.
-/// The rest is [`analyse`]'s: the same analysis wherever the grid holds the same numbers.
+/// The rest is [`analyse`]'s: the same analysis wherever the grid holds the same numbers. A
+/// constant log is the caller's to tell (it compares the samples, as [`analyse`] does): a grid
+/// zero at every τ is [`AllanError::Underflow`] here.
 ///
 /// # Errors
 /// As [`analyse`].
@@ -323,7 +358,8 @@ pub fn analyse_grid(
     analyse_points(points, samples, tau0_s, confidence)
 }
 
-/// The fit and its reading on the points of a log of `samples` samples.
+/// The fit and its reading on the points of a log of `samples` samples, which are not all
+/// equal (the callers compare them): points zero at every τ are an underflow.
 fn analyse_points(
     points: Vec<AllanPoint>,
     samples: usize,
@@ -331,7 +367,17 @@ fn analyse_points(
     confidence: f64,
 ) -> Result<Analysis, AllanError> {
     if points.iter().all(|p| p.adev == 0.0) {
-        return Err(AllanError::Constant);
+        return Err(AllanError::Underflow);
+    }
+    let (low, high) = ADEV_RANGE;
+    if let Some(p) = points
+        .iter()
+        .find(|p| p.adev != 0.0 && !(low..=high).contains(&p.adev))
+    {
+        return Err(AllanError::OutOfRange {
+            adev: p.adev,
+            tau_s: p.tau_s,
+        });
     }
     let fit_points: Vec<FitPoint> = points
         .iter()

@@ -10,6 +10,7 @@ use accelcal::allan::imu::stream::StreamError;
 use accelcal::allan::imu::{self, ImuAnalysis};
 use accelcal::allan::{self, Term, export};
 use accelcal::format::{count, interval_digits, sig};
+use accelcal::input::container::{Container, Kind, copy_stream};
 use accelcal::input::csv::piped::PipedLog;
 use accelcal::input::csv::read::LogFile;
 use accelcal::input::csv::static_log::read_static_log;
@@ -172,37 +173,56 @@ fn run_imu(args: &AllanArgs, path: &std::path::Path) -> Result<()> {
 }
 
 /// The analysis of every channel of the log `path`: a regular file or a recording read twice
-/// from disk ([`imu::stream`]), a pipe copied once to a temporary file read twice.
+/// from disk ([`imu::stream`]), a stream (a pipe, `/dev/stdin`) copied once to a temporary file
+/// read twice, as CSV or as the recording its first bytes say it is. What the reading found
+/// amiss but read past is printed as warnings.
 fn analyse_imu_log(args: &AllanArgs, path: &std::path::Path) -> Result<ImuAnalysis> {
     let source = LogFile::new(path);
+    let name = path.display().to_string();
     let regular_file = std::fs::metadata(path).is_ok_and(|m| m.is_file());
     let spill_dir = spill_directory(&args.out);
+    let topic = args.topic.as_deref();
+    let read_as_csv = || {
+        if topic.is_some() {
+            return Err(super::logs::UsageError(format!(
+                "--topic names a topic of an MCAP file or a ROS bag; {name} is read as CSV"
+            )));
+        }
+        Ok(())
+    };
     let piped: PipedLog;
     let records: Box<dyn ImuRecords + '_> = if recording::is_recording(path) {
-        recording::open_recording(path, args.topic.as_deref())?
-    } else if args.topic.is_some() {
-        return Err(super::logs::UsageError(format!(
-            "--topic names a topic of an MCAP file or a ROS 2 bag; {} is read as CSV",
-            path.display()
-        ))
-        .into());
+        recording::open_recording(path, topic)?
     } else if regular_file {
+        read_as_csv()?;
         Box::new(CsvRecords::open(&source)?)
     } else {
-        // A pipe is read once, into a temporary file read twice.
-        piped = PipedLog::copy(path, &spill_dir)?;
-        Box::new(CsvRecords::open(&piped)?)
+        // A stream is read once, into a temporary file read twice.
+        let expected = "a CSV log (UTF-8 text), an MCAP file or a ROS 1 bag";
+        match copy_stream(path, &spill_dir, expected)? {
+            (kind @ (Kind::Mcap | Kind::Ros1), file) => {
+                recording::open_stream(Container::copy(&name, file), kind, topic)?
+            }
+            (_, file) => {
+                read_as_csv()?;
+                piped = PipedLog::from_copy(&name, file);
+                Box::new(CsvRecords::open(&piped)?)
+            }
+        }
     };
-    match imu::stream::analyse_records(records.as_ref(), args.confidence, &spill_dir) {
+    let analysis = imu::stream::analyse_records(records.as_ref(), args.confidence, &spill_dir);
+    // Warnings go to standard error even with --quiet: they are about the numbers.
+    for w in records.warnings() {
+        eprintln!("warning: {w}");
+    }
+    match analysis {
         Ok(a) => Ok(a),
         Err(StreamError::Log(e)) => Err(e.into()),
         Err(StreamError::Spill(e)) => Err(anyhow::Error::new(e).context(format!(
             "the temporary file of the phase in {}",
             spill_dir.display()
         ))),
-        Err(StreamError::Channel(e)) => {
-            Err(anyhow::Error::new(e).context(path.display().to_string()))
-        }
+        Err(StreamError::Channel(e)) => Err(anyhow::Error::new(e).context(name)),
     }
 }
 

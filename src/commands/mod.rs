@@ -43,6 +43,7 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
             || e.is::<LogError>()
             || e.is::<partial::PartialError>()
             || e.is::<accelcal::allan::AllanError>()
+            || e.is::<accelcal::allan::imu::ImuError>()
             || e.is::<logs::UsageError>()
             || e.downcast_ref::<CalibrateError>()
                 .is_some_and(CalibrateError::is_bad_input)

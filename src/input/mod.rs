@@ -9,12 +9,15 @@
 //! - the containers of ROS recordings, [`mcap`] (an MCAP file), [`rosbag2`] (a ROS 2 bag
 //!   directory of MCAP files) and [`rosbag1`] (a ROS 1 bag), their messages decoded by
 //!   [`messages`] (`sensor_msgs/Imu`), the chosen topic read by [`recording`];
+//! - [`container`]: what a log is, told by its first bytes, and where a recording's bytes are
+//!   read from (a file, or a stream's copy);
 //! - [`records`]: what the readers hand on, whatever the format.
 //!
 //! Every reader refuses bad input with a [`LogError`] naming the file, the line (or the message)
 //! and what was expected; none knows what its numbers are used for. The layer imports nothing of
 //! the analyses above it.
 
+pub mod container;
 pub mod csv;
 pub mod gnss_csv;
 pub mod imu_channels_csv;

@@ -13,9 +13,10 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use super::container::{Container, Kind};
 use super::csv::static_log::{first_gap, median_step};
 use super::mcap::{MCAP_MAGIC, McapEvent, McapRecords, visit_mcap};
-use super::messages::{ImuMessage, ROS1_IMU_TYPE, ROS2_IMU_TYPE, decode_imu, decode_ros1_message};
+use super::messages::{ImuMessage, ROS1_IMU_TYPE, decode_ros1_message};
 use super::records::{Channel, ImuRecords, ImuSamples};
 use super::rosbag2::bag_files;
 use super::{LogError, LogProblem, unreadable};
@@ -29,24 +30,34 @@ pub(super) struct Topics {
     pub types: BTreeMap<String, String>,
 }
 
+/// What an MCAP file's `Imu` topic is, in the words of a message that finds none.
+const MCAP_IMU: (&str, &str) = (
+    "sensor_msgs/msg/Imu",
+    " (a schema sensor_msgs/msg/Imu or sensor_msgs/Imu, encoding cdr or ros1)",
+);
+
+/// What a ROS 1 bag's `Imu` topic is.
+const ROS1_IMU: (&str, &str) = (ROS1_IMU_TYPE, "");
+
 /// Reads the messages of one MCAP file into `topics` (every `Imu` topic's decoded).
-fn read_mcap(path: &Path, topics: &mut Topics) -> Result<(), LogError> {
-    let file = path.display().to_string();
-    visit_mcap(path, true, &mut |event| match event {
-        McapEvent::Channel(topic, kind) => {
+fn read_mcap(source: &Container, topics: &mut Topics) -> Result<(), LogError> {
+    let file = source.name();
+    visit_mcap(source, true, &mut |event| match event {
+        McapEvent::Channel(topic) => {
             topics
                 .types
-                .entry(topic.to_string())
-                .or_insert(kind.to_string());
+                .entry(topic.topic.clone())
+                .or_insert(topic.describe());
             Ok(())
         }
-        McapEvent::Message(topic, kind, data) => {
-            if kind != ROS2_IMU_TYPE {
+        McapEvent::Message(topic, data) => {
+            if !topic.is_imu() {
                 return Ok(());
             }
-            let list = topics.imu.entry(topic.to_string()).or_default();
-            let decoded = decode_imu(data).map_err(|e| {
-                unreadable(&format!("{file}, topic {topic}, message {}", list.len()), e)
+            let name = &topic.topic;
+            let list = topics.imu.entry(name.clone()).or_default();
+            let decoded = topic.decode(data).map_err(|e| {
+                unreadable(&format!("{file}, topic {name}, message {}", list.len()), e)
             })?;
             list.push(decoded);
             Ok(())
@@ -54,13 +65,13 @@ fn read_mcap(path: &Path, topics: &mut Topics) -> Result<(), LogError> {
     })
 }
 
-/// Reads the connections and `Imu` messages of the ROS 1 bag at `path` into `topics`.
+/// Reads the connections and `Imu` messages of the ROS 1 bag `source` into `topics`.
 ///
 /// # Errors
 /// As [`super::rosbag1::visit_ros1`], and a message too short for an `Imu`.
-fn read_ros1(path: &Path, topics: &mut Topics) -> Result<(), LogError> {
-    let file = path.display().to_string();
-    super::rosbag1::visit_ros1(path, &mut |event| {
+fn read_ros1(source: &Container, topics: &mut Topics) -> Result<(), LogError> {
+    let file = source.name();
+    super::rosbag1::visit_ros1(source, &mut |event| {
         match event {
             super::rosbag1::Ros1Event::Connection(topic, kind) => {
                 topics
@@ -70,7 +81,7 @@ fn read_ros1(path: &Path, topics: &mut Topics) -> Result<(), LogError> {
             }
             super::rosbag1::Ros1Event::Message(topic, kind, data) if kind == ROS1_IMU_TYPE => {
                 let list = topics.imu.entry(topic.to_string()).or_default();
-                list.push(decode_ros1_message(&file, topic, list.len(), data)?);
+                list.push(decode_ros1_message(file, topic, list.len(), data)?);
             }
             super::rosbag1::Ros1Event::Message(..) => {}
         }
@@ -79,7 +90,8 @@ fn read_ros1(path: &Path, topics: &mut Topics) -> Result<(), LogError> {
 }
 
 /// Whether `path` is read as a recording (an MCAP file or a bag directory) rather than CSV. Only
-/// a regular file's first bytes are looked at: a pipe is read as CSV, its bytes left unread.
+/// a regular file's first bytes are looked at: a pipe's bytes are left unread (a stream is told
+/// by [`super::container::copy_stream`]).
 pub fn is_recording(path: &Path) -> bool {
     if path.is_dir() {
         return true;
@@ -114,22 +126,23 @@ pub fn read_recording(path: &Path, topic: Option<&str>) -> Result<ImuSamples, Lo
     let mut topics = Topics::default();
     for f in &files {
         if f.is_file() && super::rosbag1::is_ros1(f) {
-            read_ros1(f, &mut topics)?;
+            read_ros1(&Container::file(f), &mut topics)?;
         } else {
-            read_mcap(f, &mut topics)?;
+            read_mcap(&Container::file(f), &mut topics)?;
         }
     }
     let imu_type = if files.iter().any(|f| super::rosbag1::is_ros1(f)) {
-        ROS1_IMU_TYPE
+        ROS1_IMU
     } else {
-        ROS2_IMU_TYPE
+        MCAP_IMU
     };
     let chosen = choose_topic(&name, &topics, topic, imu_type)?;
     let messages = &topics.imu[&chosen];
     samples(&name, &chosen, messages)
 }
 
-/// The `Imu` topic read: `topic` when given, else the only one.
+/// The `Imu` topic read: `topic` when given, else the only one (the type's name and what is
+/// accepted as one, for messages).
 ///
 /// # Errors
 /// [`LogError`] naming `name` when `topic` is not an `Imu` topic of the recording, or none is
@@ -138,7 +151,7 @@ fn choose_topic(
     name: &str,
     topics: &Topics,
     topic: Option<&str>,
-    imu_type: &str,
+    (imu_type, accepted): (&str, &str),
 ) -> Result<String, LogError> {
     let listing = || {
         let all: Vec<String> = topics
@@ -154,9 +167,9 @@ fn choose_topic(
     };
     let problem = match (topic, topics.imu.len()) {
         (Some(t), _) if topics.imu.contains_key(t) => return Ok(t.to_string()),
-        (Some(t), _) => format!("no {imu_type} topic {t}; {}", listing()),
+        (Some(t), _) => format!("no {imu_type} topic {t}{accepted}; {}", listing()),
         (None, 1) => return Ok(topics.imu.keys().next().expect("one").clone()),
-        (None, 0) => format!("no {imu_type} topic; {}", listing()),
+        (None, 0) => format!("no {imu_type} topic{accepted}; {}", listing()),
         (None, _) => format!(
             "several {imu_type} topics: choose one with --topic; {}",
             listing()
@@ -178,26 +191,59 @@ pub fn open_recording(path: &Path, topic: Option<&str>) -> Result<Box<dyn ImuRec
         vec![path.to_path_buf()]
     };
     let ros1 = path.is_file() && super::rosbag1::is_ros1(path);
+    let files = files.iter().map(|f| Container::file(f)).collect();
+    open_parts(name, files, ros1, topic)
+}
+
+/// The `Imu` topic of the copy of a stream, `source`, whose first bytes told `kind` (an MCAP
+/// file or a ROS 1 bag), as records read from the copy each time.
+///
+/// # Errors
+/// As [`open_recording`].
+pub fn open_stream(
+    source: Container,
+    kind: Kind,
+    topic: Option<&str>,
+) -> Result<Box<dyn ImuRecords>, LogError> {
+    let name = source.name().to_string();
+    open_parts(name, vec![source], kind == Kind::Ros1, topic)
+}
+
+/// The `Imu` topic of the recording `name`: a ROS 1 bag (`ros1`), or MCAP files read in
+/// sequence.
+fn open_parts(
+    name: String,
+    files: Vec<Container>,
+    ros1: bool,
+    topic: Option<&str>,
+) -> Result<Box<dyn ImuRecords>, LogError> {
     let mut topics = Topics::default();
-    for f in &files {
-        let listed = if ros1 {
-            super::rosbag1::topics(f)?
-        } else {
-            super::mcap::topics(f)?
-        };
-        for (t, kind) in listed {
-            if kind == ROS2_IMU_TYPE || kind == ROS1_IMU_TYPE {
+    if ros1 {
+        for f in &files {
+            for (t, kind) in super::rosbag1::topics(f)? {
+                if kind == ROS1_IMU_TYPE {
+                    topics.imu.entry(t.clone()).or_default();
+                }
+                topics.types.entry(t).or_insert(kind);
+            }
+        }
+        let chosen = choose_topic(&name, &topics, topic, ROS1_IMU)?;
+        let bag = files.into_iter().next().expect("a bag is one file");
+        return Ok(Box::new(super::rosbag1::Ros1Records::new(bag, chosen)));
+    }
+    let mut parts = Vec::with_capacity(files.len());
+    for f in files {
+        let (listed, counts) = super::mcap::topics(&f)?;
+        for (t, described) in listed {
+            if described.is_imu() {
                 topics.imu.entry(t.clone()).or_default();
             }
-            topics.types.entry(t).or_insert(kind);
+            topics.types.entry(t).or_insert(described.describe());
         }
+        parts.push((f, counts));
     }
-    if ros1 {
-        let chosen = choose_topic(&name, &topics, topic, ROS1_IMU_TYPE)?;
-        return Ok(Box::new(super::rosbag1::Ros1Records::new(path, chosen)));
-    }
-    let chosen = choose_topic(&name, &topics, topic, ROS2_IMU_TYPE)?;
-    Ok(Box::new(McapRecords::new(name, files, chosen)))
+    let chosen = choose_topic(&name, &topics, topic, MCAP_IMU)?;
+    Ok(Box::new(McapRecords::new(name, parts, chosen)))
 }
 
 /// The samples of the topic's messages, checked as a CSV log's rows are.

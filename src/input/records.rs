@@ -119,6 +119,12 @@ pub trait ImuRecords {
 
     /// The error of `problem` for the whole log.
     fn error(&self, problem: LogProblem) -> LogError;
+
+    /// What a whole read found amiss but read past (a recording's summary that counts other
+    /// messages than were read), in words; none before a read.
+    fn warnings(&self) -> Vec<String> {
+        Vec::new()
+    }
 }
 
 /// One step of the IMU log: the increments over (`t_s − dt_s`, `t_s`], in body axes

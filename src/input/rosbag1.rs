@@ -18,14 +18,14 @@
 
 use std::cell::Cell;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use super::container::{Container, MAX_EXPANSION, expansion_limit};
 use super::messages::{ROS1_IMU_TYPE, decode_ros1_message, u32_at};
 use super::records::{Channel, ImuRecords, Record};
 use super::{LogError, LogProblem, unreadable};
 
-/// The first bytes of a ROS 1 bag.
-pub const ROSBAG_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
+pub use super::container::ROSBAG_MAGIC;
 
 /// Whether the file at `path` starts as a ROS 1 bag does.
 pub fn is_ros1(path: &Path) -> bool {
@@ -159,9 +159,23 @@ impl Reading {
         let place = format!("the chunk at byte {at}");
         let compression = header.get(&b"compression"[..]).copied().unwrap_or(b"none");
         // The chunk header's `size` is the records' length once decompressed: no more is
-        // decompressed than it says (a corrupt chunk cannot fill the memory).
+        // decompressed than it says, nor than its compressed bytes can hold (a corrupt chunk
+        // cannot fill the memory).
         let size = header.get(&b"size"[..]).and_then(|c| u32_at(c, 0));
-        let limit = u64::from(size.unwrap_or(u32::MAX));
+        let possible = expansion_limit(data.len() as u64);
+        let limit = size.map_or(possible, u64::from);
+        if compression != b"none" && limit > possible {
+            return Err(unreadable(
+                file,
+                format!(
+                    "{place} declares {limit} bytes once decompressed, more than its {} bytes of \
+                     {} data can hold: expected at most {possible} (compressed data is taken to \
+                     expand at most {MAX_EXPANSION} times)",
+                    data.len(),
+                    String::from_utf8_lossy(compression)
+                ),
+            ));
+        }
         let inflate = |name: &str, reader: std::io::Result<Box<dyn std::io::Read + '_>>| {
             let mut out = Vec::new();
             reader
@@ -197,20 +211,19 @@ impl Reading {
     }
 }
 
-/// Reads the records of the ROS 1 bag at `path` in order from disk, one top-level record (a
+/// Reads the records of the ROS 1 bag `source` in order from disk, one top-level record (a
 /// chunk, decompressed) at a time, handing its connections and messages to `visit`.
 ///
 /// # Errors
 /// [`LogError`] naming the file and the byte offset of a record that is cut short or malformed
-/// (a length past the file's end included), a chunk compressed otherwise than plain, lz4 or bz2
-/// or whose data does not decompress, a
-/// message on no connection, or `visit`'s error.
-pub(super) fn visit_ros1(path: &Path, visit: &mut Visit<'_>) -> Result<(), LogError> {
+/// (a length past the file's end included), a chunk compressed otherwise than plain, lz4 or bz2,
+/// declaring more bytes than its data can hold ([`expansion_limit`]) or whose data does not
+/// decompress, a message on no connection, or `visit`'s error.
+pub(super) fn visit_ros1(source: &Container, visit: &mut Visit<'_>) -> Result<(), LogError> {
     use std::io::Read as _;
-    let file = path.display().to_string();
+    let file = source.name().to_string();
     let io = |e: std::io::Error| unreadable(&file, e.to_string());
-    let f = std::fs::File::open(path).map_err(io)?;
-    let len = f.metadata().map_err(io)?.len();
+    let (f, len) = source.open()?;
     let mut input = std::io::BufReader::with_capacity(1 << 20, f);
     let mut magic = [0u8; ROSBAG_MAGIC.len()];
     if input.read_exact(&mut magic).is_err() || magic != ROSBAG_MAGIC {
@@ -266,17 +279,17 @@ fn part(
     input.read_exact(buffer).map_err(|_| ())
 }
 
-/// The topics of the ROS 1 bag at `path` and their types, from the connection records of its
+/// The topics of the ROS 1 bag `source` and their types, from the connection records of its
 /// index (the bag header's `index_pos`) when it has one, else by reading it through.
 ///
 /// # Errors
 /// As [`visit_ros1`].
-pub(super) fn topics(path: &Path) -> Result<BTreeMap<String, String>, LogError> {
-    if let Some(t) = index_topics(path) {
+pub(super) fn topics(source: &Container) -> Result<BTreeMap<String, String>, LogError> {
+    if let Some(t) = index_topics(source) {
         return Ok(t);
     }
     let mut out = BTreeMap::new();
-    visit_ros1(path, &mut |event| {
+    visit_ros1(source, &mut |event| {
         if let Ros1Event::Connection(topic, kind) = event {
             out.entry(topic.to_string()).or_insert(kind.to_string());
         }
@@ -287,17 +300,20 @@ pub(super) fn topics(path: &Path) -> Result<BTreeMap<String, String>, LogError> 
 
 /// The topics the connection records after `index_pos` name; `None` without an index or when
 /// it does not parse.
-fn index_topics(path: &Path) -> Option<BTreeMap<String, String>> {
+fn index_topics(source: &Container) -> Option<BTreeMap<String, String>> {
     use std::io::{Read as _, Seek, SeekFrom};
-    let mut f = std::fs::File::open(path).ok()?;
-    let mut head = vec![0u8; 4096 + ROSBAG_MAGIC.len()];
-    let n = f.read(&mut head).ok()?;
+    let (f, len) = source.open().ok()?;
+    let mut head = Vec::with_capacity(4096 + ROSBAG_MAGIC.len());
+    let mut f = std::io::BufReader::new(f);
+    std::io::Read::take(&mut f, 4096 + ROSBAG_MAGIC.len() as u64)
+        .read_to_end(&mut head)
+        .ok()?;
+    let n = head.len();
     let (header, _, _) = record(&head[..n], ROSBAG_MAGIC.len())?;
     if header.get(&b"op"[..])?.first() != Some(&0x03) {
         return None;
     }
     let index_pos = u64::from_le_bytes(header.get(&b"index_pos"[..])?.get(..8)?.try_into().ok()?);
-    let len = f.metadata().ok()?.len();
     if index_pos == 0 || index_pos >= len {
         return None;
     }
@@ -321,17 +337,17 @@ fn index_topics(path: &Path) -> Option<BTreeMap<String, String>> {
 /// The chosen `Imu` topic of a ROS 1 bag, as records of the six channels read from disk each
 /// time.
 pub struct Ros1Records {
-    path: PathBuf,
+    source: Container,
     topic: String,
     /// The first message's whole second, once read.
     sec0: Cell<Option<i64>>,
 }
 
 impl Ros1Records {
-    /// The `Imu` topic `topic` of the bag at `path`.
-    pub(super) fn new(path: &Path, topic: String) -> Self {
+    /// The `Imu` topic `topic` of the bag `source`.
+    pub(super) fn new(source: Container, topic: String) -> Self {
         Self {
-            path: path.to_path_buf(),
+            source,
             topic,
             sec0: Cell::new(None),
         }
@@ -344,10 +360,10 @@ impl ImuRecords for Ros1Records {
     }
 
     fn read(&self, visit: &mut dyn FnMut(&Record) -> Result<(), LogError>) -> Result<(), LogError> {
-        let file = self.path.display().to_string();
+        let file = self.source.name();
         // Messages per `Imu` topic: every one is decoded, as the whole-series reader does.
         let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-        visit_ros1(&self.path, &mut |event| {
+        visit_ros1(&self.source, &mut |event| {
             let Ros1Event::Message(topic, kind, data) = event else {
                 return Ok(());
             };
@@ -358,7 +374,7 @@ impl ImuRecords for Ros1Records {
                 counts.insert(topic.to_string(), 0);
             }
             let k = counts.get_mut(topic).expect("inserted");
-            let m = decode_ros1_message(&file, topic, *k, data)?;
+            let m = decode_ros1_message(file, topic, *k, data)?;
             let at = *k as u64;
             *k += 1;
             if topic != self.topic {
@@ -369,16 +385,12 @@ impl ImuRecords for Ros1Records {
     }
 
     fn error_at(&self, at: u64, problem: LogProblem) -> LogError {
-        let at = format!(
-            "{}, topic {}, message {at}",
-            self.path.display(),
-            self.topic
-        );
+        let at = format!("{}, topic {}, message {at}", self.source.name(), self.topic);
         LogError::of_file(&at, problem)
     }
 
     fn error(&self, problem: LogProblem) -> LogError {
-        let at = format!("{}, topic {}", self.path.display(), self.topic);
+        let at = format!("{}, topic {}", self.source.name(), self.topic);
         LogError::of_file(&at, problem)
     }
 }

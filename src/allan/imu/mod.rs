@@ -92,13 +92,12 @@ impl Sensor {
 
 /// A channel the analysis cannot use.
 #[derive(Debug, Error, Clone, PartialEq)]
-#[error("column {column}: {source}")]
+#[error("column {column}: {reason}")]
 pub struct ImuError {
     /// The channel's column.
     pub column: &'static str,
-    /// Why.
-    #[source]
-    pub source: AllanError,
+    /// Why (in the message itself, not again as its source: the reason is printed once).
+    pub reason: AllanError,
 }
 
 /// One channel's analysis.
@@ -201,9 +200,9 @@ pub fn analyse_imu(log: &ImuSamples, confidence: f64) -> Result<ImuAnalysis, Imu
                     channel: *channel,
                     analysis,
                 })
-                .map_err(|source| ImuError {
+                .map_err(|reason| ImuError {
                     column: channel.column(),
-                    source,
+                    reason,
                 })
         })
         .collect::<Result<Vec<_>, _>>()?;

@@ -9,8 +9,8 @@
 use rayon::prelude::*;
 
 use super::{ChannelAnalysis, ImuAnalysis, ImuError};
-use crate::allan::analyse_grid;
 use crate::allan::stream::{AllanStream, StreamingMean};
+use crate::allan::{AllanError, analyse_grid};
 use crate::input::csv::steps::{ACCEPTED_STEP_RATIO, StepMedian};
 use crate::input::records::{ImuRecords, Record};
 use crate::input::{LogError, LogProblem};
@@ -56,17 +56,26 @@ fn checked(
     Ok(previous_s.replace(r.t_s).map(|p| r.t_s - p))
 }
 
-/// The first read: each channel's mean and the median step, s, the stamps and values checked.
-fn first_read(records: &dyn ImuRecords) -> Result<(Vec<f64>, usize, f64), LogError> {
+/// What the first read finds: each channel's mean and whether its samples differ, the count
+/// and the median step, s.
+type FirstRead = (Vec<f64>, Vec<bool>, usize, f64);
+
+/// The first read: each channel's mean, whether its samples differ, and the median step, s, the
+/// stamps and values checked.
+fn first_read(records: &dyn ImuRecords) -> Result<FirstRead, LogError> {
     let mut means = vec![StreamingMean::default(); records.channels().len()];
+    let mut first: Option<[f64; 6]> = None;
+    let mut distinct = vec![false; records.channels().len()];
     let mut steps = StepMedian::new();
     let mut previous_s = None;
     records.read(&mut |r| {
         if let Some(step_s) = checked(records, r, &mut previous_s)? {
             steps.add(step_s);
         }
-        for (m, v) in means.iter_mut().zip(&r.values) {
+        let first = first.get_or_insert(r.values);
+        for (k, (m, v)) in means.iter_mut().zip(&r.values).enumerate() {
             m.push(*v);
+            distinct[k] |= *v != first[k];
         }
         Ok(())
     })?;
@@ -79,7 +88,7 @@ fn first_read(records: &dyn ImuRecords) -> Result<(Vec<f64>, usize, f64), LogErr
     };
     let samples = means.first().map_or(0, StreamingMean::count) as usize;
     let means = means.iter().map(StreamingMean::mean).collect();
-    Ok((means, samples, median_s))
+    Ok((means, distinct, samples, median_s))
 }
 
 /// Analyses every channel of `records` at `confidence`, reading them twice; the phase of a log
@@ -96,7 +105,7 @@ pub fn analyse_records(
     spill_dir: &std::path::Path,
 ) -> Result<ImuAnalysis, StreamError> {
     let channels = records.channels().to_vec();
-    let (means, count, median_s) = first_read(records).map_err(StreamError::Log)?;
+    let (means, distinct, count, median_s) = first_read(records).map_err(StreamError::Log)?;
     let (lo, hi) = (
         ACCEPTED_STEP_RATIO.0 * median_s,
         ACCEPTED_STEP_RATIO.1 * median_s,
@@ -159,16 +168,12 @@ pub fn analyse_records(
         .map(AllanStream::finish)
         .collect::<Result<_, _>>()
         .map_err(StreamError::Spill)?;
-    let analyses: Vec<ChannelAnalysis> = grids
+    let analyses = grids
         .par_iter()
         .zip(channels.par_iter())
-        .map(|(grid, &channel)| {
-            analyse_grid(grid, samples, median_s, confidence)
-                .map(|analysis| ChannelAnalysis { channel, analysis })
-                .map_err(|source| ImuError {
-                    column: channel.column(),
-                    source,
-                })
+        .zip(distinct.par_iter())
+        .map(|((grid, &channel), &distinct)| {
+            analyse_channel(grid, channel, distinct, (samples, median_s), confidence)
         })
         .collect::<Result<_, _>>()
         .map_err(StreamError::Channel)?;
@@ -178,4 +183,26 @@ pub fn analyse_records(
         confidence,
         channels: analyses,
     })
+}
+
+/// One channel's analysis from its grid, for `samples` samples τ₀ = `tau0_s` apart; a channel
+/// whose samples are not `distinct` (all one number) is refused as constant.
+fn analyse_channel(
+    grid: &[(usize, f64, Option<crate::allan::NoiseId>)],
+    channel: crate::input::records::Channel,
+    distinct: bool,
+    (samples, tau0_s): (usize, f64),
+    confidence: f64,
+) -> Result<ChannelAnalysis, ImuError> {
+    let analysis = if distinct {
+        analyse_grid(grid, samples, tau0_s, confidence)
+    } else {
+        Err(AllanError::Constant)
+    };
+    analysis
+        .map(|analysis| ChannelAnalysis { channel, analysis })
+        .map_err(|reason| ImuError {
+            column: channel.column(),
+            reason,
+        })
 }

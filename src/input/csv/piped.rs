@@ -6,6 +6,7 @@ use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
+use crate::input::container::{Kind, copy_stream};
 use crate::input::csv::read::{LogSource, decompressed};
 use crate::input::{LogError, LogProblem};
 
@@ -19,28 +20,35 @@ pub struct PipedLog {
 
 impl PipedLog {
     /// Copies every byte of `path` (as it is: gzip is told when the copy is read) to a temporary
-    /// file in `spill_dir`.
+    /// file in `spill_dir`, once its first bytes tell text or gzip.
     ///
     /// # Errors
-    /// [`LogProblem::Unreadable`] naming `path` when it cannot be read, or the temporary file
-    /// when it cannot be made or written.
+    /// [`LogProblem::Unreadable`] naming `path` when it cannot be read or its first bytes are
+    /// not text (binary data, a recording; nothing is copied then), or the temporary file when
+    /// it cannot be made or written.
     pub fn copy(path: &Path, spill_dir: &Path) -> Result<Self, LogError> {
         let name = path.display().to_string();
-        let unreadable = |what: &str, e: std::io::Error| {
-            let message = format!("{what}: {e}");
-            LogError::of_file(&name, LogProblem::Unreadable { message })
-        };
-        let mut file = tempfile::tempfile_in(spill_dir).map_err(|e| {
-            unreadable(
-                &format!("its copy in {} cannot be made", spill_dir.display()),
-                e,
-            )
-        })?;
-        let mut input = File::open(path).map_err(|e| unreadable("cannot be opened", e))?;
-        std::io::copy(&mut input, &mut file).map_err(|e| unreadable("cannot be copied", e))?;
-        Ok(Self { name, file })
+        match copy_stream(path, spill_dir, CSV_EXPECTED)? {
+            (Kind::Text | Kind::Gzip, file) => Ok(Self::from_copy(&name, file)),
+            (kind, _) => {
+                let message = format!("{}, not a CSV log: expected {CSV_EXPECTED}", kind.words());
+                Err(LogError::of_file(&name, LogProblem::Unreadable { message }))
+            }
+        }
+    }
+
+    /// The log `name` whose bytes were copied to `file`.
+    pub fn from_copy(name: &str, file: File) -> Self {
+        Self {
+            name: name.to_string(),
+            file,
+        }
     }
 }
+
+/// What a CSV log is, in the words of a message refusing another.
+pub const CSV_EXPECTED: &str = "a CSV log (UTF-8 text: a header row naming the columns, then \
+                                rows of numbers)";
 
 /// The copy read from its start, by positioned reads (no shared offset).
 struct FromStart<'a> {

@@ -5,6 +5,8 @@
 //! # Format
 //! The CSV text of [`super`]: `t_s` and the column read (`accel_m_s2`, or any one column named).
 
+use crate::input::container::{Kind, not_a_log};
+use crate::input::csv::piped::CSV_EXPECTED;
 use crate::input::csv::read::{AccelReader, LogSource};
 use crate::input::csv::steps::ACCEPTED_STEP_RATIO;
 use crate::input::{LogError, LogProblem};
@@ -122,15 +124,25 @@ pub fn read_static_log(
     column: &'static str,
 ) -> Result<StaticSamples, LogError> {
     use rayon::prelude::*;
+    use std::io::BufRead as _;
+    let unreadable =
+        |message: String| LogError::of_file(source.name(), LogProblem::Unreadable { message });
+    let mut input = source.open()?;
+    // Binary data (a device, a recording) is refused at its first bytes, before it is held.
+    let head = input.fill_buf().map_err(|e| unreadable(e.to_string()))?;
+    match Kind::of(head) {
+        Kind::Text | Kind::Gzip => {}
+        Kind::Binary => return Err(not_a_log(source.name(), head, CSV_EXPECTED)),
+        kind => {
+            let words = kind.words();
+            return Err(unreadable(format!(
+                "{words}, not a CSV log: expected {CSV_EXPECTED} (an IMU recording is read by \
+                 `allan --imu`)"
+            )));
+        }
+    }
     let mut text = Vec::new();
-    std::io::Read::read_to_end(&mut source.open()?, &mut text).map_err(|e| {
-        LogError::of_file(
-            source.name(),
-            LogProblem::Unreadable {
-                message: e.to_string(),
-            },
-        )
-    })?;
+    std::io::Read::read_to_end(&mut input, &mut text).map_err(|e| unreadable(e.to_string()))?;
     let parts = stretches(source.name(), &text);
     let parsed: Vec<Parsed> = parts.par_iter().map(|(s, _)| parse(s, column)).collect();
     let (mut times, mut values) = (Vec::new(), Vec::new());
