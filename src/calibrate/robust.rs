@@ -21,6 +21,7 @@ use serde::Serialize;
 use crate::state::{ErrorState, MeasMatrix, StateMatrix, StateVector};
 use crate::stats::normal_bound;
 
+use super::bartlett::weighted_autocovariance;
 use super::diagnose::Diagnostics;
 use super::forward::FilteredFix;
 use super::nis::NisTest;
@@ -273,14 +274,8 @@ pub fn bias_variance_factor(fixes: &[FilteredFix]) -> (f64, f64) {
     if n == 0 || white <= 0.0 {
         return (f64::NAN, bandwidth);
     }
-    let gamma = |j: usize| psi.iter().zip(&psi[j..]).map(|(a, b)| a * b).sum::<f64>();
-    let lags = (1..n).take_while(|&j| (j as f64) < bandwidth);
-    let long_run = gamma(0)
-        + 2.0
-            * lags
-                .map(|j| (1.0 - j as f64 / bandwidth) * gamma(j))
-                .sum::<f64>();
-    (long_run.max(0.0) / white.min(gamma(0)), bandwidth)
+    let (long_run, gamma0) = weighted_autocovariance(&psi, bandwidth);
+    (long_run.max(0.0) / white.min(gamma0), bandwidth)
 }
 
 /// The long-run variance λ = Σ_j γ(j) of a sequence `u` of mean 0, with the AR(1) coefficient
@@ -312,13 +307,7 @@ pub fn long_run_variance(u: &[f64]) -> (f64, f64, f64) {
     let m = e.len() as f64;
     let alpha = 4.0 * rho * rho / ((1.0 - rho).powi(2) * (1.0 + rho).powi(2));
     let bandwidth = (1.1447 * (alpha * m).cbrt()).min(m - 1.0);
-    let gamma = |j: usize| e.iter().zip(&e[j..]).map(|(a, b)| a * b).sum::<f64>() / m;
-    let lags = (1..e.len()).take_while(|&j| (j as f64) < bandwidth);
-    let lambda_e = gamma(0)
-        + 2.0
-            * lags
-                .map(|j| (1.0 - j as f64 / bandwidth) * gamma(j))
-                .sum::<f64>();
+    let lambda_e = weighted_autocovariance(&e, bandwidth).0 / m;
     (lambda_e.max(0.0) / (1.0 - phi).powi(2), phi, bandwidth)
 }
 
