@@ -8,45 +8,8 @@ use std::path::Path;
 
 use accelcal::input::LogProblem;
 use accelcal::input::csv::read::{AccelReader, LogText};
-use std::process::{Command, Stdio};
+use common::{assert_refused, run_limited};
 use std::time::{Duration, Instant};
-
-/// What a run ended with: its exit code (None when killed at the limit) and its stderr.
-struct Ended {
-    code: Option<i32>,
-    stderr: String,
-}
-
-/// Runs the binary with `args` in `dir`, killed when it has not ended within `limit_s` seconds.
-fn run_limited(dir: &Path, args: &[&str], limit_s: u64) -> Ended {
-    let child = Command::new(common::bin())
-        .args(args)
-        .current_dir(dir)
-        .env("RAYON_NUM_THREADS", "2")
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the binary runs");
-    let (status, stderr) = common::wait_limited(child, limit_s);
-    Ended {
-        code: status.and_then(|s| s.code()),
-        stderr,
-    }
-}
-
-/// Expects `ended` to be a refusal: exit code 2, no panic, every word of `expect` in the message.
-fn assert_refused(ended: &Ended, expect: &[&str], what: &str) {
-    let msg = &ended.stderr;
-    assert_eq!(
-        ended.code,
-        Some(2),
-        "{what}: exit code (None = hung): {msg}"
-    );
-    assert!(!msg.contains("panicked"), "{what}: {msg}");
-    for word in expect {
-        assert!(msg.contains(word), "{what}: message lacks {word:?}: {msg}");
-    }
-}
 
 #[test]
 fn false_alarm_rates_below_the_accurate_range_are_refused_by_every_command() {

@@ -7,44 +7,8 @@
 mod common;
 
 use std::path::Path;
-use std::process::{Command, Stdio};
 
-/// What a run ended with: its exit code (None when killed at the limit) and its stderr.
-struct Ended {
-    code: Option<i32>,
-    stderr: String,
-}
-
-/// Runs the binary with `args` in `dir`, killed when it has not ended within `limit_s` seconds.
-fn run_limited(dir: &Path, args: &[&str], limit_s: u64) -> Ended {
-    let child = Command::new(common::bin())
-        .args(args)
-        .current_dir(dir)
-        .env("RAYON_NUM_THREADS", "2")
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the binary runs");
-    let (status, stderr) = common::wait_limited(child, limit_s);
-    Ended {
-        code: status.and_then(|s| s.code()),
-        stderr,
-    }
-}
-
-/// Expects `ended` to be a refusal: exit code 2, no panic, every word of `expect` in the message.
-fn assert_refused(ended: &Ended, expect: &[&str], what: &str) {
-    let msg = &ended.stderr;
-    assert_eq!(
-        ended.code,
-        Some(2),
-        "{what}: exit code (None = hung): {msg}"
-    );
-    assert!(!msg.contains("panicked"), "{what}: {msg}");
-    for word in expect {
-        assert!(msg.contains(word), "{what}: message lacks {word:?}: {msg}");
-    }
-}
+use common::{Ended, assert_refused, run_limited};
 
 /// The shipped comma2k19 three-axis log `name`, its rows up to `seconds` (all with `None`).
 fn shipped(name: &str, seconds: Option<f64>) -> String {

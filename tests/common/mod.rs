@@ -6,7 +6,7 @@ pub mod partials;
 pub mod plain;
 
 use std::path::Path;
-use std::process::{Child, Command, ExitStatus, Output};
+use std::process::{Child, Command, ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use accelcal::checks::Verdicts;
@@ -88,5 +88,43 @@ pub struct Keep(pub Vec<accelcal::simulation::FixState>);
 impl accelcal::simulation::Observer for Keep {
     fn fix(&mut self, f: &accelcal::simulation::FixState) {
         self.0.push(*f);
+    }
+}
+
+/// What a run ended with: its exit code (None when killed at the limit) and its stderr.
+pub struct Ended {
+    pub code: Option<i32>,
+    pub stderr: String,
+}
+
+/// Runs the binary with `args` in `dir` on two threads, killed when it has not ended within
+/// `limit_s` seconds.
+pub fn run_limited(dir: &Path, args: &[&str], limit_s: u64) -> Ended {
+    let child = Command::new(bin())
+        .args(args)
+        .current_dir(dir)
+        .env("RAYON_NUM_THREADS", "2")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    let (status, stderr) = wait_limited(child, limit_s);
+    Ended {
+        code: status.and_then(|s| s.code()),
+        stderr,
+    }
+}
+
+/// Expects `ended` to be a refusal: exit code 2, no panic, every word of `expect` in the message.
+pub fn assert_refused(ended: &Ended, expect: &[&str], what: &str) {
+    let msg = &ended.stderr;
+    assert_eq!(
+        ended.code,
+        Some(2),
+        "{what}: exit code (None = hung): {msg}"
+    );
+    assert!(!msg.contains("panicked"), "{what}: {msg}");
+    for word in expect {
+        assert!(msg.contains(word), "{what}: message lacks {word:?}: {msg}");
     }
 }
