@@ -468,18 +468,10 @@ fn base(dir: &Path) -> Base {
         "one.json",
     ]);
     let read = |p: &str| std::fs::read(dir.join(p)).unwrap();
-    std::fs::write(dir.join("imu.csv"), first_seconds("imu.csv")).unwrap();
-    std::fs::write(dir.join("gnss.csv"), first_seconds("gnss.csv")).unwrap();
-    ok(&[
-        "calibrate",
-        "-q",
-        "--imu",
-        "imu.csv",
-        "--gnss",
-        "gnss.csv",
-        "--out",
-        "cal3",
-    ]);
+    let (imu, gnss) = (first_seconds("imu.csv"), first_seconds("gnss.csv"));
+    std::fs::write(dir.join("imu.csv"), &imu).unwrap();
+    std::fs::write(dir.join("gnss.csv"), &gnss).unwrap();
+    ok(&CALIBRATE_IMU);
     let summary = std::fs::read_to_string(dir.join("cal3/summary.json")).unwrap();
     Base {
         three_axis: ["ins", "car"].map(|m| three_axis::tiny_three_axis(dir, m)),
@@ -487,8 +479,8 @@ fn base(dir: &Path) -> Base {
         dir: dir.to_path_buf(),
         accel: read("logs/accelerometer.csv"),
         gps: read("logs/gps.csv"),
-        imu: first_seconds("imu.csv"),
-        gnss: first_seconds("gnss.csv"),
+        imu,
+        gnss,
         partials: [read("p1.bin"), read("p2.bin")],
         one: common::summary_without_timing(&dir.join("one.json")),
         bags: [
@@ -832,23 +824,25 @@ fn case_imu(rng: &mut Rng, base: &Base, dir: &Path) -> (Vec<String>, Vec<&'stati
     (args, vec!["cal3/summary.json", "cal3/estimates.csv"])
 }
 
+/// The calibration of the three-axis recording `imu.csv`, `gnss.csv` into `cal3`.
+const CALIBRATE_IMU: [&str; 8] = [
+    "calibrate",
+    "-q",
+    "--imu",
+    "imu.csv",
+    "--gnss",
+    "gnss.csv",
+    "--out",
+    "cal3",
+];
+
 /// One meridian case: the unmutated recording with its longitudes written another way.
 fn case_meridian(rng: &mut Rng, base: &Base, dir: &Path) -> (Vec<String>, Vec<&'static str>) {
     std::fs::write(dir.join("imu.csv"), &base.imu).unwrap();
     let gnss = three_axis::same_meridians(rng, &base.gnss);
     std::fs::write(dir.join("gnss.csv"), gnss).unwrap();
-    let args = [
-        "calibrate",
-        "-q",
-        "--imu",
-        "imu.csv",
-        "--gnss",
-        "gnss.csv",
-        "--out",
-        "cal3",
-    ];
     (
-        args.map(String::from).to_vec(),
+        CALIBRATE_IMU.map(String::from).to_vec(),
         vec!["cal3/summary.json", "cal3/estimates.csv"],
     )
 }

@@ -44,6 +44,16 @@ pub enum ImuLayout {
     Increments,
 }
 
+impl ImuLayout {
+    /// The log's columns in this layout.
+    pub fn columns(self) -> [&'static str; 7] {
+        match self {
+            ImuLayout::Rates => RATE_COLUMNS,
+            ImuLayout::Increments => INCREMENT_COLUMNS,
+        }
+    }
+}
+
 /// The layout a header names, or why it names none.
 fn choose(found: &[&str], line: u64, file: &str) -> Result<[&'static str; 7], LogError> {
     let has = |c: &&str| found.contains(c);
@@ -232,10 +242,7 @@ impl Rows {
     /// or the increment over the step `dt_s`) exceeds [`MAX_SPECIFIC_FORCE_M_S2`] or
     /// [`MAX_ANGULAR_RATE_RAD_S`].
     fn in_range(&self, v: &[f64; 7], dt_s: f64) -> Result<(), LogProblem> {
-        let columns = match self.layout {
-            ImuLayout::Rates => RATE_COLUMNS,
-            ImuLayout::Increments => INCREMENT_COLUMNS,
-        };
+        let columns = self.layout.columns();
         for k in 1..7 {
             let (limit, unit) = if k <= 3 {
                 (MAX_SPECIFIC_FORCE_M_S2, "m/s²")
@@ -396,10 +403,7 @@ pub fn held_steps(
     layout: ImuLayout,
     axes: Axes,
 ) -> Result<(Vec<ImuStep>, ImuSpan, ImuLayout), LogError> {
-    let names = match layout {
-        ImuLayout::Rates => RATE_COLUMNS,
-        ImuLayout::Increments => INCREMENT_COLUMNS,
-    };
+    let names = layout.columns();
     if let Some(k) = columns.iter().position(|c| c.len() != t_s.len()) {
         let message = format!(
             "{} has {} values and t_s has {}: expected one value per time stamp",
