@@ -319,6 +319,11 @@ pub struct AllanArgs {
     /// Confidence of the two-sided intervals, in (0, 1).
     #[arg(long, value_name = "C", default_value_t = accelcal::allan::DEFAULT_CONFIDENCE)]
     pub confidence: f64,
+    /// Memory the log may be held in, MB (with --imu; 64 bytes a six-channel row): a log that fits is
+    /// read once; a longer one is read twice and streamed, in memory that does not grow with
+    /// its length. The numbers are the same either way.
+    #[arg(long, value_name = "MB", default_value_t = accelcal::allan::imu::stream::DEFAULT_HOLD_BYTES >> 20, requires = "imu")]
+    pub memory: usize,
     /// Print nothing but the result.
     #[arg(long, short)]
     pub quiet: bool,

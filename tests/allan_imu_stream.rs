@@ -1,6 +1,7 @@
-//! `allan --imu` read as a stream: the accumulator against the whole-series estimator, the
-//! command's file and pipe paths (both streamed) against the one-column form (the log held
-//! whole), and the peak memory of a CSV file, a pipe and a ROS 1 bag four times longer.
+//! `allan --imu` read as a stream or held: the accumulator against the whole-series estimator,
+//! the command's file and pipe paths (streamed and held) against the one-column form (the log
+//! held whole), the peak memory of a CSV file, a pipe and a ROS 1 bag four times longer, and
+//! the bound `--memory` sets.
 
 use std::io::Write as _;
 use std::path::Path;
@@ -96,9 +97,10 @@ fn csv(rows: usize, seed: u64) -> String {
     text
 }
 
-/// Runs `allan --imu path`, polling the child's VmHWM: its allan.json and peak RSS, bytes.
+/// Runs `allan --imu path` streamed (`--memory 0`: the log held nowhere), polling the child's
+/// VmHWM: its allan.json and peak RSS, bytes.
 fn run(path: &Path, stdin: Option<&[u8]>, out: &Path) -> (Value, u64) {
-    run_with(&["--imu"], path, stdin, out)
+    run_with(&["--memory", "0", "--imu"], path, stdin, out)
 }
 
 /// Runs `allan FLAG… path`, polling the child's VmHWM: its allan.json and peak RSS, bytes.
@@ -149,9 +151,10 @@ fn run_with(flags: &[&str], path: &Path, stdin: Option<&[u8]>, out: &Path) -> (V
     (serde_json::from_str(&json).unwrap(), peak_kb * 1024)
 }
 
-/// The file (streamed, read twice) and the same bytes on a pipe (copied once, then streamed)
-/// give the same allan.json, and its channel is the one-column form's (the log held whole, the
-/// deviation in memory), the τ beyond the window included: every number bit for bit.
+/// The file streamed (read twice), the same bytes on a pipe (copied once, then streamed) and
+/// the file held (read once, the default for a log of this length) give the same allan.json,
+/// and its channel is the one-column form's (the log held whole, the deviation in memory), the
+/// τ beyond the window included: every number bit for bit.
 #[test]
 fn a_long_file_streamed_equals_the_log_held_whole() {
     let dir = tempfile::tempdir().unwrap();
@@ -159,6 +162,8 @@ fn a_long_file_streamed_equals_the_log_held_whole() {
     let file = dir.path().join("imu.csv");
     std::fs::write(&file, &text).unwrap();
     let (streamed, _) = run(&file, None, &dir.path().join("file"));
+    let (held, _) = run_with(&["--imu"], &file, None, &dir.path().join("held"));
+    assert_eq!(streamed, held);
     let (piped, _) = run(
         Path::new("/dev/stdin"),
         Some(text.as_bytes()),
@@ -260,8 +265,28 @@ fn ros1_bag(path: &Path, rows: usize, seed: u64) {
     file.flush().unwrap();
 }
 
-/// Peak memory does not follow the log's length: from 1.1·10⁶ to 4.4·10⁶ rows a CSV file, the same
-/// bytes on a pipe (copied once to a temporary file, read twice from it) and a ROS 1 bag of as
+/// `--memory` is the bound of what a log held takes: the 1.1·10⁶-row one-channel file (24
+/// bytes a row held: 25 MB) held by default peaks above those 25 MB (the control: a log held is
+/// seen; its streamed run peaks at 17 MB), and with `--memory 8` its peak stays below them and
+/// within the 8 MB it may hold and 4 MB of spread of the streamed run's (measured: 17.4 MB
+/// streamed, 21.4 MB with `--memory 8`, 34.4 MB held).
+fn budget_is_kept(file: &Path, streamed_peak: u64, dir: &Path) {
+    let (_, held_peak) = run_with(&["--imu"], file, None, &dir.join("held"));
+    let (_, capped_peak) = run_with(&["--memory", "8", "--imu"], file, None, &dir.join("cap"));
+    eprintln!("held {held_peak} B, --memory 8 {capped_peak} B, streamed {streamed_peak} B");
+    let log_bytes = 24 * LONG as u64;
+    assert!(
+        held_peak > log_bytes,
+        "held {held_peak} B: the log takes {log_bytes} B"
+    );
+    assert!(
+        capped_peak < log_bytes && capped_peak < streamed_peak + (12 << 20),
+        "--memory 8: {capped_peak} B, streamed {streamed_peak} B, the log {log_bytes} B"
+    );
+}
+
+/// Peak memory does not follow the log's length, streamed (`--memory 0`): from 1.1·10⁶ to
+/// 4.4·10⁶ rows a CSV file, the same bytes on a pipe (copied once to a temporary file, read twice from it) and a ROS 1 bag of as
 /// many messages (six channels, read a chunk at a time; 0.39 and 1.56 GB on disk for the test's
 /// time) each grow by less than a quarter of the 79 MB that holding one channel's samples and
 /// their stamps (16 bytes a row) and its phase (8) would add: 20 MB, above the bag's run-to-run
@@ -278,6 +303,9 @@ fn peak_memory_does_not_follow_the_length() {
         let file = dir.path().join(format!("imu{rows}.csv"));
         std::fs::write(&file, &text).unwrap();
         let (_, file_peak) = run(&file, None, &dir.path().join(format!("f{rows}")));
+        if k == 0 {
+            budget_is_kept(&file, file_peak, dir.path());
+        }
         let stdin = Path::new("/dev/stdin");
         let out = dir.path().join(format!("p{rows}"));
         let (_, pipe_peak) = run(stdin, Some(text.as_bytes()), &out);

@@ -220,7 +220,7 @@ fn points(
         .zip(avars)
         .map(|(&m, avar)| {
             cancel.check()?;
-            Ok((m, avar, noise_id::identify(&noise_id::block_means(x, m))))
+            Ok((m, avar, noise_id::identify_phase(x, m)))
         })
         .collect::<Result<_, Cancelled>>()?;
     Ok(with_intervals(&raw, n, tau0_s, confidence))

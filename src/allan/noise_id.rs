@@ -59,13 +59,89 @@ pub fn remove_line(z: &[f64]) -> Vec<f64> {
 /// Identifies the noise of the block means `means` (rate data averaged over τ); `None` with
 /// fewer than [`MIN_POINTS`] means or a series without variation.
 pub fn identify(means: &[f64]) -> Option<NoiseId> {
-    if means.len() < MIN_POINTS {
+    identify_with(means.len(), |i| means[i])
+}
+
+/// [`identify`] of the block means of m samples of the rate data whose phase (in samples) is
+/// `x` ([`block_means`]), taken from the phase as they are needed: nothing is allocated.
+pub fn identify_phase(x: &[f64], m: usize) -> Option<NoiseId> {
+    let scale = 1.0 / m as f64;
+    identify_with((x.len() - 1) / m, |k| (x[(k + 1) * m] - x[k * m]) * scale)
+}
+
+/// r₁ of the series w_0 … w_{L−1} given by `at`, L = `len` ≥ 2, in one pass.
+///
+/// # Formula
+/// Riley & Greenhall (2004), eq. (2), with the sums Σw, Σw², Σ w_i w_{i+1} of one pass:
+/// Σ_{i<L−1} (w_i − w̄)(w_{i+1} − w̄) = Σ w_i w_{i+1} − w̄ (2Σw − w_0 − w_{L−1}) + (L − 1) w̄²
+/// and Σ (w_i − w̄)² = Σw² − w̄ Σw. Every series identified has a mean near zero (a line
+/// removed, or differences of one), so the expansion loses nothing to cancellation.
+fn lag1_of(len: usize, at: impl Fn(usize) -> f64) -> f64 {
+    // Four running sums of each kind (the additions of one do not wait on the other three).
+    let first = at(0);
+    let (mut sum, mut squares, mut lagged) = (
+        [first, 0.0, 0.0, 0.0],
+        [first * first, 0.0, 0.0, 0.0],
+        [0.0; 4],
+    );
+    let mut previous = first;
+    let mut i = 1;
+    while i + 4 <= len {
+        let w = [at(i), at(i + 1), at(i + 2), at(i + 3)];
+        for j in 0..4 {
+            sum[j] += w[j];
+            squares[j] += w[j] * w[j];
+        }
+        lagged[0] += previous * w[0];
+        lagged[1] += w[0] * w[1];
+        lagged[2] += w[1] * w[2];
+        lagged[3] += w[2] * w[3];
+        previous = w[3];
+        i += 4;
+    }
+    for k in i..len {
+        let w = at(k);
+        sum[0] += w;
+        squares[0] += w * w;
+        lagged[0] += previous * w;
+        previous = w;
+    }
+    let total = |a: [f64; 4]| (a[0] + a[1]) + (a[2] + a[3]);
+    let (sum, squares, lagged) = (total(sum), total(squares), total(lagged));
+    let l = len as f64;
+    let mean = sum / l;
+    let num = lagged - mean * (2.0 * sum - first - previous) + (l - 1.0) * mean * mean;
+    num / (squares - mean * sum)
+}
+
+/// [`identify`] of the series u_0 … u_{L−1} given by `at`: the line removed by its
+/// least-squares fit over the index (numpy's `polyfit(t, u, 1)`), then differenced while
+/// δ ≥ 0.25, each series taken from `at` as it is needed.
+fn identify_with(len: usize, at: impl Fn(usize) -> f64) -> Option<NoiseId> {
+    if len < MIN_POINTS {
         return None;
     }
-    let mut z = remove_line(means);
+    let l = len as f64;
+    let t_mean = (l - 1.0) / 2.0;
+    let (mut sum, mut moment) = ([0.0f64; 4], [0.0f64; 4]);
+    for i in 0..len {
+        let u = at(i);
+        sum[i % 4] += u;
+        moment[i % 4] += (i as f64 - t_mean) * u;
+    }
+    let total = |a: [f64; 4]| (a[0] + a[1]) + (a[2] + a[3]);
+    let (sum, moment) = (total(sum), total(moment));
+    let u_mean = sum / l;
+    // Σ (i − ī)² = L (L² − 1) / 12; Σ (i − ī)(u_i − ū) = Σ (i − ī) u_i.
+    let slope = moment / (l * (l * l - 1.0) / 12.0);
+    let z = |i: usize| at(i) - u_mean - slope * (i as f64 - t_mean);
     let mut d = 0u32;
     loop {
-        let r1 = lag1_autocorrelation(&z);
+        let r1 = match d {
+            0 => lag1_of(len, z),
+            1 => lag1_of(len - 1, |i| z(i + 1) - z(i)),
+            _ => lag1_of(len - 2, |i| z(i + 2) - 2.0 * z(i + 1) + z(i)),
+        };
         if !r1.is_finite() {
             return None;
         }
@@ -78,7 +154,6 @@ pub fn identify(means: &[f64]) -> Option<NoiseId> {
                 delta,
             });
         }
-        z = z.windows(2).map(|w| w[1] - w[0]).collect();
         d += 1;
     }
 }

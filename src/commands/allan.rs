@@ -210,7 +210,12 @@ fn analyse_imu_log(args: &AllanArgs, path: &std::path::Path) -> Result<ImuAnalys
             }
         }
     };
-    let analysis = imu::stream::analyse_records(records.as_ref(), args.confidence, &spill_dir);
+    let analysis = imu::stream::analyse_records(
+        records.as_ref(),
+        args.confidence,
+        &spill_dir,
+        args.memory.saturating_mul(1 << 20),
+    );
     // Warnings go to standard error even with --quiet: they are about the numbers.
     for w in records.warnings() {
         eprintln!("warning: {w}");

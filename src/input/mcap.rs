@@ -6,18 +6,21 @@
 //! MCAP (mcap.dev/spec, version 0): the magic bytes, then records of an opcode, a u64 length and
 //! their data — Schema, Channel (a topic and its schema), Message (a channel's message) —, most
 //! of them in Chunks (plain, lz4 or zstd, a CRC each), a summary section after the data
-//! whose Footer points at it. The `mcap` crate reads the records: chunks, compression, CRCs.
+//! whose Footer points at it. The `mcap` crate's linear reader splits the file into records;
+//! chunks are opened here (`input::mcap_chunks`: lz4, zstd, CRC32).
 
 use std::cell::{Cell, RefCell};
 use std::collections::BTreeMap;
 use std::io::Read as _;
 
 use super::container::{Container, expansion_limit};
-use super::messages::{ImuMessage, ROS1_IMU_TYPE, ROS2_IMU_TYPE, decode_imu, decode_ros1};
+use super::mcap_chunks::{self, Ahead, ChunkError, Opened};
+use super::mcap_summary::{Counts, summary, topic_of};
 use super::records::{Channel, ImuRecords, Record};
 use super::{LogError, LogProblem, unreadable};
 
 pub use super::container::MCAP_MAGIC;
+pub(super) use super::mcap_summary::Topic;
 
 /// The longest record the MCAP reader accepts, bytes: a corrupt length then is an error, where
 /// `mcap::MessageStream` (0.26, no limit) panics on a length near 2⁶⁴. A file of n bytes is
@@ -27,53 +30,6 @@ const RECORD_LIMIT: u64 = 1 << 30;
 /// Bytes read from the file at most per request of the reader.
 const READ_PIECE: usize = 1 << 20;
 
-/// A channel as its record defines it: its topic, its schema's name, its messages' encoding.
-#[derive(Clone, Debug, PartialEq)]
-pub(super) struct Topic {
-    /// The topic.
-    pub topic: String,
-    /// The schema's name (`sensor_msgs/msg/Imu`).
-    pub kind: String,
-    /// The channel's message encoding (`cdr`).
-    pub encoding: String,
-}
-
-impl Topic {
-    /// Whether its messages are `sensor_msgs/Imu` messages this reader decodes: a schema named
-    /// `sensor_msgs/msg/Imu` or, as ROS 1 spells it, `sensor_msgs/Imu` (the same message), in
-    /// CDR or in ROS 1's serialization.
-    pub fn is_imu(&self) -> bool {
-        matches!(self.kind.as_str(), ROS2_IMU_TYPE | ROS1_IMU_TYPE)
-            && matches!(self.encoding.as_str(), "cdr" | "ros1")
-    }
-
-    /// The message `data` of this `Imu` topic decoded.
-    ///
-    /// # Errors
-    /// What was expected, in words, when the bytes are not such a message.
-    pub fn decode(&self, data: &[u8]) -> Result<ImuMessage, String> {
-        if self.encoding == "ros1" {
-            return decode_ros1(data).ok_or_else(|| {
-                format!(
-                    "{} bytes: too short for a ROS 1 serialized {ROS1_IMU_TYPE} message",
-                    data.len()
-                )
-            });
-        }
-        decode_imu(data)
-    }
-
-    /// The topic's type as a listing of topics gives it: the schema's name, and the encoding
-    /// when it is not one this reader decodes.
-    pub fn describe(&self) -> String {
-        if matches!(self.encoding.as_str(), "cdr" | "ros1") {
-            self.kind.clone()
-        } else {
-            format!("{}, encoding {}", self.kind, self.encoding)
-        }
-    }
-}
-
 /// What [`visit_mcap`] hands on: a channel, then each message of a channel.
 pub(super) enum McapEvent<'a> {
     /// A channel.
@@ -82,33 +38,22 @@ pub(super) enum McapEvent<'a> {
     Message(&'a Topic, &'a [u8]),
 }
 
-/// The channel of a record that names a schema (by its id among `schemas`) or none.
-fn topic_of(c: mcap::records::Channel, schemas: &BTreeMap<u16, String>) -> Topic {
-    let kind = schemas
-        .get(&c.schema_id)
-        .cloned()
-        .unwrap_or_else(|| "(no schema)".to_string());
-    Topic {
-        topic: c.topic,
-        kind,
-        encoding: c.message_encoding,
-    }
-}
-
-/// Reads the records of the MCAP file `source` in order (chunks decompressed, their CRCs
-/// checked when `check_crcs`, records no longer than [`RECORD_LIMIT`] nor than the file's
-/// [`expansion_limit`]), handing channels and messages to `visit`.
+/// Reads the records of the MCAP file `source` in order (chunks decompressed on the thread
+/// pool while earlier ones are handed on, [`mcap_chunks`]; their CRCs
+/// checked when `check_crcs`; records no longer than [`RECORD_LIMIT`] nor than the file's
+/// [`expansion_limit`]), handing channels and messages to `visit`. Records other than schemas,
+/// channels, messages and chunks are skipped unread.
 ///
 /// # Errors
 /// [`LogError`] for a file the `mcap` crate refuses (naming the message it stopped at), a
 /// record longer than the file can hold, a message of a channel not defined before it, or
-/// `visit`'s error.
+/// `visit`'s error: the first in the file's order.
 pub(super) fn visit_mcap(
     source: &Container,
     check_crcs: bool,
     visit: &mut dyn FnMut(McapEvent<'_>) -> Result<(), LogError>,
 ) -> Result<(), LogError> {
-    use mcap::records::Record;
+    use mcap::records::op;
     use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
     let file = source.name();
     let (mut input, file_len) = source.open()?;
@@ -123,72 +68,147 @@ pub(super) fn visit_mcap(
     let limit = RECORD_LIMIT.min(expansion_limit(file_len));
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default()
-            .with_validate_chunk_crcs(check_crcs)
+            .with_emit_chunks(true)
             .with_record_length_limit(usize::try_from(limit).unwrap_or(usize::MAX)),
     );
-    let mut schemas: BTreeMap<u16, String> = BTreeMap::new();
-    let mut channels: BTreeMap<u16, Topic> = BTreeMap::new();
-    let mut index = 0usize;
-    let broken = |index: usize, e: &dyn std::fmt::Display| {
-        unreadable(
-            file,
-            format!("not a readable MCAP file at message {index}: {e}"),
-        )
+    let mut reading = Reading {
+        file,
+        file_len,
+        limit,
+        schemas: BTreeMap::new(),
+        channels: BTreeMap::new(),
+        index: 0,
+        visit,
     };
+    let mut ahead = Ahead::new(check_crcs, limit);
     while let Some(event) = reader.next_event() {
-        let event = event.map_err(|e| match e {
-            mcap::McapError::RecordTooLarge { opcode, len } => unreadable(
-                file,
-                format!(
-                    "at message {index}, a record (opcode 0x{opcode:02x}) declares {len} bytes, \
-                     more than a file of {file_len} bytes can hold: expected at most {limit} \
-                     (compressed data is taken to expand at most {} times)",
-                    super::container::MAX_EXPANSION
-                ),
-            ),
-            e => broken(index, &e),
-        })?;
-        let (opcode, data) = match event {
+        let event = match event {
+            Ok(event) => event,
+            Err(e) => {
+                // What the chunks before the damage hold comes first.
+                while let Some(opened) = ahead.pop() {
+                    reading.chunk(opened, &mut ahead)?;
+                }
+                return Err(match e {
+                    mcap::McapError::RecordTooLarge { opcode, len } => {
+                        reading.too_large(opcode, len)
+                    }
+                    e => reading.broken(&e),
+                });
+            }
+        };
+        match event {
             LinearReadEvent::ReadRequest(need) => {
                 let buffer = reader.insert(need.min(READ_PIECE));
                 let got = input
                     .read(buffer)
                     .map_err(|e| unreadable(file, e.to_string()))?;
                 reader.notify_read(got);
-                continue;
             }
-            LinearReadEvent::Record { opcode, data } => (opcode, data),
-        };
-        match mcap::parse_record(opcode, data).map_err(|e| broken(index, &e))? {
-            Record::Schema { header, .. } => {
-                schemas.insert(header.id, header.name);
+            LinearReadEvent::Record { opcode, data } if opcode == op::CHUNK => {
+                if let Some(opened) = ahead.push(data) {
+                    reading.chunk(opened, &mut ahead)?;
+                }
             }
-            Record::Channel(c) => {
-                let (id, topic) = (c.id, topic_of(c, &schemas));
-                visit(McapEvent::Channel(&topic))?;
-                channels.insert(id, topic);
+            LinearReadEvent::Record { opcode, data }
+                if matches!(opcode, op::SCHEMA | op::CHANNEL | op::MESSAGE) =>
+            {
+                while let Some(opened) = ahead.pop() {
+                    reading.chunk(opened, &mut ahead)?;
+                }
+                reading.record(opcode, data)?;
             }
-            Record::Message { header, data } => {
-                index += 1;
-                let Some(topic) = channels.get(&header.channel_id) else {
-                    let e = format!("channel {} is not defined before it", header.channel_id);
-                    return Err(broken(index - 1, &e));
-                };
-                visit(McapEvent::Message(topic, &data))?;
-            }
-            _ => {}
+            LinearReadEvent::Record { .. } => {}
         }
+    }
+    while let Some(opened) = ahead.pop() {
+        reading.chunk(opened, &mut ahead)?;
     }
     Ok(())
 }
 
-/// What a file's summary section counts: its chunks and each topic's messages.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub(super) struct Counts {
-    /// Chunks (the Statistics record's, else the Chunk Index records').
-    pub chunks: u64,
-    /// Messages per topic (the Statistics record's channel message counts).
-    pub messages: BTreeMap<String, u64>,
+/// The state of one reading of a file: its schemas and channels so far, the messages handed on.
+struct Reading<'a, 'v> {
+    file: &'a str,
+    file_len: u64,
+    limit: u64,
+    schemas: BTreeMap<u16, String>,
+    channels: BTreeMap<u16, Topic>,
+    /// Messages handed on so far.
+    index: usize,
+    visit: &'v mut dyn FnMut(McapEvent<'_>) -> Result<(), LogError>,
+}
+
+impl Reading<'_, '_> {
+    /// The error of the file at the current message.
+    fn broken(&self, e: &dyn std::fmt::Display) -> LogError {
+        unreadable(
+            self.file,
+            format!("not a readable MCAP file at message {}: {e}", self.index),
+        )
+    }
+
+    /// The error of a record (opcode `opcode`) declaring `len` bytes.
+    fn too_large(&self, opcode: u8, len: u64) -> LogError {
+        unreadable(
+            self.file,
+            format!(
+                "at message {}, a record (opcode 0x{opcode:02x}) declares {len} bytes, more than \
+                 a file of {} bytes can hold: expected at most {} (compressed data is taken to \
+                 expand at most {} times)",
+                self.index,
+                self.file_len,
+                self.limit,
+                super::container::MAX_EXPANSION
+            ),
+        )
+    }
+
+    /// Hands on the records of an opened chunk, its buffers then back to `ahead`.
+    fn chunk(&mut self, (opened, copy): Opened, ahead: &mut Ahead) -> Result<(), LogError> {
+        let error = |r: &Self, e: ChunkError| match e {
+            ChunkError::TooLarge { opcode, len } => r.too_large(opcode, len),
+            ChunkError::Broken(e) => r.broken(&e),
+        };
+        let bytes = opened.map_err(|e| error(self, e))?;
+        for record in mcap_chunks::records(&bytes, self.limit) {
+            let (opcode, data) = record.map_err(|e| error(self, e))?;
+            self.record(opcode, data)?;
+        }
+        ahead.recycle([bytes, copy]);
+        Ok(())
+    }
+
+    /// Hands on a schema, channel or message record (others are skipped).
+    fn record(&mut self, opcode: u8, data: &[u8]) -> Result<(), LogError> {
+        use mcap::records::{Record, op};
+        // A message's header: channel id (u16), sequence (u32), log and publish times (u64).
+        const MESSAGE_HEADER: usize = 2 + 4 + 8 + 8;
+        if opcode == op::MESSAGE && data.len() >= MESSAGE_HEADER {
+            let id = u16::from_le_bytes([data[0], data[1]]);
+            self.index += 1;
+            let Some(topic) = self.channels.get(&id) else {
+                self.index -= 1;
+                return Err(self.broken(&format!("channel {id} is not defined before it")));
+            };
+            return (self.visit)(McapEvent::Message(topic, &data[MESSAGE_HEADER..]));
+        }
+        if !matches!(opcode, op::SCHEMA | op::CHANNEL | op::MESSAGE) {
+            return Ok(());
+        }
+        match mcap::parse_record(opcode, data).map_err(|e| self.broken(&e))? {
+            Record::Schema { header, .. } => {
+                self.schemas.insert(header.id, header.name);
+            }
+            Record::Channel(c) => {
+                let (id, topic) = (c.id, topic_of(c, &self.schemas));
+                (self.visit)(McapEvent::Channel(&topic))?;
+                self.channels.insert(id, topic);
+            }
+            _ => {}
+        }
+        Ok(())
+    }
 }
 
 /// One MCAP file to read: where it is, and what its summary counts (when it does).
@@ -317,67 +337,4 @@ pub(super) fn topics(
         Ok(())
     })?;
     Ok((out, None))
-}
-
-/// The topics the summary section lists, and its counts when it has a Statistics record;
-/// `None` without a summary or when it does not parse.
-fn summary(source: &Container) -> Option<(BTreeMap<String, Topic>, Option<Counts>)> {
-    use mcap::records::Record;
-    use std::io::{Seek, SeekFrom};
-    // The footer: opcode, length (8), summary_start (8), summary_offset_start (8), CRC (4),
-    // then the closing magic bytes.
-    const FOOTER: u64 = 1 + 8 + 8 + 8 + 4;
-    let (mut f, len) = source.open().ok()?;
-    let footer_at = len.checked_sub(FOOTER + MCAP_MAGIC.len() as u64)?;
-    f.seek(SeekFrom::Start(footer_at)).ok()?;
-    let mut footer = [0u8; FOOTER as usize];
-    f.read_exact(&mut footer).ok()?;
-    let summary_start = u64::from_le_bytes(footer[9..17].try_into().ok()?);
-    if footer[0] != 0x02 || summary_start == 0 || summary_start >= footer_at {
-        return None;
-    }
-    let mut summary = vec![0u8; usize::try_from(footer_at - summary_start).ok()?];
-    f.seek(SeekFrom::Start(summary_start)).ok()?;
-    f.read_exact(&mut summary).ok()?;
-    let (mut schemas, mut channels, mut out) = (BTreeMap::new(), BTreeMap::new(), BTreeMap::new());
-    let (mut statistics, mut chunk_indices) = (None, 0u64);
-    let mut rest = summary.as_slice();
-    while !rest.is_empty() {
-        let opcode = *rest.first()?;
-        let n = usize::try_from(u64::from_le_bytes(rest.get(1..9)?.try_into().ok()?)).ok()?;
-        let data = rest.get(9..9usize.checked_add(n)?)?;
-        match mcap::parse_record(opcode, data).ok()? {
-            Record::Schema { header, .. } => {
-                schemas.insert(header.id, header.name);
-            }
-            Record::Channel(c) => {
-                let (id, topic) = (c.id, topic_of(c, &schemas));
-                channels.insert(id, topic.topic.clone());
-                out.entry(topic.topic.clone()).or_insert(topic);
-            }
-            Record::Statistics(s) => statistics = Some(s),
-            Record::ChunkIndex(_) => chunk_indices += 1,
-            _ => {}
-        }
-        rest = &rest[9 + n..];
-    }
-    // A summary that repeats no channel says nothing of the topics.
-    if out.is_empty() {
-        return None;
-    }
-    let counts = statistics.map(|s| {
-        let mut messages = BTreeMap::new();
-        for (id, n) in &s.channel_message_counts {
-            if let Some(topic) = channels.get(id) {
-                *messages.entry(topic.clone()).or_insert(0) += n;
-            }
-        }
-        let chunks = if s.chunk_count > 0 {
-            u64::from(s.chunk_count)
-        } else {
-            chunk_indices
-        };
-        Counts { chunks, messages }
-    });
-    Some((out, counts))
 }

@@ -23,6 +23,8 @@ pub mod gnss_csv;
 pub mod imu_channels_csv;
 pub mod imu_csv;
 pub mod mcap;
+mod mcap_chunks;
+mod mcap_summary;
 pub mod messages;
 pub mod read_ahead;
 pub mod recording;

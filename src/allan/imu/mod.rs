@@ -191,9 +191,11 @@ pub fn fitted_correlation_time(a: &Analysis) -> bool {
 /// # Errors
 /// [`ImuError`] naming the first channel the analysis cannot use.
 pub fn analyse_imu(log: &ImuSamples, confidence: f64) -> Result<ImuAnalysis, ImuError> {
-    let channels = log
+    use rayon::prelude::*;
+    // Every channel on the pool, the first error in the channels' order.
+    let analysed: Vec<_> = log
         .channels
-        .iter()
+        .par_iter()
         .map(|(channel, y)| {
             analyse(y, log.sample_period_s, confidence)
                 .map(|analysis| ChannelAnalysis {
@@ -205,7 +207,8 @@ pub fn analyse_imu(log: &ImuSamples, confidence: f64) -> Result<ImuAnalysis, Imu
                     reason,
                 })
         })
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect();
+    let channels = analysed.into_iter().collect::<Result<Vec<_>, _>>()?;
     Ok(ImuAnalysis {
         samples: log.channels.first().map_or(0, |c| c.1.len()),
         sample_period_s: log.sample_period_s,

@@ -1,22 +1,40 @@
-//! `allan --imu` on a log read twice and held nowhere: a first read finds each channel's mean
-//! (the phase subtracts it, as the whole-series form does), the count and the median step, a
-//! second checks every step against that median and feeds each channel's [`AllanStream`].
-//! Memory is that of the streams (the window of
-//! [`stream::EXACT_MAX_M`](crate::allan::stream::EXACT_MAX_M) phase points per channel; a longer
-//! log's phase goes to a temporary file), whatever the log's length; every τ is the
-//! whole-series analysis's, bit for bit.
+//! `allan --imu` on a log read once and held, or read twice and held nowhere.
+//!
+//! - A log of at most the rows the caller lets it hold ([`DEFAULT_HOLD_BYTES`], 64 bytes a
+//!   six-channel row: the stamp, its place and the values, [`held_row_bytes`]) is read once into memory and analysed as the
+//!   whole-series form does ([`analyse_imu`]).
+//! - A longer one is read twice: a first read finds each channel's mean (the phase subtracts
+//!   it, as the whole-series form does), the count and the median step, a second checks every
+//!   step against that median and feeds each channel's [`AllanStream`]. Memory is that of the
+//!   streams (the window of [`stream::EXACT_MAX_M`](crate::allan::stream::EXACT_MAX_M) phase
+//!   points per channel; a longer log's phase goes to a temporary file), whatever the log's
+//!   length.
+//!
+//! Either way every τ is the whole-series analysis's, bit for bit, and the errors are the same,
+//! in the same order: a malformed record first, then a step outside the accepted band around
+//! the median.
 
 use rayon::prelude::*;
 
-use super::{ChannelAnalysis, ImuAnalysis, ImuError};
+use super::{ChannelAnalysis, ImuAnalysis, ImuError, analyse_imu};
 use crate::allan::stream::{AllanStream, StreamingMean};
 use crate::allan::{AllanError, analyse_grid};
 use crate::input::csv::steps::{ACCEPTED_STEP_RATIO, StepMedian};
-use crate::input::records::{ImuRecords, Record};
+use crate::input::records::{Channel, ImuRecords, ImuSamples, Record};
 use crate::input::{LogError, LogProblem};
 
 /// Samples of each channel handed to the streams at once.
 const BATCH: usize = 1 << 16;
+
+/// The memory a log may be held in by default, bytes: 4.2·10⁶ six-channel rows,
+/// 2.9 hours at 400 Hz.
+pub const DEFAULT_HOLD_BYTES: usize = 256 << 20;
+
+/// Bytes a held row of `channels` channels takes: its stamp, its place in the log and a value
+/// per channel (64 for six).
+pub const fn held_row_bytes(channels: usize) -> usize {
+    8 + 8 + 8 * channels
+}
 
 /// Why a streamed analysis stopped.
 #[derive(Debug)]
@@ -91,8 +109,9 @@ fn first_read(records: &dyn ImuRecords) -> Result<FirstRead, LogError> {
     Ok((means, distinct, samples, median_s))
 }
 
-/// Analyses every channel of `records` at `confidence`, reading them twice; the phase of a log
-/// with τ beyond the streams' window is written to a temporary file in `spill_dir`.
+/// Analyses every channel of `records` at `confidence`: read once and held when the log takes
+/// at most `hold_bytes` ([`held_row_bytes`] a row), else read twice, the phase of a log with τ
+/// beyond the streams' window written to a temporary file in `spill_dir`.
 ///
 /// # Errors
 /// [`StreamError::Log`] for the first problem of the log (as the whole-series readers tell
@@ -100,6 +119,101 @@ fn first_read(records: &dyn ImuRecords) -> Result<FirstRead, LogError> {
 /// [`StreamError::Channel`] naming the first channel the analysis cannot use,
 /// [`StreamError::Spill`] for the temporary file.
 pub fn analyse_records(
+    records: &dyn ImuRecords,
+    confidence: f64,
+    spill_dir: &std::path::Path,
+    hold_bytes: usize,
+) -> Result<ImuAnalysis, StreamError> {
+    let row_bytes = held_row_bytes(records.channels().len());
+    let Some(held) = held_read(records, hold_bytes / row_bytes)? else {
+        return analyse_streamed(records, confidence, spill_dir);
+    };
+    let samples = held.check_steps(records).map_err(StreamError::Log)?;
+    analyse_imu(&samples, confidence).map_err(StreamError::Channel)
+}
+
+/// A log held whole: its stamps, their places, each channel's values.
+struct Held {
+    t_s: Vec<f64>,
+    at: Vec<u64>,
+    values: Vec<Vec<f64>>,
+    channels: Vec<Channel>,
+}
+
+/// The log read once and held, its stamps and values checked; `None` once it has more than
+/// `max_rows` rows (the read stops there).
+fn held_read(records: &dyn ImuRecords, max_rows: usize) -> Result<Option<Held>, StreamError> {
+    let channels = records.channels().to_vec();
+    let mut held = Held {
+        t_s: Vec::new(),
+        at: Vec::new(),
+        values: vec![Vec::new(); channels.len()],
+        channels,
+    };
+    let mut previous_s = None;
+    let mut too_long = false;
+    let read = records.read(&mut |r| {
+        if held.t_s.len() == max_rows {
+            // Stops the read; the error itself is never shown.
+            too_long = true;
+            return Err(records.error(LogProblem::Changed));
+        }
+        checked(records, r, &mut previous_s)?;
+        held.t_s.push(r.t_s);
+        held.at.push(r.at);
+        for (h, v) in held.values.iter_mut().zip(&r.values) {
+            h.push(*v);
+        }
+        Ok(())
+    });
+    match read {
+        _ if too_long => Ok(None),
+        Err(e) => Err(StreamError::Log(e)),
+        Ok(()) => Ok(Some(held)),
+    }
+}
+
+impl Held {
+    /// The samples, every step checked against the band around their median.
+    ///
+    /// # Errors
+    /// [`LogProblem::TooFewRows`] for fewer than two rows, [`LogProblem::Gap`] at the first
+    /// step outside the band.
+    fn check_steps(self, records: &dyn ImuRecords) -> Result<ImuSamples, LogError> {
+        let mut steps = StepMedian::new();
+        for w in self.t_s.windows(2) {
+            steps.add(w[1] - w[0]);
+        }
+        let Some(median_s) = steps.median() else {
+            let problem = LogProblem::TooFewRows {
+                found: self.t_s.len() as u64,
+                needed: 2,
+            };
+            return Err(records.error(problem));
+        };
+        let band = ACCEPTED_STEP_RATIO.0 * median_s..=ACCEPTED_STEP_RATIO.1 * median_s;
+        for (k, w) in self.t_s.windows(2).enumerate() {
+            let step_s = w[1] - w[0];
+            if !band.contains(&step_s) {
+                let problem = LogProblem::Gap {
+                    previous_s: w[0],
+                    t_s: w[1],
+                    step_s,
+                    ratio: step_s / median_s,
+                    median_s,
+                };
+                return Err(records.error_at(self.at[k + 1], problem));
+            }
+        }
+        Ok(ImuSamples {
+            channels: self.channels.into_iter().zip(self.values).collect(),
+            sample_period_s: median_s,
+        })
+    }
+}
+
+/// [`analyse_records`] reading the log twice, holding none of it.
+fn analyse_streamed(
     records: &dyn ImuRecords,
     confidence: f64,
     spill_dir: &std::path::Path,

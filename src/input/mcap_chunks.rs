@@ -1,0 +1,185 @@
+//! An MCAP file's chunks opened on all threads while their records are handed on in file order:
+//! each chunk decompressed (none, lz4 or zstd) and its CRC checked on a worker of the thread
+//! pool, up to [`AHEAD`] chunks ahead of the records being read. The records, their order and
+//! every error are those of reading the chunks one after the other; only the time differs.
+//!
+//! # Format
+//! MCAP (mcap.dev/spec, version 0), § Chunk: message_start_time (u64), message_end_time (u64),
+//! uncompressed_size (u64), uncompressed_crc (u32, CRC-32 of the uncompressed records, 0 when
+//! not computed), compression (string: "", "lz4" as an LZ4 frame, "zstd" as a Zstandard
+//! frame), records (u64 length, then the compressed bytes); the records inside are the file's
+//! own, an opcode (u8), a length (u64) and their data each.
+
+use std::collections::VecDeque;
+use std::io::Read as _;
+use std::sync::mpsc::{Receiver, sync_channel};
+
+/// Chunks opened ahead of the one whose records are handed on, per thread of the pool.
+const AHEAD: usize = 4;
+
+/// Compressed bytes held ahead at most: chunks are waited for beyond this, however few.
+const AHEAD_BYTES: usize = 64 << 20;
+
+/// Why a chunk cannot be read, in the words of the record it stopped at.
+#[derive(Debug)]
+pub(super) enum ChunkError {
+    /// A record (or the chunk's decompressed records) declares more bytes than the file can
+    /// hold: its opcode and its length.
+    TooLarge { opcode: u8, len: u64 },
+    /// Anything else, in words.
+    Broken(String),
+}
+
+/// A chunk's records decompressed, and the buffer its record was copied to (for the next).
+pub(super) type Opened = (Result<Vec<u8>, ChunkError>, Vec<u8>);
+
+/// The chunk record `body` (after its opcode and length) decompressed into `out` (cleared
+/// first), its CRC checked when `check_crc` and the CRC is not 0; no more than `limit` bytes
+/// are decompressed.
+///
+/// # Errors
+/// [`ChunkError::TooLarge`] when the records decompress to more than `limit` bytes,
+/// [`ChunkError::Broken`] for a chunk that does not parse, an unknown compression, a
+/// decompression error or a CRC that does not match.
+fn open(body: &[u8], check_crc: bool, limit: u64, mut out: Vec<u8>) -> Result<Vec<u8>, ChunkError> {
+    use mcap::records::Record;
+    let broken = |e: &dyn std::fmt::Display| ChunkError::Broken(e.to_string());
+    let Record::Chunk { header, data } =
+        mcap::parse_record(mcap::records::op::CHUNK, body).map_err(|e| broken(&e))?
+    else {
+        return Err(broken(&"expected a chunk"));
+    };
+    let cap = header.uncompressed_size.min(limit);
+    out.clear();
+    out.reserve(usize::try_from(cap).unwrap_or(usize::MAX));
+    // One byte past the cap tells a chunk longer than it may be.
+    let read = match header.compression.as_str() {
+        "" => (&data[..]).take(cap + 1).read_to_end(&mut out),
+        "lz4" => lz4::Decoder::new(&data[..]).and_then(|d| d.take(cap + 1).read_to_end(&mut out)),
+        "zstd" => zstd::stream::read::Decoder::with_buffer(&data[..])
+            .and_then(|d| d.take(cap + 1).read_to_end(&mut out)),
+        other => {
+            return Err(broken(&mcap::McapError::UnsupportedCompression(
+                other.to_string(),
+            )));
+        }
+    };
+    read.map_err(|e| broken(&mcap::McapError::DecompressionError(e.to_string())))?;
+    let got = out.len() as u64;
+    if got > limit {
+        return Err(ChunkError::TooLarge {
+            opcode: mcap::records::op::CHUNK,
+            len: got,
+        });
+    }
+    if check_crc && header.uncompressed_crc != 0 {
+        let calculated = crc32fast::hash(&out);
+        if calculated != header.uncompressed_crc {
+            return Err(broken(&mcap::McapError::BadChunkCrc {
+                saved: header.uncompressed_crc,
+                calculated,
+            }));
+        }
+    }
+    if got > header.uncompressed_size {
+        return Err(broken(&mcap::McapError::DecompressionError(format!(
+            "the chunk decompresses to more than its declared {} bytes",
+            header.uncompressed_size
+        ))));
+    }
+    Ok(out)
+}
+
+/// The records of an opened chunk in order: (opcode, data), none longer than `limit`.
+///
+/// # Errors
+/// [`ChunkError::TooLarge`] for a record longer than `limit`, [`ChunkError::Broken`] for one
+/// cut by the chunk's end (then nothing more is read).
+pub(super) fn records(
+    mut rest: &[u8],
+    limit: u64,
+) -> impl Iterator<Item = Result<(u8, &[u8]), ChunkError>> {
+    std::iter::from_fn(move || {
+        let (&opcode, tail) = rest.split_first()?;
+        let Some((len, tail)) = tail.split_first_chunk::<8>() else {
+            rest = &[];
+            return Some(Err(ChunkError::Broken(
+                mcap::McapError::UnexpectedEoc.to_string(),
+            )));
+        };
+        let len = u64::from_le_bytes(*len);
+        if len > limit {
+            rest = &[];
+            return Some(Err(ChunkError::TooLarge { opcode, len }));
+        }
+        let Some(data) = usize::try_from(len).ok().and_then(|n| tail.get(..n)) else {
+            rest = &[];
+            return Some(Err(ChunkError::Broken(
+                mcap::McapError::UnexpectedEoc.to_string(),
+            )));
+        };
+        rest = &tail[data.len()..];
+        Some(Ok((opcode, data)))
+    })
+}
+
+/// Chunks being opened on the pool, in file order, and the buffers of those handed on (their
+/// pages used again: a fresh buffer per chunk costs its page faults every time).
+pub(super) struct Ahead {
+    queue: VecDeque<(usize, Receiver<Opened>)>,
+    bytes: usize,
+    check_crc: bool,
+    limit: u64,
+    free: Vec<Vec<u8>>,
+}
+
+impl Ahead {
+    /// None yet; chunks will be checked against their CRC when `check_crc`, and decompressed
+    /// to at most `limit` bytes.
+    pub fn new(check_crc: bool, limit: u64) -> Self {
+        Self {
+            queue: VecDeque::new(),
+            bytes: 0,
+            check_crc,
+            limit,
+            free: Vec::new(),
+        }
+    }
+
+    /// Takes back the buffers of a chunk whose records were handed on.
+    pub fn recycle(&mut self, buffers: [Vec<u8>; 2]) {
+        self.free.extend(buffers);
+    }
+
+    /// Starts opening the chunk record `body` on the pool; returns the oldest chunk opened
+    /// when more are ahead than [`AHEAD`] per thread (or [`AHEAD_BYTES`]), for its records to
+    /// be handed on now.
+    pub fn push(&mut self, body: &[u8]) -> Option<Opened> {
+        let (send, receive) = sync_channel(1);
+        let mut copy = self.free.pop().unwrap_or_default();
+        copy.clear();
+        copy.extend_from_slice(body);
+        let out = self.free.pop().unwrap_or_default();
+        let (check_crc, limit, len) = (self.check_crc, self.limit, body.len());
+        self.bytes += len;
+        rayon::spawn(move || {
+            let opened = open(&copy, check_crc, limit, out);
+            // The reader may have stopped at an earlier error: nobody waits then.
+            let _ = send.send((opened, copy));
+        });
+        self.queue.push_back((len, receive));
+        let full = self.queue.len() > AHEAD * rayon::current_num_threads().max(1)
+            || self.bytes > AHEAD_BYTES;
+        if full { self.pop() } else { None }
+    }
+
+    /// The oldest chunk, waited for; `None` when none is ahead.
+    pub fn pop(&mut self) -> Option<Opened> {
+        let (len, receive) = self.queue.pop_front()?;
+        self.bytes -= len;
+        Some(receive.recv().unwrap_or_else(|_| {
+            let e = "the worker opening the chunk ended without a result";
+            (Err(ChunkError::Broken(e.into())), Vec::new())
+        }))
+    }
+}
