@@ -137,6 +137,11 @@ fn identify_with(len: usize, at: impl Fn(usize) -> f64) -> Option<NoiseId> {
     let z = |i: usize| at(i) - u_mean - slope * (i as f64 - t_mean);
     let mut d = 0u32;
     loop {
+        // The series differenced d times, d ≤ MAX_DIFFERENCES = 2.
+        const _: () = assert!(
+            MAX_DIFFERENCES == 2,
+            "identify_with differences at most twice"
+        );
         let r1 = match d {
             0 => lag1_of(len, z),
             1 => lag1_of(len - 1, |i| z(i + 1) - z(i)),
