@@ -26,36 +26,6 @@ pub struct NoiseId {
     pub delta: f64,
 }
 
-/// The lag-1 autocorrelation of `z`.
-///
-/// # Formula
-/// Riley & Greenhall (2004), eq. (2): r₁ = Σ_{n=0}^{L−2} (z_n − z̄)(z_{n+1} − z̄) / Σ (z_n − z̄)².
-pub fn lag1_autocorrelation(z: &[f64]) -> f64 {
-    let mean = z.iter().sum::<f64>() / z.len() as f64;
-    let num: f64 = z.windows(2).map(|w| (w[0] - mean) * (w[1] - mean)).sum();
-    let den: f64 = z.iter().map(|v| (v - mean) * (v - mean)).sum();
-    num / den
-}
-
-/// `z` less its least-squares straight line over the index 0, 1, …, L − 1 (numpy's
-/// `polyfit(t, z, 1)`).
-pub fn remove_line(z: &[f64]) -> Vec<f64> {
-    let l = z.len() as f64;
-    let t_mean = (l - 1.0) / 2.0;
-    let z_mean = z.iter().sum::<f64>() / l;
-    let (mut stz, mut stt) = (0.0, 0.0);
-    for (i, v) in z.iter().enumerate() {
-        let dt = i as f64 - t_mean;
-        stz += dt * (v - z_mean);
-        stt += dt * dt;
-    }
-    let slope = if stt > 0.0 { stz / stt } else { 0.0 };
-    z.iter()
-        .enumerate()
-        .map(|(i, v)| v - z_mean - slope * (i as f64 - t_mean))
-        .collect()
-}
-
 /// Identifies the noise of the block means `means` (rate data averaged over τ); `None` with
 /// fewer than [`MIN_POINTS`] means or a series without variation.
 pub fn identify(means: &[f64]) -> Option<NoiseId> {
@@ -201,6 +171,98 @@ pub fn non_increasing(values: &[f64], weights: &[f64]) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::random::Stream;
+
+    // The two-pass reference: the line removed into a new series, r₁ from its mean.
+    /// The lag-1 autocorrelation of `z`.
+    ///
+    /// # Formula
+    /// Riley & Greenhall (2004), eq. (2): r₁ = Σ_{n=0}^{L−2} (z_n − z̄)(z_{n+1} − z̄) / Σ (z_n − z̄)².
+    fn lag1_autocorrelation(z: &[f64]) -> f64 {
+        let mean = z.iter().sum::<f64>() / z.len() as f64;
+        let num: f64 = z.windows(2).map(|w| (w[0] - mean) * (w[1] - mean)).sum();
+        let den: f64 = z.iter().map(|v| (v - mean) * (v - mean)).sum();
+        num / den
+    }
+
+    /// `z` less its least-squares straight line over the index 0, 1, …, L − 1 (numpy's
+    /// `polyfit(t, z, 1)`).
+    fn remove_line(z: &[f64]) -> Vec<f64> {
+        let l = z.len() as f64;
+        let t_mean = (l - 1.0) / 2.0;
+        let z_mean = z.iter().sum::<f64>() / l;
+        let (mut stz, mut stt) = (0.0, 0.0);
+        for (i, v) in z.iter().enumerate() {
+            let dt = i as f64 - t_mean;
+            stz += dt * (v - z_mean);
+            stt += dt * dt;
+        }
+        let slope = if stt > 0.0 { stz / stt } else { 0.0 };
+        z.iter()
+            .enumerate()
+            .map(|(i, v)| v - z_mean - slope * (i as f64 - t_mean))
+            .collect()
+    }
+
+    /// [`identify`] as Riley & Greenhall state it, one series after another.
+    fn identify_reference(means: &[f64]) -> (u32, f64) {
+        let mut z = remove_line(means);
+        let mut d = 0;
+        loop {
+            let r1 = lag1_autocorrelation(&z);
+            let delta = r1 / (1.0 + r1);
+            if delta < 0.25 || d >= MAX_DIFFERENCES {
+                return (d, delta);
+            }
+            z = z.windows(2).map(|w| w[1] - w[0]).collect();
+            d += 1;
+        }
+    }
+
+    #[test]
+    fn one_pass_agrees_with_the_two_pass_reference() {
+        let mut s = Stream::new(11, 0);
+        let white: Vec<f64> = (0..5000).map(|_| 3.0 + s.normal()).collect();
+        let mut acc = 0.0;
+        let walk: Vec<f64> = white
+            .iter()
+            .map(|w| {
+                acc += w;
+                acc
+            })
+            .collect();
+        let mut acc2 = 0.0;
+        let walk2: Vec<f64> = walk
+            .iter()
+            .map(|w| {
+                acc2 += w;
+                acc2
+            })
+            .collect();
+        let phase: Vec<f64> = white.windows(2).map(|w| w[1] - w[0]).collect();
+        for (name, series) in [
+            ("white", &white),
+            ("walk", &walk),
+            ("walk2", &walk2),
+            ("phase", &phase),
+        ] {
+            let got = identify(series).unwrap();
+            let (d, delta) = identify_reference(series);
+            assert_eq!(got.differences, d, "{name}");
+            assert!(
+                (got.delta - delta).abs() < 1e-9,
+                "{name}: {} against {delta}",
+                got.delta
+            );
+        }
+        // The control: without the line removed a trend is a different series.
+        let trend: Vec<f64> = white
+            .iter()
+            .enumerate()
+            .map(|(i, w)| w + 0.01 * i as f64)
+            .collect();
+        let r_plain = lag1_autocorrelation(&trend);
+        assert!((identify(&trend).unwrap().delta - r_plain / (1.0 + r_plain)).abs() > 0.1);
+    }
 
     #[test]
     fn tells_white_from_random_walk_and_white_phase() {

@@ -219,26 +219,64 @@ pub fn diagnose(
     nis: &NisTest,
     false_alarm_rate: f64,
 ) -> Diagnostics {
-    let b = ErrorState::BIAS;
-    let series: Vec<FixSeries> = fixes
-        .iter()
-        .zip(smoothed)
-        .map(|(f, sm)| FixSeries {
+    let gps_sigma = [stats.gps_position_sigma_m, stats.gps_velocity_sigma_m_s];
+    let series = Calibrated { fixes, smoothed };
+    of(&series, gps_sigma, stats.bias_model, nis, false_alarm_rate)
+}
+
+/// Fixes as the diagnosis reads them, one at a time: a calibration's are formed from its
+/// filtered and smoothed records as they are read, not copied whole (80 bytes a fix).
+pub trait Series {
+    /// How many fixes.
+    fn len(&self) -> usize;
+    /// Fix `i`, `i` < [`Series::len`].
+    fn at(&self, i: usize) -> FixSeries;
+    /// Whether there is none.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl Series for [FixSeries] {
+    fn len(&self) -> usize {
+        <[FixSeries]>::len(self)
+    }
+    fn at(&self, i: usize) -> FixSeries {
+        self[i]
+    }
+}
+
+/// A calibration's fixes with their smoothed estimates.
+struct Calibrated<'a> {
+    fixes: &'a [FilteredFix],
+    smoothed: &'a [SmoothedFix],
+}
+
+impl Series for Calibrated<'_> {
+    fn len(&self) -> usize {
+        self.fixes.len().min(self.smoothed.len())
+    }
+    fn at(&self, i: usize) -> FixSeries {
+        let (f, sm, b) = (&self.fixes[i], &self.smoothed[i], ErrorState::BIAS);
+        FixSeries {
             t_s: f.t_s,
             residual: std::array::from_fn(|k| f.residual[k]),
             s_diag: std::array::from_fn(|k| f.s[(k, k)]),
             nis: f.nis,
             bias_filtered: [f.post[b], f.p_post[(b, b)]],
             bias_smoothed: [sm.x[b], sm.p[(b, b)]],
-        })
-        .collect();
-    let gps_sigma = [stats.gps_position_sigma_m, stats.gps_velocity_sigma_m_s];
-    of(&series, gps_sigma, stats.bias_model, nis, false_alarm_rate)
+        }
+    }
+}
+
+/// The fixes of `series` in order.
+fn each<S: Series + ?Sized>(series: &S) -> impl Iterator<Item = FixSeries> + '_ {
+    (0..series.len()).map(|i| series.at(i))
 }
 
 /// [`diagnose`] of plain series: `gps_sigma` = (σ_p, σ_v) the filter assumes.
-pub fn of(
-    series: &[FixSeries],
+pub fn of<S: Series + ?Sized>(
+    series: &S,
     gps_sigma: [f64; M],
     bias_model: BiasModel,
     nis: &NisTest,
@@ -262,8 +300,11 @@ pub fn of(
 
 /// 1 / the mean interval between fixes over the intervals within 0.5 to 1.5 times the median
 /// (a missing fix is a gap, not a slower rate); 0 below two fixes.
-fn fix_rate_hz(series: &[FixSeries]) -> f64 {
-    let mut steps: Vec<f64> = series.windows(2).map(|w| w[1].t_s - w[0].t_s).collect();
+fn fix_rate_hz<S: Series + ?Sized>(series: &S) -> f64 {
+    let mut steps: Vec<f64> = each(series)
+        .zip(each(series).skip(1))
+        .map(|(a, b)| b.t_s - a.t_s)
+        .collect();
     steps.sort_by(f64::total_cmp);
     let Some(&median) = steps.get(steps.len() / 2) else {
         return 0.0;
@@ -276,8 +317,8 @@ fn fix_rate_hz(series: &[FixSeries]) -> f64 {
 }
 
 /// The diagnostics of measured component `k` at rate `rate`.
-fn measurement(
-    series: &[FixSeries],
+fn measurement<S: Series + ?Sized>(
+    series: &S,
     k: usize,
     gps_sigma: f64,
     rate: f64,
@@ -288,23 +329,22 @@ fn measurement(
         "filter.gps_velocity_sigma_m_s",
     ];
     let variable = ErrorState::MEASURED[k];
-    let u: Vec<f64> = series
-        .iter()
+    let u: Vec<f64> = each(series)
         .map(|f| f.residual[k] / f.s_diag[k].sqrt())
         .collect();
     let n = u.len().max(1) as f64;
     let mean_square = u.iter().map(|x| x * x).sum::<f64>() / n;
     let (lo, hi) = chi_squared_band(n, n, rate);
     let r = gps_sigma * gps_sigma;
-    let gps_share = series.iter().map(|f| r / f.s_diag[k]).sum::<f64>() / n;
+    let gps_share = each(series).map(|f| r / f.s_diag[k]).sum::<f64>() / n;
     // The fixes where the GPS is at least half of S: the first fixes, where the prior's σ
     // dominates S, would swamp the residuals' spread with S − R.
-    let settled: Vec<&FixSeries> = series.iter().filter(|f| 2.0 * r >= f.s_diag[k]).collect();
-    let excess = settled
-        .iter()
+    let settled = || each(series).filter(|f| 2.0 * r >= f.s_diag[k]);
+    let settled_count = settled().count();
+    let excess = settled()
         .map(|f| f.residual[k].powi(2) - (f.s_diag[k] - r))
         .sum::<f64>()
-        / settled.len().max(1) as f64;
+        / settled_count.max(1) as f64;
     MeasurementDiagnostics {
         measurement: variable.key,
         unit: variable.unit,
@@ -315,7 +355,7 @@ fn measurement(
         mean_square_band: [lo, hi],
         mean_square_place: place(mean_square, lo, hi),
         gps_share,
-        gps_sigma_from_residuals: (excess > 0.0 && !settled.is_empty()).then(|| excess.sqrt()),
+        gps_sigma_from_residuals: (excess > 0.0 && settled_count > 0).then(|| excess.sqrt()),
     }
 }
 
@@ -331,13 +371,14 @@ fn place(x: f64, lo: f64, hi: f64) -> &'static str {
 }
 
 /// The per-fix NIS of `series` against its band at rate α.
-fn nis_per_fix(series: &[FixSeries], alpha: f64) -> NisPerFix {
+fn nis_per_fix<S: Series + ?Sized>(series: &S, alpha: f64) -> NisPerFix {
     let (lower, upper) = chi_squared_band(M as f64, 1.0, alpha);
-    let outside: Vec<&FixSeries> = series
-        .iter()
+    // (t, NIS) of each fix outside.
+    let outside: Vec<(f64, f64)> = each(series)
         .filter(|f| !(lower..=upper).contains(&f.nis))
+        .map(|f| (f.t_s, f.nis))
         .collect();
-    let below = outside.iter().filter(|f| f.nis < lower).count();
+    let below = outside.iter().filter(|&&(_, nis)| nis < lower).count();
     let bound = binomial_bound(series.len() as u64, alpha, alpha);
     let listed = &outside[..outside.len().min(MAX_LISTED)];
     NisPerFix {
@@ -354,8 +395,8 @@ fn nis_per_fix(series: &[FixSeries], alpha: f64) -> NisPerFix {
         } else {
             "fail"
         },
-        outside_t_s: listed.iter().map(|f| f.t_s).collect(),
-        outside_nis: listed.iter().map(|f| f.nis).collect(),
+        outside_t_s: listed.iter().map(|&(t, _)| t).collect(),
+        outside_nis: listed.iter().map(|&(_, nis)| nis).collect(),
     }
 }
 

@@ -20,6 +20,7 @@ const _: () = assert!(
 
 use super::StepMode;
 use super::integration::Integrated;
+use super::symmetric::Symmetric;
 
 /// What the filter did at one GPS fix: everything the smoother and the report need.
 #[derive(Clone, Debug, PartialEq)]
@@ -45,11 +46,9 @@ pub struct FilteredFix {
     /// Normalized innovation squared rᵀ·S⁻¹·r.
     pub nis: f64,
     /// A priori covariance P⁻.
-    pub p_prior: StateMatrix,
-    /// (P⁻)⁻¹.
-    pub p_prior_inv: StateMatrix,
+    pub p_prior: Symmetric,
     /// A posteriori covariance P⁺.
-    pub p_post: StateMatrix,
+    pub p_post: Symmetric,
     /// Transition of the estimate from the previous fix (or the log's first sample).
     pub phi_from_previous: StateMatrix,
 }
@@ -85,9 +84,8 @@ impl FilteredFix {
             residual,
             s: cov.s,
             nis: (residual.transpose() * cov.s_inv * residual)[0],
-            p_prior: cov.p_prior,
-            p_prior_inv: cov.p_prior_inv,
-            p_post: cov.p_post,
+            p_prior: Symmetric::of(&cov.p_prior),
+            p_post: Symmetric::of(&cov.p_post),
             phi_from_previous: phi,
         })
     }
@@ -101,9 +99,19 @@ impl FilteredFix {
             && finite(self.s.as_slice())
             && finite(self.prior.as_slice())
             && finite(self.post.as_slice())
-            && finite(self.p_prior.as_slice())
-            && finite(self.p_prior_inv.as_slice())
-            && finite(self.p_post.as_slice())
+            && finite(self.p_prior.entries())
+            && finite(self.p_post.entries())
+            && finite(self.p_prior_inv().as_slice())
+    }
+
+    /// (P⁻)⁻¹ by Cholesky, as the update formed it ([`ErrorStateModel::update_covariance`]):
+    /// not kept, at 72 bytes a fix.
+    pub fn p_prior_inv(&self) -> StateMatrix {
+        self.p_prior
+            .matrix()
+            .cholesky()
+            .expect("the update checked P⁻ positive definite")
+            .inverse()
     }
 }
 
@@ -315,7 +323,7 @@ impl<'m> Forward<'m> {
         let at = (self.k, t_s);
         let fixed = FilteredFix::update(self.model, fix, at, integrated, (prior, &self.p, phi))?;
         self.x = fixed.post;
-        self.p = fixed.p_post;
+        self.p = fixed.p_post.matrix();
         self.last_fix = (self.k, t_s, fixed.post);
         Ok(fixed)
     }

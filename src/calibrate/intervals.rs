@@ -10,6 +10,7 @@ use crate::model::NoiseStats;
 use crate::simulation::measurement;
 use crate::state::{ErrorState, StateMatrix, StateModel, StateVector};
 
+use super::chunked::Chunked;
 use super::forward::FilteredFix;
 use super::pass::{FixAt, Reduced};
 use super::scan::Scan;
@@ -60,7 +61,7 @@ fn first_gap(scan: &Scan, reduced: &Reduced, accel: &str) -> Option<Found> {
 
 /// The first fix applied at the time of the fix before it (two fixes beyond one end of the log,
 /// both applied at its end sample), and its index.
-fn first_misplaced_fix(scan: &Scan, fixes: &[FixAt]) -> Option<(usize, Found)> {
+fn first_misplaced_fix(scan: &Scan, fixes: &Chunked<FixAt>) -> Option<(usize, Found)> {
     let i = (1..fixes.len()).find(|&i| fixes[i - 1].t_s == fixes[i].t_s)?;
     let (f, gps) = (&fixes[i], &scan.gps[fixes[i].fix]);
     let problem = LogProblem::FixOnTakenSample {
@@ -170,7 +171,7 @@ impl FixFilter<'_> {
         let integrated = measurement(integrated.pc_m, integrated.vc_m_s);
         let at = (fix.sample, fix.t_s);
         let fixed = FilteredFix::update(self.model, gps, at, integrated, (prior, &p, phi))?;
-        (self.x, self.p, self.last) = (fixed.post, fixed.p_post, (fix.sample, fix.t_s));
+        (self.x, self.p, self.last) = (fixed.post, fixed.p_post.matrix(), (fix.sample, fix.t_s));
         Ok(fixed)
     }
 
@@ -250,6 +251,34 @@ pub fn filter(
     stats: &NoiseStats,
     accel: &str,
 ) -> Result<Filtered, CalibrateError> {
+    let found = first_problem(scan, reduced, accel);
+    run(
+        scan,
+        reduced,
+        reduced.fixes.iter(),
+        found,
+        (model, stats, accel),
+    )
+}
+
+/// [`filter`] for the last time: the reduced fixes taken, each chunk freed once filtered.
+///
+/// # Errors
+/// As [`filter`].
+pub fn filter_last(
+    scan: &Scan,
+    mut reduced: Reduced,
+    model: &ErrorStateModel,
+    stats: &NoiseStats,
+    accel: &str,
+) -> Result<Filtered, CalibrateError> {
+    let found = first_problem(scan, &reduced, accel);
+    let fixes = std::mem::take(&mut reduced.fixes).into_items();
+    run(scan, &reduced, fixes, found, (model, stats, accel))
+}
+
+/// The first problem a sample-by-sample pass would meet, with the fixes to filter before it.
+fn first_problem(scan: &Scan, reduced: &Reduced, accel: &str) -> (usize, Option<Found>) {
     let misplaced = first_misplaced_fix(scan, &reduced.fixes);
     let stop_fix = misplaced.as_ref().map_or(reduced.fixes.len(), |(i, _)| *i);
     let found = [
@@ -260,6 +289,18 @@ pub fn filter(
     .into_iter()
     .flatten()
     .min_by_key(Found::key);
+    (stop_fix, found)
+}
+
+/// The filter over the first `stop_fix` of `fixes` up to the problem `found`, then to the end
+/// of `reduced`.
+fn run<F: std::borrow::Borrow<FixAt>>(
+    scan: &Scan,
+    reduced: &Reduced,
+    fixes: impl Iterator<Item = F>,
+    (stop_fix, found): (usize, Option<Found>),
+    (model, stats, accel): (&ErrorStateModel, &NoiseStats, &str),
+) -> Result<Filtered, CalibrateError> {
     let mut f = FixFilter {
         model,
         stats: *stats,
@@ -269,9 +310,10 @@ pub fn filter(
         x: StateVector::zeros(),
         p: model.p0,
     };
-    let mut fixes = Vec::with_capacity(stop_fix);
+    let mut filtered_fixes = Vec::with_capacity(stop_fix);
     let mut since_line = reduced.first_line;
-    for fix in &reduced.fixes[..stop_fix] {
+    for fix in fixes.take(stop_fix) {
+        let fix = fix.borrow();
         // A fix inside a step needs the step: after the step's own overflow (phase 3).
         let phase = if fix.tau_s > 0.0 { 4 } else { 2 };
         if found
@@ -286,13 +328,13 @@ pub fn filter(
             return Err(not_finite(&filtered, scan, gps, (accel, since_line)).into());
         }
         since_line = fix.line;
-        fixes.push(filtered);
+        filtered_fixes.push(filtered);
     }
     if let Some(e) = found {
         return Err(e.error.into());
     }
     let end = f.end(reduced);
-    Ok((fixes, end))
+    Ok((filtered_fixes, end))
 }
 
 /// The overflow at a fix whose residual, NIS or estimate is not finite: naming the fix's line

@@ -20,6 +20,7 @@
 //! Nothing is written before the logs have passed every check.
 
 mod bartlett;
+mod chunked;
 pub mod diagnose;
 mod forward;
 pub mod imu;
@@ -34,6 +35,7 @@ pub mod robust;
 mod scan;
 mod smoother;
 pub mod summary;
+pub mod symmetric;
 mod units;
 pub mod warnings;
 
@@ -302,7 +304,10 @@ pub fn prepare_with<'a>(
         settings = settings.with_gps_sigmas(p, v);
         noise = Some(found);
     }
-    let (model, (fixes, end)) = run(&settings.filter_stats)?;
+    let stats = &settings.filter_stats;
+    let model = ErrorStateModel::new(dt_s, stats);
+    // The reduced log is freed as this last run goes, before the smoother's pass.
+    let (fixes, end) = intervals::filter_last(&scan, reduced, &model, stats, accel.name())?;
     Ok(Prepared {
         settings,
         model,
@@ -327,7 +332,7 @@ impl Prepared<'_> {
     pub fn write_fix_estimates(&self, out: &mut dyn Write) -> Result<(), CalibrateError> {
         use rayon::prelude::*;
         /// Fixes formatted at once, and per thread's share.
-        const BLOCK: usize = 1 << 16;
+        const BLOCK: usize = 1 << 14;
         const SHARE: usize = BLOCK / 16;
         let header = format!("{}\n", summary::FIX_ESTIMATES_COLUMNS.join(","));
         out.write_all(header.as_bytes())?;

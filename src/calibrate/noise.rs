@@ -6,6 +6,7 @@ use serde::ser::{Serialize, SerializeMap, Serializer};
 use crate::likelihood::{self, Drive, Interval, Key, NoiseEstimate, Request};
 use crate::state::{BiasModel, ErrorState, NoiseStats};
 
+use super::chunked::Chunked;
 use super::forward::FilteredFix;
 use super::pass::FixAt;
 
@@ -37,11 +38,15 @@ pub fn start_stats(stats: &NoiseStats, duration_s: f64) -> NoiseStats {
 
 /// The drive as the likelihood sees it: per fix, the filter's Φ from the previous fix, the
 /// interval's unit noise from the pass, and the measured δz = z − (p_c, v_c).
-pub fn drive(filtered: &[FilteredFix], reduced: &[FixAt], prior_from_first_fix: bool) -> Drive {
+pub fn drive(
+    filtered: &[FilteredFix],
+    reduced: &Chunked<FixAt>,
+    prior_from_first_fix: bool,
+) -> Drive {
     let rows = likelihood::evaluate::rows;
     let intervals = filtered
         .iter()
-        .zip(reduced)
+        .zip(reduced.iter())
         .map(|(f, r)| {
             let dz = f.z - f.integrated;
             Interval {
@@ -92,7 +97,7 @@ impl Serialize for NoiseRecord {
 /// is not finite at the configured statistics.
 pub fn estimate(
     filtered: &[FilteredFix],
-    reduced: &[FixAt],
+    reduced: &Chunked<FixAt>,
     stats: &NoiseStats,
     (request, prior_from_first_fix, duration_s): (&Request, bool, f64),
 ) -> Option<NoiseEstimate> {

@@ -18,6 +18,8 @@ use crate::input::csv::{ACCEL_COLUMNS, GpsFix};
 use crate::input::{LogError, LogProblem};
 use crate::state::BiasModel;
 
+use super::chunked::Chunked;
+
 pub use super::integration::{Integrated, Start, update_time_s};
 pub use super::units::NoiseUnits;
 
@@ -68,7 +70,7 @@ pub struct Reduced {
     /// lies on a sample (its time stamp that sample's, or beyond the log's ends).
     pub nominal: bool,
     /// Every fix at its sample, in the GPS log's order.
-    pub fixes: Vec<FixAt>,
+    pub fixes: Chunked<FixAt>,
     /// The last sample: (p_c, v_c) as in [`FixAt::integrated`], and the per-step noise since
     /// the last fix.
     pub end: ([Integrated; 2], NoiseUnits),
@@ -257,7 +259,7 @@ impl<'g> Stitch<'g> {
                 median: StepMedian::new(),
                 step_range: (empty, StepAt::default()),
                 nominal: true,
-                fixes: Vec::with_capacity(gps.len()),
+                fixes: Chunked::default(),
                 end: Default::default(),
                 overflow: [None; 2],
             },

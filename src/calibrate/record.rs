@@ -1,8 +1,85 @@
 //! A calibration's results as they are handed on: the summary and the per-fix series.
 
-use super::summary::{Calibration, FilterRecord, FixReport, StateRecord, Summary, sigma};
+use super::summary::{Calibration, FilterRecord, FixReport, StateRecord, Summary};
 use super::{Prepared, StepMode, diagnose, nis_test, noise, robust, warnings};
 use crate::state::{ErrorState, StateVector};
+
+/// Up to this many fixes the figures are drawn from every one.
+pub const FIGURE_ALL_FIXES: usize = 1 << 16;
+/// A longer log's figures are drawn from this many slices of its fixes, equal in number.
+const FIGURE_SLICES: usize = 2048;
+
+/// The fixes the figures draw, `report(i)` of fix `i` of `n`: every one up to
+/// [`FIGURE_ALL_FIXES`]. Beyond, a figure a thousand pixels wide cannot show more than the
+/// extremes of each pixel column, so each of [`FIGURE_SLICES`] slices of consecutive fixes keeps
+/// its first and last fix and those that hold the least and the greatest of every number the
+/// figures plot (estimates, their ±σ edges, residuals, NIS): a million fixes are drawn from at
+/// most 2 048·(2 + 2·40) of them, not held whole (176 bytes a fix).
+fn figure_fixes(n: usize, report: impl Fn(usize) -> FixReport) -> Vec<FixReport> {
+    if n <= FIGURE_ALL_FIXES {
+        return (0..n).map(report).collect();
+    }
+    let mut kept = Vec::new();
+    for slice in 0..FIGURE_SLICES {
+        let (from, to) = (slice * n / FIGURE_SLICES, (slice + 1) * n / FIGURE_SLICES);
+        let mut least = [(f64::INFINITY, usize::MAX); PLOTTED];
+        let mut most = [(f64::NEG_INFINITY, usize::MAX); PLOTTED];
+        for i in from..to {
+            for (k, v) in plotted(&report(i)).into_iter().enumerate() {
+                // NaN compares false: never an extreme.
+                if v < least[k].0 {
+                    least[k] = (v, i);
+                }
+                if v > most[k].0 {
+                    most[k] = (v, i);
+                }
+            }
+        }
+        let mut at: Vec<usize> = [from, to - 1]
+            .into_iter()
+            .chain(least.iter().chain(&most).map(|&(_, i)| i))
+            .filter(|&i| i < to)
+            .collect();
+        at.sort_unstable();
+        at.dedup();
+        kept.extend(at.into_iter().map(&report));
+    }
+    kept
+}
+
+/// How many numbers of a fix the figures plot.
+const PLOTTED: usize = 8 * ErrorState::DIM + 7 * ErrorState::MEAS + 2;
+
+/// The numbers of `f` the figures plot: each estimate, its σ and ±σ edges; the fix, the
+/// integration, the corrected trajectory and the drift; the residuals and their ±σ; the NIS and
+/// the bias's departure.
+fn plotted(f: &FixReport) -> [f64; PLOTTED] {
+    const _: () = assert!(
+        ErrorState::MEAS == 2,
+        "the measured components' states below"
+    );
+    let states = [ErrorState::POSITION, ErrorState::VELOCITY];
+    let b = ErrorState::BIAS;
+    let mut v = Vec::with_capacity(PLOTTED);
+    for k in 0..ErrorState::DIM {
+        for (x, s) in [
+            (f.filtered[k], f.filtered_sigma[k]),
+            (f.smoothed[k], f.smoothed_sigma[k]),
+        ] {
+            v.extend([x, x - s, x + s, s]);
+        }
+    }
+    for (k, state) in states.into_iter().enumerate() {
+        let (r, s, pc) = (f.residual[k], f.residual_sigma[k], f.integrated[k]);
+        v.extend([f.z[k], pc, r, -s, s, pc + f.smoothed[state], pc - f.z[k]]);
+    }
+    let departure = super::diagnose::bias_departure(
+        [f.filtered[b], f.filtered_sigma[b].powi(2)],
+        [f.smoothed[b], f.smoothed_sigma[b].powi(2)],
+    );
+    v.extend([f.nis, departure.unwrap_or(f64::NAN)]);
+    v.try_into().expect("PLOTTED numbers")
+}
 
 impl Prepared<'_> {
     /// The calibration's summary and per-fix series.
@@ -12,7 +89,7 @@ impl Prepared<'_> {
         let f = &s.filter_stats;
         let sc = &self.scan;
         let start_smoothed = match (self.fixes.first(), self.smoothed.first()) {
-            (Some(fix), Some(sm)) => sm.smooth(
+            (Some(fix), Some(sm)) => sm.carry(fix).smooth(
                 &StateVector::zeros(),
                 &self.model.p0,
                 &fix.phi_from_previous,
@@ -20,23 +97,21 @@ impl Prepared<'_> {
             _ => (StateVector::zeros(), self.model.p0),
         };
         let nis: Vec<f64> = self.fixes.iter().map(|f| f.nis).collect();
-        let fixes: Vec<FixReport> = self
-            .fixes
-            .iter()
-            .zip(&self.smoothed)
-            .map(|(f, sm)| FixReport {
+        let fixes = figure_fixes(self.fixes.len(), |i| {
+            let (f, sm) = (&self.fixes[i], &self.smoothed[i]);
+            FixReport {
                 t_s: f.t_s,
                 z: f.z.into(),
                 integrated: f.integrated.into(),
                 filtered: f.post.into(),
-                filtered_sigma: sigma(&f.p_post),
+                filtered_sigma: f.p_post.sigma(),
                 smoothed: sm.x.into(),
-                smoothed_sigma: sigma(&sm.p),
+                smoothed_sigma: sm.p.sigma(),
                 residual: f.residual.into(),
                 residual_sigma: std::array::from_fn(|k| f.s[(k, k)].sqrt()),
                 nis: f.nis,
-            })
-            .collect();
+            }
+        });
         let (lo, hi) = sc.accepted_step_s();
         let nis_test = nis_test(&nis, s.false_alarm_rate);
         let diagnostics = diagnose::diagnose(
@@ -144,5 +219,78 @@ impl Prepared<'_> {
     /// Which Δt mode runs.
     pub fn mode(&self) -> StepMode {
         self.scan.mode
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Fix `i`'s report: noise-like numbers from a hash of `i`, the NIS with a lone spike.
+    fn report(i: usize) -> FixReport {
+        let u = |k: u64| {
+            let h = (i as u64 ^ (k << 40)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            (h >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        FixReport {
+            t_s: i as f64 * 0.005,
+            z: [u(1), u(2)],
+            integrated: [u(3), u(4)],
+            filtered: [u(5), u(6), u(7)],
+            filtered_sigma: [1.0 + u(8), 1.0 + u(9), 1.0 + u(10)],
+            smoothed: [u(11), u(12), u(13)],
+            smoothed_sigma: [0.5 + u(14), 0.5 + u(15), 0.5 + u(16)],
+            residual: [u(17), u(18)],
+            residual_sigma: [1.0 + u(19), 1.0 + u(20)],
+            nis: if i == 123_457 { 1e6 } else { 2.0 + u(21) },
+        }
+    }
+
+    #[test]
+    fn a_short_log_keeps_every_fix() {
+        let kept = figure_fixes(FIGURE_ALL_FIXES, report);
+        assert_eq!(kept.len(), FIGURE_ALL_FIXES);
+        assert!(kept.iter().enumerate().all(|(i, f)| *f == report(i)));
+    }
+
+    #[test]
+    fn a_long_log_keeps_each_slice_s_ends_and_extremes() {
+        let n = 300_000;
+        let kept = figure_fixes(n, report);
+        assert!(
+            kept.len() <= FIGURE_SLICES * (2 + 2 * PLOTTED),
+            "{}",
+            kept.len()
+        );
+        assert!(kept.len() < n / 2, "{} of {n} kept", kept.len());
+        // In time order, each fix once, the log's ends and its spike among them.
+        assert!(kept.windows(2).all(|w| w[0].t_s < w[1].t_s));
+        assert_eq!(kept[0], report(0));
+        assert_eq!(kept.last(), Some(&report(n - 1)));
+        assert!(kept.iter().any(|f| f.nis == 1e6));
+        // Every slice's least and greatest of every plotted number are drawn.
+        for slice in [0, 1, FIGURE_SLICES / 2, FIGURE_SLICES - 1] {
+            let (from, to) = (slice * n / FIGURE_SLICES, (slice + 1) * n / FIGURE_SLICES);
+            let in_slice: Vec<&FixReport> = kept
+                .iter()
+                .filter(|f| (from as f64 * 0.005..to as f64 * 0.005).contains(&f.t_s))
+                .collect();
+            for k in 0..PLOTTED {
+                let all = (from..to).map(|i| plotted(&report(i))[k]);
+                let drawn = in_slice.iter().map(|f| plotted(f)[k]);
+                let lo = |v: &mut dyn Iterator<Item = f64>| v.fold(f64::INFINITY, f64::min);
+                let hi = |v: &mut dyn Iterator<Item = f64>| v.fold(f64::NEG_INFINITY, f64::max);
+                assert_eq!(
+                    lo(&mut all.clone()),
+                    lo(&mut drawn.clone()),
+                    "slice {slice} {k}"
+                );
+                assert_eq!(
+                    hi(&mut all.clone()),
+                    hi(&mut drawn.clone()),
+                    "slice {slice} {k}"
+                );
+            }
+        }
     }
 }

@@ -169,6 +169,8 @@ impl Prepared<'_> {
         out.write_all(header.as_bytes())?;
         let mut rows = summary::EstimateChunks::new(out);
         let (mut seen, mut next) = (0usize, 0usize);
+        // λ and Λ of the fix `next`, formed when its first sample comes.
+        let mut carry: Option<(usize, smoother::Carry)> = None;
         let changed = || LogError::of_file(self.accel.name(), LogProblem::Changed);
         self.forward_pass(&mut |fw, applied| {
             for f in applied {
@@ -182,7 +184,13 @@ impl Prepared<'_> {
                 next += 1;
             }
             let (xs, ps) = match (self.fixes.get(next), self.smoothed.get(next)) {
-                (Some(f), Some(sm)) => sm.smooth(&fw.x, &fw.p, &fw.transition_to(f)),
+                (Some(f), Some(sm)) => {
+                    if carry.as_ref().is_none_or(|(at, _)| *at != next) {
+                        carry = Some((next, sm.carry(f)));
+                    }
+                    let (_, c) = carry.as_ref().expect("formed above");
+                    c.smooth(&fw.x, &fw.p, &fw.transition_to(f))
+                }
                 _ => (fw.x, fw.p),
             };
             let row = EstimateRow {

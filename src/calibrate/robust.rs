@@ -245,7 +245,7 @@ pub fn bias_terms(fixes: &[FilteredFix]) -> (Vec<f64>, Vec<f64>) {
             return (vec![], vec![]);
         };
         let s_inv: MeasMatrix = s_inv;
-        let gain = f.p_prior * h.transpose() * s_inv;
+        let gain = f.p_prior.matrix() * h.transpose() * s_inv;
         let a = gain.transpose() * lambda;
         psi[i] = a.dot(&f.residual);
         predicted[i] = (a.transpose() * f.s * a)[(0, 0)];

@@ -19,19 +19,26 @@
 //! the RTS recursion composed over the interval. At a fix (k = a, x̂_a = x̂_a⁺) it is the
 //! fix-level RTS step, which the backward pass runs from the last fix to the first; after the
 //! last fix no measurement follows and the smoothed estimate is the filtered one. So the backward
-//! pass keeps O(fixes) and every sample's smoothed value costs a few 3×3 products.
+//! pass keeps O(fixes) and every sample's smoothed value costs a few 3×3 products (λ_b and Λ_b
+//! once for the samples before each fix).
 
 use crate::state::{StateMatrix, StateVector};
 
 use super::forward::FilteredFix;
+use super::symmetric::Symmetric;
 
-/// The smoothed estimate at a fix and what the samples before it need.
+/// The smoothed estimate at a fix.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SmoothedFix {
     /// Smoothed estimate x̂^s at the fix.
     pub x: StateVector,
     /// Its covariance P^s.
-    pub p: StateMatrix,
+    pub p: Symmetric,
+}
+
+/// What the samples before a fix need of its smoothed estimate: formed when they are reached,
+/// not kept at every fix.
+pub struct Carry {
     /// λ = (P⁻)⁻¹ (x̂^s − x̂⁻).
     lambda: StateVector,
     /// Λ = (P⁻)⁻¹ (P^s − P⁻) (P⁻)⁻¹.
@@ -43,16 +50,17 @@ fn symmetric(m: StateMatrix) -> StateMatrix {
 }
 
 impl SmoothedFix {
-    fn new(f: &FilteredFix, x: StateVector, p: StateMatrix) -> Self {
-        let inv = &f.p_prior_inv;
-        Self {
-            lambda: inv * (x - f.prior),
-            big_lambda: symmetric(inv * (p - f.p_prior) * inv),
-            x,
-            p,
+    /// The smoothed estimate at the fix `f`, carried to the samples before it.
+    pub fn carry(&self, f: &FilteredFix) -> Carry {
+        let inv = f.p_prior_inv();
+        Carry {
+            lambda: inv * (self.x - f.prior),
+            big_lambda: symmetric(inv * (self.p.matrix() - f.p_prior.matrix()) * inv),
         }
     }
+}
 
+impl Carry {
     /// The smoothed estimate and covariance at a sample whose filtered ones are `x`, `p`, with
     /// this fix the next one after it and `phi` the transition from the sample to this fix.
     pub fn smooth(
@@ -75,11 +83,20 @@ pub fn backward(fixes: &[FilteredFix]) -> Vec<SmoothedFix> {
     for (i, f) in fixes.iter().enumerate().rev() {
         let smoothed = match fixes.get(i + 1) {
             // At the last fix nothing follows: smoothed = filtered.
-            None => SmoothedFix::new(f, f.post, f.p_post),
+            None => SmoothedFix {
+                x: f.post,
+                p: f.p_post,
+            },
             Some(next) => {
                 let after = out.last().expect("the later fix was smoothed first");
-                let (x, p) = after.smooth(&f.post, &f.p_post, &next.phi_from_previous);
-                SmoothedFix::new(f, x, p)
+                let (x, p) =
+                    after
+                        .carry(next)
+                        .smooth(&f.post, &f.p_post.matrix(), &next.phi_from_previous);
+                SmoothedFix {
+                    x,
+                    p: Symmetric::of(&p),
+                }
             }
         };
         out.push(smoothed);

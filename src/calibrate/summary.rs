@@ -89,7 +89,7 @@ pub(super) fn push_fix_row(out: &mut String, f: &FilteredFix, gps_t_s: f64, sm: 
     let (gp, gv) = (ErrorState::GPS_POSITION, ErrorState::GPS_VELOCITY);
     let (dp, dv, b) = (ErrorState::POSITION, ErrorState::VELOCITY, ErrorState::BIAS);
     let (pc, vc) = (f.integrated[gp], f.integrated[gv]);
-    let (s0, s1, s2) = (sigma(&f.p_prior), sigma(&f.p_post), sigma(&sm.p));
+    let (s0, s1, s2) = (f.p_prior.sigma(), f.p_post.sigma(), sm.p.sigma());
     let (x0, x1, x2) = (&f.prior, &f.post, &sm.x);
     push_row(
         out,

@@ -4,7 +4,7 @@
 use crate::state::BiasModel;
 use crate::stats::normal_bound;
 
-use super::{BiasDiagnostics, FixSeries};
+use super::{BiasDiagnostics, Series, each};
 
 /// A fix enters the bias steadiness test when the smoother has removed at least this fraction of
 /// its filtered variance: near the end of the log the difference of the two estimates and of
@@ -20,24 +20,26 @@ pub fn bias_departure(filtered: [f64; 2], smoothed: [f64; 2]) -> Option<f64> {
 }
 
 /// The bias's path through `series` for a filter assuming `model`, tested at α.
-pub(super) fn bias(series: &[FixSeries], model: BiasModel, alpha: f64) -> BiasDiagnostics {
+pub(super) fn bias<S: Series + ?Sized>(
+    series: &S,
+    model: BiasModel,
+    alpha: f64,
+) -> BiasDiagnostics {
     // A constant bias's smoothed estimate is one number, the last fix's: the others differ from
     // it by rounding alone, which is no range.
     let path: Vec<f64> = match model {
-        BiasModel::Constant => series
-            .last()
-            .map(|f| f.bias_smoothed[0])
+        BiasModel::Constant => (series.len().checked_sub(1))
+            .map(|last| series.at(last).bias_smoothed[0])
             .into_iter()
             .collect(),
-        _ => series.iter().map(|f| f.bias_smoothed[0]).collect(),
+        _ => each(series).map(|f| f.bias_smoothed[0]).collect(),
     };
     let lo = path.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = path.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let mut sigmas: Vec<f64> = series.iter().map(|f| f.bias_smoothed[1].sqrt()).collect();
+    let mut sigmas: Vec<f64> = each(series).map(|f| f.bias_smoothed[1].sqrt()).collect();
     sigmas.sort_by(f64::total_cmp);
     let median_sigma = sigmas.get(sigmas.len() / 2).copied().unwrap_or(f64::NAN);
-    let departures: Vec<(f64, f64)> = series
-        .iter()
+    let departures: Vec<(f64, f64)> = each(series)
         .filter_map(|f| Some((f.t_s, bias_departure(f.bias_filtered, f.bias_smoothed)?)))
         .collect();
     let (t_s, worst) = departures
