@@ -135,20 +135,26 @@ impl Prepared<'_> {
     /// per-sample recursion (the reduced pass agrees to rounding); in nominal mode they are
     /// the same bits already, and nothing is read.
     ///
+    /// The reduced pass's fixes and their smoothed estimates are freed before the pass, so that
+    /// the two sets are never held together (a million fixes: 400 MB each).
+    ///
     /// # Errors
-    /// As [`Prepared::write_estimates`].
+    /// As [`Prepared::write_estimates`]; the calibration holds no fixes then and is to be
+    /// prepared again.
     pub fn per_sample(&mut self) -> Result<(), CalibrateError> {
         if self.scan.mode == StepMode::Nominal {
             return Ok(());
         }
-        let mut fixes = Vec::with_capacity(self.fixes.len());
+        let count = self.fixes.len();
+        (self.fixes, self.smoothed) = (Vec::new(), Vec::new());
+        let mut fixes = Vec::with_capacity(count);
         let mut end = self.end;
         self.forward_pass(&mut |fw, applied| {
             fixes.extend_from_slice(applied);
             end = (fw.x, fw.p);
             Ok(())
         })?;
-        if fixes.len() != self.fixes.len() {
+        if fixes.len() != count {
             return Err(LogError::of_file(self.accel.name(), LogProblem::Changed).into());
         }
         self.smoothed = smoother::backward(&fixes);
