@@ -30,7 +30,7 @@ fn write_logs(dir: &Path, n: usize) {
 /// code 0.
 fn calibrate(dir: &Path, limit_s: u64) -> (f64, f64) {
     let start = Instant::now();
-    let mut child = Command::new(common::bin())
+    let child = Command::new(common::bin())
         .args(["calibrate", "--accel", "accel.csv", "--gps", "gps.csv"])
         .args(["--out", "out", "-q"])
         .current_dir(dir)
@@ -39,34 +39,13 @@ fn calibrate(dir: &Path, limit_s: u64) -> (f64, f64) {
         .stderr(Stdio::piped())
         .spawn()
         .expect("the binary runs");
-    let pid = child.id() as i32;
-    let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
-    loop {
-        // SAFETY: rusage is plain data that wait4 fills; the pid is our own unwaited child.
-        let done = unsafe { libc::wait4(pid, &mut status, libc::WNOHANG, &mut usage) };
-        if done == pid {
-            break;
-        }
-        assert_eq!(done, 0, "wait4 failed");
-        if start.elapsed().as_secs() > limit_s {
-            child.kill().unwrap();
-            child.wait().unwrap();
-            panic!("{}: not done within {limit_s} s", dir.display());
-        }
-        std::thread::sleep(std::time::Duration::from_millis(10));
-    }
+    let ended = common::wait_measured(child, limit_s);
     let elapsed = start.elapsed().as_secs_f64();
-    // Already reaped by wait4: std's wait finds no child.
-    assert!(child.wait().is_err());
-    let mut stderr = String::new();
-    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
-    assert!(
-        libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
-        "{}: status {status}: {stderr}",
-        dir.display()
-    );
-    // ru_maxrss is in kilobytes on Linux.
-    (elapsed, usage.ru_maxrss as f64 * 1024.0)
+    match ended.code {
+        Some(0) => (elapsed, ended.peak_bytes),
+        Some(code) => panic!("{}: exit {code}: {}", dir.display(), ended.stderr),
+        None => panic!("{}: not done within {limit_s} s", dir.display()),
+    }
 }
 
 #[test]

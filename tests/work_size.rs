@@ -3,6 +3,8 @@
 //! process, from `wait4`) from above within a factor 2, and a run predicted to need more than
 //! the machine has is refused at once with the figure and the key to change.
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Stdio};
 
@@ -15,7 +17,7 @@ const THREADS: usize = 2;
 /// Runs the binary with `args` in `dir` and returns its exit code and maximum resident set,
 /// bytes.
 fn peak_of(dir: &Path, args: &[&str]) -> (i32, f64) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_accelcal"))
+    let child = Command::new(env!("CARGO_BIN_EXE_accelcal"))
         .args(args)
         .current_dir(dir)
         .env("RAYON_NUM_THREADS", THREADS.to_string())
@@ -23,15 +25,11 @@ fn peak_of(dir: &Path, args: &[&str]) -> (i32, f64) {
         .stdout(Stdio::null())
         .spawn()
         .unwrap();
-    let mut status = 0;
-    // SAFETY: rusage is plain data that wait4 fills; the pid is our own unwaited child.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    let pid = unsafe { libc::wait4(child.id() as i32, &mut status, 0, &mut usage) };
-    assert_eq!(pid, child.id() as i32);
-    // Already reaped by wait4: std's wait finds no child, which is what is expected here.
-    assert!(child.wait().is_err());
-    // ru_maxrss is in kilobytes on Linux.
-    (libc::WEXITSTATUS(status), usage.ru_maxrss as f64 * 1024.0)
+    let ended = common::wait_measured(child, 3600);
+    (
+        ended.code.expect("the run ends with a code"),
+        ended.peak_bytes,
+    )
 }
 
 fn estimate(text: &str, work: Work) -> f64 {

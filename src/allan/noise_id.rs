@@ -203,6 +203,16 @@ mod tests {
             .collect()
     }
 
+    /// The running sums of `v`: a random walk of white steps.
+    fn cumulative(v: &[f64]) -> Vec<f64> {
+        v.iter()
+            .scan(0.0, |acc, w| {
+                *acc += w;
+                Some(*acc)
+            })
+            .collect()
+    }
+
     /// [`identify`] as Riley & Greenhall state it, one series after another.
     fn identify_reference(means: &[f64]) -> (u32, f64) {
         let mut z = remove_line(means);
@@ -222,22 +232,8 @@ mod tests {
     fn one_pass_agrees_with_the_two_pass_reference() {
         let mut s = Stream::new(11, 0);
         let white: Vec<f64> = (0..5000).map(|_| 3.0 + s.normal()).collect();
-        let mut acc = 0.0;
-        let walk: Vec<f64> = white
-            .iter()
-            .map(|w| {
-                acc += w;
-                acc
-            })
-            .collect();
-        let mut acc2 = 0.0;
-        let walk2: Vec<f64> = walk
-            .iter()
-            .map(|w| {
-                acc2 += w;
-                acc2
-            })
-            .collect();
+        let walk = cumulative(&white);
+        let walk2 = cumulative(&walk);
         let phase: Vec<f64> = white.windows(2).map(|w| w[1] - w[0]).collect();
         for (name, series) in [
             ("white", &white),
@@ -268,14 +264,7 @@ mod tests {
     fn tells_white_from_random_walk_and_white_phase() {
         let mut s = Stream::new(7, 0);
         let white: Vec<f64> = (0..4000).map(|_| s.normal()).collect();
-        let mut acc = 0.0;
-        let walk: Vec<f64> = white
-            .iter()
-            .map(|w| {
-                acc += w;
-                acc
-            })
-            .collect();
+        let walk = cumulative(&white);
         let phase: Vec<f64> = white.windows(2).map(|w| w[1] - w[0]).collect();
         assert_eq!(identify(&white).unwrap().alpha, 0);
         assert_eq!(identify(&walk).unwrap().alpha, -2);

@@ -5,7 +5,7 @@ use super::{Prepared, StepMode, diagnose, nis_test, noise, robust, warnings};
 use crate::state::{ErrorState, StateVector};
 
 /// Up to this many fixes the figures are drawn from every one.
-pub const FIGURE_ALL_FIXES: usize = 1 << 16;
+const FIGURE_ALL_FIXES: usize = 1 << 16;
 /// A longer log's figures are drawn from this many slices of its fixes, equal in number.
 const FIGURE_SLICES: usize = 2048;
 
@@ -60,25 +60,28 @@ fn plotted(f: &FixReport) -> [f64; PLOTTED] {
     );
     let states = [ErrorState::POSITION, ErrorState::VELOCITY];
     let b = ErrorState::BIAS;
-    let mut v = Vec::with_capacity(PLOTTED);
-    for k in 0..ErrorState::DIM {
-        for (x, s) in [
-            (f.filtered[k], f.filtered_sigma[k]),
-            (f.smoothed[k], f.smoothed_sigma[k]),
-        ] {
-            v.extend([x, x - s, x + s, s]);
-        }
-    }
-    for (k, state) in states.into_iter().enumerate() {
-        let (r, s, pc) = (f.residual[k], f.residual_sigma[k], f.integrated[k]);
-        v.extend([f.z[k], pc, r, -s, s, pc + f.smoothed[state], pc - f.z[k]]);
-    }
     let departure = super::diagnose::bias_departure(
         [f.filtered[b], f.filtered_sigma[b].powi(2)],
         [f.smoothed[b], f.smoothed_sigma[b].powi(2)],
     );
-    v.extend([f.nis, departure.unwrap_or(f64::NAN)]);
-    v.try_into().expect("PLOTTED numbers")
+    let estimates = (0..ErrorState::DIM).flat_map(|k| {
+        [
+            (f.filtered[k], f.filtered_sigma[k]),
+            (f.smoothed[k], f.smoothed_sigma[k]),
+        ]
+        .into_iter()
+        .flat_map(|(x, s)| [x, x - s, x + s, s])
+    });
+    let measured = states.into_iter().enumerate().flat_map(|(k, state)| {
+        let (r, s, pc) = (f.residual[k], f.residual_sigma[k], f.integrated[k]);
+        [f.z[k], pc, r, -s, s, pc + f.smoothed[state], pc - f.z[k]]
+    });
+    let mut numbers = estimates
+        .chain(measured)
+        .chain([f.nis, departure.unwrap_or(f64::NAN)]);
+    let v = std::array::from_fn(|_| numbers.next().expect("PLOTTED numbers"));
+    assert!(numbers.next().is_none(), "more than PLOTTED numbers");
+    v
 }
 
 impl Prepared<'_> {

@@ -62,6 +62,53 @@ pub fn summary_without_timing(path: &Path) -> serde_json::Value {
     v
 }
 
+/// What a child ended with, measured by [`wait_measured`].
+pub struct Measured {
+    /// Its exit code: `None` when it was killed at the limit (or ended by a signal).
+    pub code: Option<i32>,
+    /// Its peak resident memory (the maximum resident set, from `wait4`), bytes.
+    pub peak_bytes: f64,
+    /// Its stderr, when the caller piped it (empty otherwise).
+    pub stderr: String,
+}
+
+/// Waits for `child` at most `limit_s` seconds (then kills it), reaping it with `wait4` for
+/// its maximum resident set.
+pub fn wait_measured(mut child: Child, limit_s: u64) -> Measured {
+    let start = Instant::now();
+    let pid = child.id() as i32;
+    let mut status = 0;
+    // SAFETY: rusage is plain data that wait4 fills.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    let killed = loop {
+        // SAFETY: the pid is our own unwaited child; status and usage are ours to fill.
+        let done = unsafe { libc::wait4(pid, &mut status, libc::WNOHANG, &mut usage) };
+        if done == pid {
+            // Already reaped by wait4: std's wait finds no child.
+            assert!(child.wait().is_err());
+            break false;
+        }
+        assert_eq!(done, 0, "wait4 failed");
+        if start.elapsed() > Duration::from_secs(limit_s) {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            break true;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    let mut stderr = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        std::io::Read::read_to_string(&mut e, &mut stderr).unwrap();
+    }
+    let exited = !killed && libc::WIFEXITED(status);
+    Measured {
+        code: exited.then(|| libc::WEXITSTATUS(status)),
+        // ru_maxrss is in kilobytes on Linux.
+        peak_bytes: usage.ru_maxrss as f64 * 1024.0,
+        stderr,
+    }
+}
+
 /// Waits for `child` at most `limit_s` seconds (then kills it: `None`); its status and stderr
 /// (piped by the caller).
 pub fn wait_limited(mut child: Child, limit_s: u64) -> (Option<ExitStatus>, String) {
