@@ -40,6 +40,9 @@ pub enum Command {
     /// Measure the accelerometer's noise terms from a static log: Allan deviation with
     /// intervals, N, B and K, and noise.toml for calibrate.
     Allan(AllanArgs),
+    /// Calibrate an IMU on a table: bias, scale factors and non-orthogonality from a few static
+    /// poses turned by hand, each with its interval, written to intrinsics.json.
+    Intrinsics(IntrinsicsArgs),
     /// Print the default configuration file.
     Config(ConfigArgs),
 }
@@ -324,6 +327,58 @@ pub struct AllanArgs {
     /// its length. The numbers are the same either way.
     #[arg(long, value_name = "MB", default_value_t = accelcal::allan::imu::stream::DEFAULT_HOLD_BYTES >> 20, requires = "imu")]
     pub memory: usize,
+    /// Print nothing but the result.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Options of `intrinsics`.
+#[derive(Debug, Args)]
+#[command(group(ArgGroup::new("local_gravity").required(true).args(["latitude", "gravity"])))]
+pub struct IntrinsicsArgs {
+    /// The six-axis log of the session: CSV with t_s, ax_m_s2, ay_m_s2, az_m_s2, gx_rad_s,
+    /// gy_rad_s, gz_rad_s; an MCAP file or a ROS 2 bag directory (storage mcap) of
+    /// sensor_msgs/msg/Imu, or a ROS 1 bag of sensor_msgs/Imu.
+    #[arg(long, value_name = "FILE")]
+    pub imu: PathBuf,
+    /// The IMU topic of an MCAP file or a bag (needed when it has several).
+    #[arg(long, value_name = "NAME")]
+    pub topic: Option<String>,
+    /// Geodetic latitude of the table, degrees: local gravity is then normal gravity there (with
+    /// --height), and the Earth's rate is allowed for by its vertical and horizontal parts.
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub latitude: Option<f64>,
+    /// Height of the table above the ellipsoid, m (with --latitude).
+    #[arg(
+        long,
+        value_name = "M",
+        default_value_t = 0.0,
+        requires = "latitude",
+        allow_negative_numbers = true
+    )]
+    pub height: f64,
+    /// Local gravity's magnitude, m/s², when known better than normal gravity (instead of
+    /// --latitude; the Earth's rate is then allowed for in any direction).
+    #[arg(long, value_name = "M_S2", conflicts_with = "latitude")]
+    pub gravity: Option<f64>,
+    /// The static detector's window, s.
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    pub window: f64,
+    /// The shortest static interval kept, s.
+    #[arg(long, value_name = "S", default_value_t = 2.0)]
+    pub min_static: f64,
+    /// Rate at which the detector calls a still window moving.
+    #[arg(long, value_name = "P", default_value_t = 1e-3)]
+    pub false_alarm: f64,
+    /// Confidence of the two-sided intervals, in (0, 1).
+    #[arg(long, value_name = "C", default_value_t = 0.95)]
+    pub confidence: f64,
+    /// Rate at which the goodness-of-fit tests reject a log drawn from the model, in (0, 1).
+    #[arg(long, value_name = "P", default_value_t = 0.01)]
+    pub alpha: f64,
+    /// Directory that receives intrinsics.json.
+    #[arg(long, value_name = "DIR", default_value = "intrinsics")]
+    pub out: PathBuf,
     /// Print nothing but the result.
     #[arg(long, short)]
     pub quiet: bool,

@@ -31,6 +31,7 @@ pub mod filter;
 pub mod format;
 pub mod input;
 pub mod ins;
+pub mod intrinsics;
 pub mod lanes;
 pub mod likelihood;
 pub mod logs;

@@ -6,6 +6,7 @@
 mod allan;
 mod calibrate_imu;
 mod ins;
+mod intrinsics;
 mod logs;
 mod monte_carlo;
 mod shards;
@@ -44,6 +45,7 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
             || e.is::<partial::PartialError>()
             || e.is::<accelcal::allan::AllanError>()
             || e.is::<accelcal::allan::imu::ImuError>()
+            || e.is::<accelcal::intrinsics::IntrinsicsError>()
             || e.is::<logs::UsageError>()
             || e.downcast_ref::<CalibrateError>()
                 .is_some_and(CalibrateError::is_bad_input)
@@ -115,6 +117,7 @@ pub fn run(cli: Cli) -> Result<()> {
             _ => logs::run_calibrate(&args),
         },
         Some(Command::Allan(args)) => allan::run_allan(&args),
+        Some(Command::Intrinsics(args)) => intrinsics::run(&args),
         Some(Command::Config(args)) => say(&match args.model {
             ModelKind::Accelerometer => DEFAULT_TOML.to_string(),
             ModelKind::Ins => accelcal::config::ins::DEFAULT_INS_TOML.to_string(),
