@@ -7,7 +7,12 @@
 //! static when T_k ≤ χ²_{1−α}(6(L − 1)): a still window is called moving at the rate α. A static
 //! interval is a run of static samples at least `min_static_s` long.
 //!
-//! The σ_c² are measured in the log by iteration: first from the fifth of the windows whose
+//! A run is kept only where the IMU can be at rest: its mean specific force within
+//! [`MAX_GRAVITY_SHARE`] of gravity's magnitude and its mean angular rate under
+//! [`MAX_REST_RATE_RAD_S`] (beyond any MEMS gyro's bias) — so that a log moving throughout, whose
+//! quietest windows would otherwise set the noise, finds no pose.
+//!
+//! The σ_c² are measured in the log by iteration: first from the tenth of the windows whose
 //! variances are smallest, then pooled over the windows inside the intervals found, until the
 //! intervals no longer change. A channel quantized so coarsely that it is constant is held to a
 //! variance of q²/12 (q its least step between samples).
@@ -16,6 +21,12 @@ use nalgebra::Vector3;
 
 use super::{IntrinsicsError, SixAxisLog};
 use crate::stats::{Tail, chi_squared_quantile};
+
+/// A still IMU's mean specific force is within this share of gravity's magnitude (scale
+/// factors of a few %, biases of a few % of g).
+pub const MAX_GRAVITY_SHARE: f64 = 0.2;
+/// A still IMU's mean angular rate is under this, rad/s (about 11°/s).
+pub const MAX_REST_RATE_RAD_S: f64 = 0.2;
 
 /// How the static intervals are found.
 #[derive(Clone, Copy, Debug)]
@@ -139,7 +150,11 @@ fn quantum_floor(log: &SixAxisLog, c: usize) -> f64 {
 /// # Errors
 /// [`IntrinsicsError::TooShort`] for a log under two windows, [`IntrinsicsError::NoStaticInterval`]
 /// when no interval is long enough.
-pub fn detect(log: &SixAxisLog, settings: &DetectorSettings) -> Result<Detection, IntrinsicsError> {
+pub fn detect(
+    log: &SixAxisLog,
+    settings: &DetectorSettings,
+    gravity_m_s2: f64,
+) -> Result<Detection, IntrinsicsError> {
     let tau = log.sample_period_s;
     let window = ((settings.window_s / tau).round() as usize).max(8);
     let n = log.len();
@@ -158,26 +173,16 @@ pub fn detect(log: &SixAxisLog, settings: &DetectorSettings) -> Result<Detection
     let threshold = chi_squared_quantile(dof as f64, settings.false_alarm, Tail::Upper);
     let min_len = ((settings.min_static_s / tau).round() as usize).max(window);
 
-    // First guess: the fifth of the tiled windows with the smallest variances, all channels.
-    let tiles: Vec<usize> = (0..n / window).map(|i| i * window).collect();
-    let mut scored: Vec<(f64, usize)> = tiles
-        .iter()
-        .map(|&a| {
-            let score = (0..6)
-                .map(|c| (prefix[c].scatter(a, a + window) + floor[c]).ln())
-                .sum();
-            (score, a)
-        })
-        .collect();
-    scored.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let quiet: Vec<usize> = scored[..(scored.len() / 5).max(1)]
-        .iter()
-        .map(|s| s.1)
-        .collect();
-    let mut noise_var = pooled(&prefix, &floor, &quiet, window);
+    let mut noise_var = first_guess(&prefix, &floor, n, window);
     let mut runs: Vec<(usize, usize)> = Vec::new();
     for _ in 0..20 {
-        let found = static_runs(&prefix, &noise_var, window, threshold, min_len, n);
+        let mut found = static_runs(&prefix, &noise_var, window, threshold, min_len, n);
+        found.retain(|&(a, b)| {
+            let i = interval(log, &prefix, a, b);
+            let f = i.mean_specific_force.norm();
+            (f - gravity_m_s2).abs() <= MAX_GRAVITY_SHARE * gravity_m_s2
+                && i.mean_angular_rate.norm() < MAX_REST_RATE_RAD_S
+        });
         let inside: Vec<usize> = found
             .iter()
             .flat_map(|&(a, b)| (0..(b + 1 - a) / window).map(move |i| a + i * window))
@@ -201,16 +206,7 @@ pub fn detect(log: &SixAxisLog, settings: &DetectorSettings) -> Result<Detection
         * (window - 1);
     let intervals = runs
         .iter()
-        .map(|&(first, last)| {
-            let m = (last + 1 - first) as f64;
-            let mean = |c: usize| value(log, c, 0) + prefix[c].total(first, last + 1) / m;
-            StaticInterval {
-                first,
-                last,
-                mean_specific_force: Vector3::new(mean(0), mean(1), mean(2)),
-                mean_angular_rate: Vector3::new(mean(3), mean(4), mean(5)),
-            }
-        })
+        .map(|&(first, last)| interval(log, &prefix, first, last))
         .collect();
     Ok(Detection {
         intervals,
@@ -222,6 +218,38 @@ pub fn detect(log: &SixAxisLog, settings: &DetectorSettings) -> Result<Detection
         sample_period_s: tau,
         samples: n,
     })
+}
+
+/// The interval of samples `first..=last` with its means.
+fn interval(log: &SixAxisLog, prefix: &[Prefix], first: usize, last: usize) -> StaticInterval {
+    let m = (last + 1 - first) as f64;
+    let mean = |c: usize| value(log, c, 0) + prefix[c].total(first, last + 1) / m;
+    StaticInterval {
+        first,
+        last,
+        mean_specific_force: Vector3::new(mean(0), mean(1), mean(2)),
+        mean_angular_rate: Vector3::new(mean(3), mean(4), mean(5)),
+    }
+}
+
+/// The first guess of the noise: pooled over the tenth of the tiled windows whose variances,
+/// all channels together, are smallest.
+fn first_guess(prefix: &[Prefix], floor: &[f64], n: usize, window: usize) -> [f64; 6] {
+    let mut scored: Vec<(f64, usize)> = (0..n / window)
+        .map(|i| {
+            let a = i * window;
+            let score = (0..6)
+                .map(|c| (prefix[c].scatter(a, a + window) + floor[c]).ln())
+                .sum();
+            (score, a)
+        })
+        .collect();
+    scored.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let quiet: Vec<usize> = scored[..(scored.len() / 10).max(1)]
+        .iter()
+        .map(|s| s.1)
+        .collect();
+    pooled(prefix, floor, &quiet, window)
 }
 
 /// Each channel's variance pooled over the windows starting at `starts`, held to its floor.

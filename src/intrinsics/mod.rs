@@ -223,7 +223,7 @@ pub fn calibrate(log: &SixAxisLog, settings: &Settings) -> Result<Intrinsics, In
     }) {
         return Err(IntrinsicsError::NotFinite { index });
     }
-    let detection = detect::detect(log, &settings.detector)?;
+    let detection = detect::detect(log, &settings.detector, settings.gravity_m_s2)?;
     let accel = accel::fit(&detection, settings);
     let gyro = gyro::bias(&detection, &accel, settings);
     Ok(Intrinsics {
