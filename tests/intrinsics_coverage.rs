@@ -63,6 +63,22 @@ fn errors(t: &TrueIntrinsics, x: &Intrinsics) -> Vec<Option<(f64, f64)>> {
             x.gyro.bias[i].sigma,
         )));
     }
+    let g = x.gyro_matrix.as_ref().expect("turns between the poses");
+    for i in 0..9 {
+        let truth = t.gyro_matrix[(i / 3, i % 3)];
+        out.push(g.determined[i].then(|| (g.params[i] - truth, g.covariance[(i, i)].sqrt())));
+    }
+    for i in 0..3 {
+        out.push(Some((g.bias[i].value - t.gyro_bias[i], g.bias[i].sigma)));
+    }
+    let mut tp = accelcal::intrinsics::gyro_matrix::GyroParams::zeros();
+    for i in 0..9 {
+        tp[i] = t.gyro_matrix[(i / 3, i % 3)];
+    }
+    let d = accelcal::intrinsics::gyro_matrix::derived(&tp);
+    for (i, e) in g.scale_ppm.iter().chain(&g.misalignment_rad).enumerate() {
+        out.push(e.determined.then(|| (e.value - d[i], e.sigma)));
+    }
     out
 }
 
@@ -80,6 +96,19 @@ fn names() -> Vec<String> {
         .map(String::from),
     );
     n.extend(["gyro_bias_x", "gyro_bias_y", "gyro_bias_z"].map(String::from));
+    n.extend((0..9).map(|i| format!("gyro_matrix_{}{}", i / 3, i % 3)));
+    n.extend(
+        [
+            "turns_gyro_bias_x",
+            "turns_gyro_bias_y",
+            "turns_gyro_bias_z",
+        ]
+        .map(String::from),
+    );
+    n.extend(["gyro_scale_x", "gyro_scale_y", "gyro_scale_z"].map(String::from));
+    n.extend(
+        accelcal::intrinsics::gyro_matrix::MISALIGNMENT_NAMES.map(|m| format!("gyro_lean_{m}")),
+    );
     n
 }
 
@@ -87,7 +116,12 @@ fn names() -> Vec<String> {
 fn intervals_cover_the_truth_and_the_goodness_test_keeps_its_rate() {
     // Each session: its errors, and whether each goodness test rejected (None: untestable,
     // nine poses for nine parameters).
-    type Run = (Vec<Option<(f64, f64)>>, Option<bool>, Option<bool>);
+    type Run = (
+        Vec<Option<(f64, f64)>>,
+        Option<bool>,
+        Option<bool>,
+        Option<bool>,
+    );
     let runs: Vec<Run> = (0..SESSIONS)
         .into_par_iter()
         .map(|i| {
@@ -97,6 +131,10 @@ fn intervals_cover_the_truth_and_the_goodness_test_keeps_its_rate() {
                 errors(&t, &x),
                 x.accel.p_value.map(|p| p < alpha),
                 x.gyro.p_value.map(|p| p < alpha),
+                x.gyro_matrix
+                    .as_ref()
+                    .and_then(|g| g.p_value)
+                    .map(|p| p < alpha),
             )
         })
         .collect();
@@ -128,10 +166,14 @@ fn intervals_cover_the_truth_and_the_goodness_test_keeps_its_rate() {
         names.len(),
         "the half-width control must fail everywhere"
     );
-    for (which, k) in [("accel", 1), ("gyro", 2)] {
+    for (which, k) in [("accel", 1), ("gyro", 2), ("turns", 3)] {
         let tested: Vec<bool> = runs
             .iter()
-            .filter_map(|r| if k == 1 { r.1 } else { r.2 })
+            .filter_map(|r| match k {
+                1 => r.1,
+                2 => r.2,
+                _ => r.3,
+            })
             .collect();
         let n = tested.len() as u64;
         let rejected = tested.iter().filter(|r| **r).count() as u64;

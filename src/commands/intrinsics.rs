@@ -129,19 +129,7 @@ fn summary(x: &Intrinsics, out: &std::path::Path) -> String {
         );
     }
     s += &accel_lines(x);
-    let g = &x.gyro;
-    s += "gyros:\n";
-    for (axis, bias) in AXES.iter().zip(&g.bias) {
-        s += &format!("  {axis}: bias {}\n", shown(bias, 1.0, "rad/s"));
-    }
-    if let Some(p) = g.p_value {
-        s += &format!(
-            "  goodness: χ² = {} on {} degrees of freedom, p = {}\n",
-            sig(g.chi_squared, 4),
-            g.dof,
-            sig(p, 3)
-        );
-    }
+    s += &gyro_lines(x);
     s += &format!(
         "{} intervals at {} % confidence in {}\n",
         JSON_FILE,
@@ -206,6 +194,53 @@ fn accel_lines(x: &Intrinsics) -> String {
             sig(up[1], 2),
             sig(up[2], 2)
         );
+    }
+    s
+}
+
+/// The gyros' lines.
+fn gyro_lines(x: &Intrinsics) -> String {
+    let mut s = "gyros:\n".to_string();
+    let Some(m) = &x.gyro_matrix else {
+        for (axis, bias) in AXES.iter().zip(&x.gyro.bias) {
+            s += &format!(
+                "  {axis}: bias {} (no turn: matrix not determined)\n",
+                shown(bias, 1.0, "rad/s")
+            );
+        }
+        return s;
+    };
+    for (i, axis) in AXES.iter().enumerate() {
+        s += &format!(
+            "  {axis}: bias {}, scale {}\n",
+            shown(&m.bias[i], 1.0, "rad/s"),
+            shown(&m.scale_ppm[i], 1.0, "ppm")
+        );
+    }
+    let leans: Vec<String> = m
+        .misalignment_rad
+        .iter()
+        .zip(accelcal::intrinsics::gyro_matrix::MISALIGNMENT_NAMES)
+        .map(|(e, n)| format!("{n} {}", shown(e, 1e3, "mrad")))
+        .collect();
+    s += &format!("  misalignment: {}\n", leans.join(", "));
+    match m.p_value {
+        Some(p) => {
+            s += &format!(
+                "  goodness over {} turns: χ² = {} on {} degrees of freedom, p = {} ({} at α = {})\n",
+                m.turns,
+                sig(m.chi_squared, 4),
+                sig(m.dof, 3),
+                sig(p, 3),
+                if p < x.settings.alpha {
+                    "rejected"
+                } else {
+                    "not rejected"
+                },
+                sig(x.settings.alpha, 2)
+            );
+        }
+        None => s += "  goodness: not testable (no degree of freedom left)\n",
     }
     s
 }

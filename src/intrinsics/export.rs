@@ -6,13 +6,15 @@ use serde_json::{Value, json};
 use super::Intrinsics;
 use super::accel::{DERIVED_NAMES, Estimate, MATRIX_ENTRIES};
 use super::gyro::EARTH_RATE_RAD_S;
+use super::gyro_matrix::MISALIGNMENT_NAMES;
 
 /// The convention, as the file states it.
 pub const CONVENTION: &str = "corrected = matrix · (measured − bias), matrix row-major. The \
 accelerometers' matrix is lower triangular: the corrected frame's x axis is the sensor's x axis, \
-its y axis lies in the plane of the sensor's x and y axes. scale_ppm is each sensing axis's gain \
-|row i of matrix⁻¹| − 1; misalignment_rad is each pair of sensing axes' departure from 90° \
-(positive when closer). A value the poses do not determine is null, with determined = false.";
+its y axis lies in the plane of the sensor's x and y axes. The gyros' matrix is full: it \
+carries their axes into that frame. scale_ppm is each sensing axis's gain |row i of matrix⁻¹| \
+− 1; the accelerometers' misalignment_rad is each pair of sensing axes' departure from 90° \
+(positive when closer), the gyros' each sensing axis's lean towards another corrected axis. A value the poses do not determine is null, with determined = false.";
 
 /// A number, or null when the poses leave it undetermined.
 fn number(value: f64, determined: bool) -> Value {
@@ -79,24 +81,78 @@ fn accel_json(x: &Intrinsics) -> Value {
     })
 }
 
-/// The gyros' part.
+/// The gyros' part: the bias from the static poses and the turns together when there are
+/// turns, the matrix from the turns.
 fn gyro_json(x: &Intrinsics) -> Value {
     let g = &x.gyro;
+    let static_goodness = json!({
+        "chi_squared": g.chi_squared,
+        "dof": g.dof,
+        "p_value": g.p_value,
+        "alpha": x.settings.alpha,
+        "rejected": g.p_value.map(|p| p < x.settings.alpha),
+    });
+    let Some(m) = &x.gyro_matrix else {
+        return json!({
+            "bias": {
+                "value": g.bias.map(|e| e.value),
+                "sigma": g.bias.map(|e| e.sigma),
+                "unit": "rad/s",
+                "from": "static poses",
+            },
+            "matrix": { "value": Value::Null, "sigma": Value::Null },
+            "undetermined": ["matrix (no turn between two poses)"],
+            "static_goodness": static_goodness,
+        });
+    };
+    let sigma = |p: usize| m.covariance[(p, p)].sqrt();
+    let matrix: Vec<Vec<Value>> = (0..3)
+        .map(|r| {
+            (0..3)
+                .map(|c| number(m.params[3 * r + c], m.determined[3 * r + c]))
+                .collect()
+        })
+        .collect();
+    let matrix_sigma: Vec<Vec<Value>> = (0..3)
+        .map(|r| {
+            (0..3)
+                .map(|c| number(sigma(3 * r + c), m.determined[3 * r + c]))
+                .collect()
+        })
+        .collect();
+    let undetermined: Vec<String> = (0..9)
+        .filter(|&p| !m.determined[p])
+        .map(|p| {
+            format!(
+                "matrix_{}{}",
+                ["x", "y", "z"][p / 3],
+                ["x", "y", "z"][p % 3]
+            )
+        })
+        .collect();
     json!({
         "bias": {
-            "value": g.bias.map(|e| e.value),
-            "sigma": g.bias.map(|e| e.sigma),
-            "lower": g.bias.map(|e| e.lower),
-            "upper": g.bias.map(|e| e.upper),
+            "value": m.bias.map(|e| e.value),
+            "sigma": m.bias.map(|e| e.sigma),
             "unit": "rad/s",
+            "from": "static poses and turns",
         },
-        "matrix": { "value": Value::Null, "sigma": Value::Null, "determined": false },
+        "matrix": { "value": matrix, "sigma": matrix_sigma },
+        "scale_ppm": (0..3)
+            .map(|i| estimate(DERIVED_NAMES[i], "axis", &m.scale_ppm[i]))
+            .collect::<Vec<_>>(),
+        "misalignment_rad": (0..6)
+            .map(|i| estimate(MISALIGNMENT_NAMES[i], "lean", &m.misalignment_rad[i]))
+            .collect::<Vec<_>>(),
+        "undetermined": undetermined,
+        "turns": m.turns,
+        "static_goodness": static_goodness,
         "goodness": {
-            "chi_squared": g.chi_squared,
-            "dof": g.dof,
-            "p_value": g.p_value,
+            "chi_squared": m.chi_squared,
+            "dof": m.dof,
+            "p_value": m.p_value,
             "alpha": x.settings.alpha,
-            "rejected": g.p_value.map(|p| p < x.settings.alpha),
+            "rejected": m.p_value.map(|p| p < x.settings.alpha),
         },
     })
 }

@@ -6,7 +6,7 @@
 //! imu_tk's): static intervals found on the IMU alone ([`detect`]), the accelerometer's model
 //! fitted so that every interval's mean specific force has the magnitude of local gravity
 //! ([`accel`]), the gyros' bias from the same intervals with the Earth's rate allowed for
-//! ([`gyro`]). Unlike imu_tk, every weight is the noise measured in the log, the fit's covariance
+//! ([`gyro`]), and the gyros' matrix from the turns between them ([`gyro_matrix`]). Unlike imu_tk, every weight is the noise measured in the log, the fit's covariance
 //! gives the intervals, and a parameter the poses leave free is named, never given as a number.
 //!
 //! # Convention
@@ -20,6 +20,7 @@ pub mod accel;
 pub mod detect;
 pub mod export;
 pub mod gyro;
+pub mod gyro_matrix;
 pub mod simulate;
 
 use nalgebra::Vector3;
@@ -159,8 +160,10 @@ pub struct Intrinsics {
     pub detection: detect::Detection,
     /// The accelerometers' model.
     pub accel: accel::AccelFit,
-    /// The gyros' bias.
+    /// The gyros' bias from the static poses.
     pub gyro: gyro::GyroBias,
+    /// The gyros' matrix and bias from the turns between the poses; `None` with one pose.
+    pub gyro_matrix: Option<gyro_matrix::GyroFit>,
     /// The settings it was computed with.
     pub settings: Settings,
 }
@@ -226,10 +229,12 @@ pub fn calibrate(log: &SixAxisLog, settings: &Settings) -> Result<Intrinsics, In
     let detection = detect::detect(log, &settings.detector, settings.gravity_m_s2)?;
     let accel = accel::fit(&detection, settings);
     let gyro = gyro::bias(&detection, &accel, settings);
+    let gyro_matrix = gyro_matrix::fit(log, &detection, &accel, &gyro, settings);
     Ok(Intrinsics {
         detection,
         accel,
         gyro,
+        gyro_matrix,
         settings: *settings,
     })
 }
