@@ -95,6 +95,18 @@ fn the_ferraris_session_beside_imucal() {
     assert!(v["accel"]["suggested_pose_up"].is_array());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("not determined"), "{text}");
+    // The page: both figures, the tables, nothing outside itself.
+    let page = std::fs::read_to_string(dir.path().join("out/index.html")).expect("the page");
+    for id in [
+        "intrinsics-poses",
+        "intrinsics-residuals",
+        "accel-table",
+        "gyro-table",
+    ] {
+        assert!(page.contains(&format!("id=\"{id}\"")), "{id}");
+    }
+    assert!(page.contains("not determined"));
+    assert!(!page.contains("http://") && !page.contains("https://") && !page.contains("src="));
     assert!(text.contains("add a pose"), "{text}");
 }
 

@@ -17,6 +17,7 @@ use accelcal::intrinsics::{self, Intrinsics, IntrinsicsError, Settings, SixAxisL
 use accelcal::output::StagedFiles;
 
 const JSON_FILE: &str = "intrinsics.json";
+const PAGE_FILE: &str = "index.html";
 
 /// The settings the command line gives.
 fn settings(args: &IntrinsicsArgs) -> Result<Settings, IntrinsicsError> {
@@ -63,7 +64,7 @@ fn settings(args: &IntrinsicsArgs) -> Result<Settings, IntrinsicsError> {
 /// Runs `intrinsics`.
 pub(super) fn run(args: &IntrinsicsArgs) -> Result<()> {
     let settings = settings(args)?;
-    accelcal::output::check_directory(&args.out, &[JSON_FILE])?;
+    accelcal::output::check_directory(&args.out, &[JSON_FILE, PAGE_FILE])?;
     let path = &args.imu;
     let name = path.display().to_string();
     if !args.quiet && std::io::stderr().is_terminal() {
@@ -83,11 +84,28 @@ pub(super) fn run(args: &IntrinsicsArgs) -> Result<()> {
     let log = SixAxisLog::from_samples(&samples).with_context(|| name.clone())?;
     let x = intrinsics::calibrate(&log, &settings).with_context(|| name.clone())?;
     let json = intrinsics::export::intrinsics_json(&x, &name);
-    let mut staged = StagedFiles::create(&args.out, &[JSON_FILE])?;
-    staged
-        .writer(JSON_FILE)
-        .write_all(json.as_bytes())
-        .with_context(|| format!("cannot write {}", args.out.join(JSON_FILE).display()))?;
+    let command = format!(
+        "accelcal intrinsics --imu {name} {} --window {} --min-static {} --false-alarm {} --confidence {} --alpha {} --out {}",
+        match (args.gravity, args.latitude) {
+            (Some(g), _) => format!("--gravity {g}"),
+            (None, Some(l)) => format!("--latitude {l} --height {}", args.height),
+            (None, None) => String::new(),
+        },
+        args.window,
+        args.min_static,
+        args.false_alarm,
+        args.confidence,
+        args.alpha,
+        args.out.display()
+    );
+    let page = accelcal::report::intrinsics::render(&x, &name, &command)?;
+    let mut staged = StagedFiles::create(&args.out, &[JSON_FILE, PAGE_FILE])?;
+    for (file, text) in [(JSON_FILE, &json), (PAGE_FILE, &page)] {
+        staged
+            .writer(file)
+            .write_all(text.as_bytes())
+            .with_context(|| format!("cannot write {}", args.out.join(file).display()))?;
+    }
     staged.commit()?;
     super::say(&summary(&x, &args.out))
 }
@@ -131,10 +149,11 @@ fn summary(x: &Intrinsics, out: &std::path::Path) -> String {
     s += &accel_lines(x);
     s += &gyro_lines(x);
     s += &format!(
-        "{} intervals at {} % confidence in {}\n",
+        "{} intervals at {} % confidence in {}, the page in {}\n",
         JSON_FILE,
         sig(100.0 * x.settings.confidence, 3),
-        out.join(JSON_FILE).display()
+        out.join(JSON_FILE).display(),
+        out.join(PAGE_FILE).display()
     );
     s
 }
@@ -179,6 +198,14 @@ fn accel_lines(x: &Intrinsics) -> String {
             );
         }
         None => s += "  goodness: not testable (no degree of freedom left)\n",
+    }
+    if a.p_value.is_some_and(|p| p < x.settings.alpha) {
+        s += &format!(
+            "  the poses' magnitudes scatter {}× more than the noise measured in them explains (a \
+             drift such as a warm-up's, or a pose that moved): the intervals hold only if the model \
+             does\n",
+            sig((a.chi_squared / a.dof).sqrt(), 2)
+        );
     }
     if let Some(up) = a.suggested_up {
         let free: Vec<&str> = accelcal::intrinsics::accel::PARAMETER_NAMES

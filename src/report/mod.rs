@@ -31,6 +31,7 @@ pub mod figures;
 pub mod findings;
 pub mod html;
 pub mod ins;
+pub mod intrinsics;
 pub mod json;
 pub mod kind;
 pub mod labels;
