@@ -13,7 +13,7 @@
 //!   error-state filter and its measurements, one driver for every run, the Monte Carlo
 //!   ensemble); [`calibrate::imu`] calibrates a recording (`calibrate --imu`); [`report`] writes
 //!   both worlds' pages. [`allan`] measures the noise terms of a static log ([`allan::imu`]: each
-//!   channel of an IMU).
+//!   channel of an IMU); [`intrinsics`] calibrates an IMU from static poses on a table.
 //!
 //! [`format`](mod@format), [`output`], [`progress`], [`error`], [`lanes`] and [`random`] are
 //! leaves every step may use. The `accelcal` binary (`src/main.rs`) parses the command line and
