@@ -254,7 +254,7 @@ fn gyro_lines(x: &Intrinsics) -> String {
     match m.p_value {
         Some(p) => {
             s += &format!(
-                "  goodness over {} turns: χ² = {} on {} degrees of freedom, p = {} ({} at α = {})\n",
+                "  goodness of {} turns and the poses' magnitudes together: χ² = {} on {} degrees of freedom, p = {} ({} at α = {})\n",
                 m.turns,
                 sig(m.chi_squared, 4),
                 sig(m.dof, 3),

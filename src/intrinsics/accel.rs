@@ -114,7 +114,7 @@ pub fn matrix_of(theta: &Params) -> Matrix3<f64> {
 }
 
 /// The prior's mean: no bias, the identity.
-fn prior_mean() -> Params {
+pub(super) fn prior_mean() -> Params {
     let mut p = Params::zeros();
     for (i, &(r, c)) in MATRIX_ENTRIES.iter().enumerate() {
         p[3 + i] = if r == c { 1.0 } else { 0.0 };
@@ -123,7 +123,7 @@ fn prior_mean() -> Params {
 }
 
 /// The residual, its Jacobian row and its variance for one interval.
-fn linearize(
+pub(super) fn linearize(
     theta: &Params,
     interval: &StaticInterval,
     noise_var: &[f64; 6],

@@ -11,15 +11,19 @@
 //! g²), the gyros' white noise integrated over the turn (N τ² σ²_g a component), and the Earth's
 //! horizontal rate over the turn's time T, of unknown azimuth ((Ω T)²/2 · cos² L, or · 2/3 with
 //! no latitude). The up directions are taken with the accelerometers' parameters, which join
-//! the fit with their own fit's estimate and covariance as prior (their errors tilt every pose
-//! alike). The prior is M_g = I ± 0.1 on each entry and b_g from the static poses
+//! the fit together with the poses' magnitudes ([`super::accel`]'s residuals, its weak prior):
+//! their errors tilt every pose alike, and the turns fix what magnitudes alone leave free. The prior is M_g = I ± 0.1 on each entry and b_g from the static poses
 //! ([`super::gyro`]) with its covariance; the fit and its tests are those of [`super::accel`]:
 //! Gauss–Newton with numerical derivatives, determined when σ is under a tenth of the prior's,
-//! goodness against χ² with 2(m − 1) − p_eff degrees of freedom.
+//! goodness of the turns and magnitudes together against χ² with 3m − 2 − p_eff degrees of
+//! freedom.
 
 use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Vector2, Vector3};
 
-use super::accel::{AccelFit, DETERMINED_SHARE, Estimate, Params, matrix_of as accel_matrix};
+use super::accel::{
+    AccelFit, DETERMINED_SHARE, Estimate, PRIOR_SIGMA, Params, linearize,
+    matrix_of as accel_matrix, prior_mean,
+};
 use super::detect::Detection;
 use super::gyro::{EARTH_RATE_RAD_S, GyroBias};
 use super::{Settings, SixAxisLog};
@@ -157,34 +161,94 @@ fn turns(detection: &Detection, accel: &AccelFit, settings: &Settings) -> Vec<Tu
         .collect()
 }
 
-/// The data's information, gradient and χ² at θ (numerical Jacobian, central differences).
-fn normal_equations(
-    log: &SixAxisLog,
-    turns: &[Turn],
-    theta: &GyroParams,
-) -> (GyroCovariance, GyroParams, f64) {
+/// What the fit reads: the log, the poses and their noise, the turns, gravity.
+struct Data<'a> {
+    log: &'a SixAxisLog,
+    detection: &'a Detection,
+    turns: &'a [Turn],
+    gravity_m_s2: f64,
+}
+
+/// The data's information, gradient and χ² at θ: the turns (numerical Jacobian, central
+/// differences) and the poses' magnitudes (the accelerometers' analytic rows).
+fn normal_equations(data: &Data<'_>, theta: &GyroParams) -> (GyroCovariance, GyroParams, f64) {
     let mut info = GyroCovariance::zeros();
     let mut grad = GyroParams::zeros();
     let mut chi = 0.0;
-    for turn in turns {
-        let r = residual(log, turn, theta);
+    for turn in data.turns {
+        let r = residual(data.log, turn, theta);
         let mut jac = SMatrix::<f64, 2, 21>::zeros();
         for p in 0..21 {
             let h = if (9..12).contains(&p) { 1e-7 } else { 1e-6 };
             let (mut up, mut down) = (*theta, *theta);
             up[p] += h;
             down[p] -= h;
-            let d = (residual(log, turn, &up) - residual(log, turn, &down)) / (2.0 * h);
+            let d = (residual(data.log, turn, &up) - residual(data.log, turn, &down)) / (2.0 * h);
             jac.set_column(p, &d);
         }
         info += jac.transpose() * turn.weight * jac;
         grad += jac.transpose() * turn.weight * r;
         chi += (r.transpose() * turn.weight * r)[0];
     }
+    let accel: Params = theta.fixed_rows::<9>(GYRO_PARAMETERS).into_owned();
+    for interval in &data.detection.intervals {
+        let (r, row, var) = linearize(
+            &accel,
+            interval,
+            &data.detection.noise_var,
+            data.gravity_m_s2,
+        );
+        let mut j = GyroParams::zeros();
+        j.fixed_rows_mut::<9>(GYRO_PARAMETERS).copy_from(&row);
+        info += j * j.transpose() / var;
+        grad += j * (r / var);
+        chi += r * r / var;
+    }
     (info, grad, chi)
 }
 
-/// Fits the gyros' matrix to the turns between the poses of `detection`; `None` with no turn.
+/// θ minimizing the turns' and the poses' residuals plus the prior, by Levenberg–Marquardt
+/// from `start`.
+fn minimize(
+    data: &Data<'_>,
+    start: GyroParams,
+    mu: &GyroParams,
+    prior_info: &GyroCovariance,
+) -> Option<GyroParams> {
+    let total = |theta: &GyroParams| {
+        let d = theta - mu;
+        normal_equations(data, theta).2 + (d.transpose() * prior_info * d)[0]
+    };
+    let mut theta = start;
+    let mut cost = total(&theta);
+    let mut lambda = 1e-3;
+    for _ in 0..100 {
+        let (info, grad, _) = normal_equations(data, &theta);
+        let h = info + prior_info;
+        let g = grad + prior_info * (theta - mu);
+        let damped = h + GyroCovariance::from_diagonal(&h.diagonal()) * lambda;
+        let step = -damped.cholesky()?.solve(&g);
+        let next = theta + step;
+        let next_cost = total(&next);
+        if next_cost <= cost {
+            theta = next;
+            cost = next_cost;
+            lambda = (lambda / 10.0).max(1e-12);
+            if (step.transpose() * h * step)[0] < 1e-12 {
+                break;
+            }
+        } else {
+            lambda *= 10.0;
+            if lambda > 1e12 {
+                break;
+            }
+        }
+    }
+    Some(theta)
+}
+
+/// Fits the gyros' matrix to the turns between the poses of `detection`, jointly with the
+/// accelerometers' parameters and the poses' magnitudes; `None` with no turn.
 pub fn fit(
     log: &SixAxisLog,
     detection: &Detection,
@@ -196,6 +260,12 @@ pub fn fit(
     if turns.is_empty() {
         return None;
     }
+    let data = Data {
+        log,
+        detection,
+        turns: &turns,
+        gravity_m_s2: settings.gravity_m_s2,
+    };
     let mut mu = GyroParams::zeros();
     let mut prior = GyroCovariance::zeros();
     for i in 0..3 {
@@ -204,34 +274,26 @@ pub fn fit(
     }
     for p in 0..9 {
         prior[(p, p)] = MATRIX_PRIOR_SIGMA.powi(2);
+        prior[(GYRO_PARAMETERS + p, GYRO_PARAMETERS + p)] = PRIOR_SIGMA[p].powi(2);
     }
     prior
         .fixed_view_mut::<3, 3>(9, 9)
         .copy_from(&bias.covariance);
     mu.fixed_rows_mut::<9>(GYRO_PARAMETERS)
-        .copy_from(&accel.params);
-    prior
-        .fixed_view_mut::<9, 9>(GYRO_PARAMETERS, GYRO_PARAMETERS)
-        .copy_from(&accel.covariance);
+        .copy_from(&prior_mean());
     let prior_info = prior.try_inverse().expect("positive definite");
-    let mut theta = mu;
-    for _ in 0..20 {
-        let (info, grad, _) = normal_equations(log, &turns, &theta);
-        let h = info + prior_info;
-        let g = grad + prior_info * (theta - mu);
-        let step = -h.cholesky()?.solve(&g);
-        theta += step;
-        if (step.transpose() * h * step)[0] < 1e-12 {
-            break;
-        }
-    }
-    let (info, _, chi_squared) = normal_equations(log, &turns, &theta);
+    let mut start = mu;
+    start
+        .fixed_rows_mut::<9>(GYRO_PARAMETERS)
+        .copy_from(&accel.params);
+    let theta = minimize(&data, start, &mu, &prior_info)?;
+    let (info, _, chi_squared) = normal_equations(&data, &theta);
     let covariance = (info + prior_info).cholesky()?.inverse();
     let determined: [bool; 12] = std::array::from_fn(|p| {
         p >= 9 || covariance[(p, p)].sqrt() < DETERMINED_SHARE * MATRIX_PRIOR_SIGMA
     });
     let p_eff = (covariance * info).trace();
-    let dof = 2.0 * turns.len() as f64 - p_eff;
+    let dof = (2 * turns.len() + detection.intervals.len()) as f64 - p_eff;
     let p_value = (dof >= 0.5).then(|| {
         use statrs::distribution::{ChiSquared, ContinuousCDF};
         ChiSquared::new(dof).map_or(f64::NAN, |c| c.sf(chi_squared))

@@ -278,7 +278,10 @@ fn verdicts(x: &Intrinsics) -> Vec<Verdict> {
     ];
     if let Some(m) = &x.gyro_matrix {
         verdicts.push(verdict(
-            &format!("The {} turns between poses", m.turns),
+            &format!(
+                "The {} turns between poses and the poses' magnitudes, together",
+                m.turns
+            ),
             m.chi_squared,
             m.dof,
             m.p_value,
