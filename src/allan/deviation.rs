@@ -73,6 +73,36 @@ pub fn phase(y: &[f64]) -> Vec<f64> {
     x
 }
 
+/// [`phase`] where the samples are: `held` is [_, y_0, …, y_{n−1}] on entry and the phase
+/// x_0 … x_n on return, the same bits as [`phase`] of y (the same sums in the same order).
+pub fn phase_in_place(held: &mut [f64]) {
+    use rayon::prelude::*;
+    let Some((first, y)) = held.split_first_mut() else {
+        return;
+    };
+    let ybar = mean(y);
+    let totals: Vec<f64> = y
+        .par_chunks(PHASE_STRETCH)
+        .map(|c| c.iter().map(|v| v - ybar).sum::<f64>())
+        .collect();
+    let mut starts = Vec::with_capacity(totals.len());
+    let mut s = 0.0;
+    for t in &totals {
+        starts.push(s);
+        s += t;
+    }
+    *first = 0.0;
+    y.par_chunks_mut(PHASE_STRETCH)
+        .zip(starts)
+        .for_each(|(chunk, start)| {
+            let mut s = start;
+            for o in chunk.iter_mut() {
+                s += *o - ybar;
+                *o = s;
+            }
+        });
+}
+
 /// Σ_{k=0}^{M−1} (x_{k+2m} − 2x_{k+m} + x_k)² over the phase `x`, M = len(x) − 2m (zero if
 /// M ≤ 0).
 pub fn second_difference_sum(x: &[f64], m: usize) -> f64 {
