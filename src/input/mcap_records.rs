@@ -223,3 +223,105 @@ impl ImuRecords for McapRecords {
         self.warnings.borrow().clone()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::input::recording::open_recording;
+
+    /// A CDR `Imu` message stamped `t_ns` whose values count from `v`; `short` cuts it.
+    fn imu(t_ns: u64, v: f64, short: bool) -> Vec<u8> {
+        let mut b = vec![0, 1, 0, 0];
+        b.extend(((t_ns / 1_000_000_000) as u32).to_le_bytes());
+        b.extend(((t_ns % 1_000_000_000) as u32).to_le_bytes());
+        b.extend(4u32.to_le_bytes());
+        b.extend(b"imu\0");
+        let mut values = [0.0; 37];
+        for (k, x) in values.iter_mut().enumerate() {
+            *x = v + k as f64;
+        }
+        values.iter().for_each(|x| b.extend(x.to_le_bytes()));
+        if short {
+            b.truncate(100);
+        }
+        b
+    }
+
+    /// An MCAP file of `n` messages on `/imu` in small chunks, one on a second `Imu` topic
+    /// and one of another schema every few, message `bad` of `/imu` (if any) cut short.
+    fn file(n: usize, bad: Option<usize>) -> tempfile::NamedTempFile {
+        let f = tempfile::NamedTempFile::new().unwrap();
+        let mut w = mcap::WriteOptions::new()
+            .chunk_size(Some(3000))
+            .create(std::io::BufWriter::new(f.reopen().unwrap()))
+            .unwrap();
+        let imu_schema = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"").unwrap();
+        let other = w.add_schema("std_msgs/msg/String", "ros2msg", b"").unwrap();
+        let no_meta = Default::default();
+        let ids = [
+            w.add_channel(imu_schema, "/imu", "cdr", &no_meta).unwrap(),
+            w.add_channel(imu_schema, "/imu2", "cdr", &no_meta).unwrap(),
+            w.add_channel(other, "/text", "cdr", &no_meta).unwrap(),
+        ];
+        for k in 0..n {
+            let t_ns = 1_700_000_000_000_000_000 + k as u64 * 2_500_000;
+            let mut put = |id: u16, data: &[u8]| {
+                let header = mcap::records::MessageHeader {
+                    channel_id: id,
+                    sequence: k as u32,
+                    log_time: t_ns,
+                    publish_time: t_ns,
+                };
+                w.write_to_known_channel(&header, data).unwrap();
+            };
+            put(ids[0], &imu(t_ns, k as f64, bad == Some(k)));
+            if k % 7 == 3 {
+                put(ids[1], &imu(t_ns, -(k as f64), false));
+            }
+            if k % 11 == 5 {
+                put(ids[2], b"\x00\x01\x00\x00hello");
+            }
+        }
+        w.finish().unwrap();
+        f
+    }
+
+    /// Every record of `records` and the error that ends them, read record by record and in
+    /// blocks.
+    fn both(records: &dyn ImuRecords) -> [(Vec<String>, Option<String>); 2] {
+        let mut one = Vec::new();
+        let e1 = records.read(&mut |r| {
+            one.push(format!("{r:?}"));
+            Ok(())
+        });
+        let mut blocks = Vec::new();
+        let e2 = records.read_blocks(&mut |b| {
+            for (i, (t_s, values)) in b.t_s.iter().zip(&b.values).enumerate() {
+                let at = b.at + i as u64;
+                let r = Record {
+                    t_s: *t_s,
+                    values: *values,
+                    at,
+                };
+                blocks.push(format!("{r:?}"));
+            }
+            Ok(())
+        });
+        [
+            (one, e1.err().map(|e| e.to_string())),
+            (blocks, e2.err().map(|e| e.to_string())),
+        ]
+    }
+
+    #[test]
+    fn blocks_are_the_records_and_the_errors_of_a_read_record_by_record() {
+        for bad in [None, Some(0), Some(700), Some(1999)] {
+            let f = file(2000, bad);
+            let records = open_recording(f.path(), Some("/imu")).unwrap();
+            let [one, blocks] = both(records.as_ref());
+            assert_eq!(one.0.len(), bad.unwrap_or(2000), "{bad:?}");
+            assert_eq!(one, blocks, "{bad:?}");
+            assert_eq!(one.1.is_some(), bad.is_some(), "{:?}", one.1);
+        }
+    }
+}

@@ -77,12 +77,13 @@ pub(super) struct Line<F> {
 }
 
 impl<F: Series> Line<F> {
-    /// z_start … z_{start+n−1} into `out[..n]` (n ≤ PIECE + 2), through `u`.
+    /// z_start … z_{start+n−1} into `out` (n = its length ≤ PIECE + 2), through `u`.
     #[inline(always)]
-    fn z(&self, start: usize, n: usize, u: &mut [f64; PIECE + 2], out: &mut [f64; PIECE + 2]) {
+    fn z(&self, start: usize, u: &mut [f64; PIECE + 2], out: &mut [f64]) {
+        let n = out.len();
         self.fill.fill(start, &mut u[..n]);
         let t0 = start as f64;
-        for ((o, &u), &j) in out[..n].iter_mut().zip(&u[..n]).zip(&IOTA[..n]) {
+        for ((o, &u), &j) in out.iter_mut().zip(&u[..n]).zip(&IOTA[..n]) {
             *o = u - self.u_mean - self.slope * ((t0 + j) - self.t_mean);
         }
     }
@@ -91,10 +92,12 @@ impl<F: Series> Line<F> {
     #[inline(always)]
     fn w(&self, d: usize, start: usize, n: usize, bufs: &mut Buffers) {
         let Buffers { u, z, w } = bufs;
-        self.z(start, n + d, u, z);
+        if d == 0 {
+            return self.z(start, u, &mut w[1..=n]);
+        }
+        self.z(start, u, &mut z[..n + d]);
         let w = &mut w[1..=n];
         match d {
-            0 => w.copy_from_slice(&z[..n]),
             1 => {
                 for (o, p) in w.iter_mut().zip(z[..n + 1].windows(2)) {
                     *o = p[1] - p[0];
