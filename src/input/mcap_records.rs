@@ -227,7 +227,6 @@ impl ImuRecords for McapRecords {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::input::recording::open_recording;
 
     /// A CDR `Imu` message stamped `t_ns` whose values count from `v`; `short` cuts it.
     fn imu(t_ns: u64, v: f64, short: bool) -> Vec<u8> {
@@ -317,8 +316,9 @@ mod tests {
     fn blocks_are_the_records_and_the_errors_of_a_read_record_by_record() {
         for bad in [None, Some(0), Some(700), Some(1999)] {
             let f = file(2000, bad);
-            let records = open_recording(f.path(), Some("/imu")).unwrap();
-            let [one, blocks] = both(records.as_ref());
+            let files = vec![(Container::file(f.path()), None)];
+            let records = McapRecords::new("test.mcap".into(), files, "/imu".into());
+            let [one, blocks] = both(&records);
             assert_eq!(one.0.len(), bad.unwrap_or(2000), "{bad:?}");
             assert_eq!(one, blocks, "{bad:?}");
             assert_eq!(one.1.is_some(), bad.is_some(), "{:?}", one.1);
