@@ -9,7 +9,7 @@ at RATE Hz, serialized as CDR (the layout rosbags writes, built here with numpy:
 white noise plus a random walk (accelerometer N = 2e-3 m/s/sqrt(s), K = 1e-3 m/s^2/sqrt(s) on
 gravity; gyro N = 1e-4 rad/sqrt(s), K = 5e-5 rad/s/sqrt(s)).
 
-Then, REPEATS times each: the binary on the file under /usr/bin/time -v (wall, peak RSS, and the
+Then, REPEATS times each (in turn with --alternate): the binary on the file under /usr/bin/time -v (wall, peak RSS, and the
 temporary disk it used: the least free space of --out's file system during the run, polled every
 20 ms, against the free space before), and allantools.oadev (octave tau, in memory, the samples
 generated again) on the six channels one after the other. Prints the medians, and the largest
@@ -139,6 +139,9 @@ def main():
     ap.add_argument("--dir", default="/tmp/accelcal-long")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--bin", default="target/release/accelcal")
+    ap.add_argument("--alternate", action="store_true",
+                    help="run the binary and allantools in turn, REPEATS rounds (the machine's "
+                         "load then falls on both alike)")
     ap.add_argument("--reference", action="store_true",
                     help="compare both with a long-double computation too")
     a = ap.parse_args()
@@ -155,28 +158,42 @@ def main():
           f"allantools {allantools.__version__}, numpy {np.__version__}")
 
     print("load average before: %.1f %.1f %.1f" % os.getloadavg())
-    runs = [run_binary(a.bin, path) for _ in range(a.repeats)]
-    walls, rss, cpus = ([r[i] for r in runs] for i in range(3))
-    print(f"accelcal allan --imu: wall median {statistics.median(walls):.2f} s "
-          f"(min {min(walls):.2f}, max {max(walls):.2f}), CPU median "
-          f"{statistics.median(cpus):.2f} s, peak RSS median {statistics.median(rss):.0f} MB "
-          f"(max {max(rss):.0f}), temporary disk at most {max(r[4] for r in runs):.0f} MB "
-          f"(the phase: {6 * 8 * (n + 1) / 1e6:.0f} MB)")
-
     y = np.concatenate([c for _, c in channels(n, a.rate, PIECE)])
-    times, cpu = [], []
-    for rep in range(a.repeats):
+
+    def allantools_six():
         start, c0 = time.perf_counter(), time.process_time()
         devs = []
         for k in range(6):
             taus, dev, _, _ = allantools.oadev(np.ascontiguousarray(y[:, k]), rate=a.rate,
                                                data_type="freq", taus="octave")
             devs.append(dev)
-        times.append(time.perf_counter() - start)
-        cpu.append(time.process_time() - c0)
+        return time.perf_counter() - start, time.process_time() - c0, devs
+
+    runs, times, cpu = [], [], []
+    if a.alternate:
+        for _ in range(a.repeats):
+            runs.append(run_binary(a.bin, path))
+            wall, c, devs = allantools_six()
+            times.append(wall)
+            cpu.append(c)
+    else:
+        runs = [run_binary(a.bin, path) for _ in range(a.repeats)]
+    walls, rss, cpus = ([r[i] for r in runs] for i in range(3))
+    print(f"accelcal allan --imu: wall median {statistics.median(walls):.2f} s "
+          f"(min {min(walls):.2f}, max {max(walls):.2f}), CPU median "
+          f"{statistics.median(cpus):.2f} s, peak RSS median {statistics.median(rss):.0f} MB "
+          f"(max {max(rss):.0f}), temporary disk at most {max(r[4] for r in runs):.0f} MB "
+          f"(the phase: {6 * 8 * (n + 1) / 1e6:.0f} MB)")
+    if not a.alternate:
+        for _ in range(a.repeats):
+            wall, c, devs = allantools_six()
+            times.append(wall)
+            cpu.append(c)
     print(f"allantools.oadev, six channels in memory: wall median {statistics.median(times):.2f} s "
           f"(min {min(times):.2f}, max {max(times):.2f}), CPU median {statistics.median(cpu):.2f} s")
     print("load average after: %.1f %.1f %.1f" % os.getloadavg())
+    print(f"ratio of the medians, allantools / accelcal: "
+          f"{statistics.median(times) / statistics.median(walls):.2f}")
     columns = ["ax_m_s2", "ay_m_s2", "az_m_s2", "gx_rad_s", "gy_rad_s", "gz_rad_s"]
     worst = {"allantools": [0.0, 0.0], "long double": [0.0, 0.0],
              "allantools vs long double": [0.0, 0.0]}

@@ -108,10 +108,14 @@ impl Pair {
             if *q == 0.0 {
                 continue;
             }
-            let s: f64 = fa
-                .iter()
-                .flat_map(|p| fb.iter().map(move |r| piece_product(p, r, h)))
-                .sum();
+            // In the order of the pieces; a zero here could only change the sign of a zero
+            // sum, which the addition to `total` (from +0) does not keep.
+            let mut s = -0.0;
+            for p in fa {
+                for r in fb {
+                    s += piece_product(p, r, h);
+                }
+            }
             total += q * s;
         }
         total

@@ -73,6 +73,36 @@ pub fn phase(y: &[f64]) -> Vec<f64> {
     x
 }
 
+/// [`phase`] where the samples are: `held` is [_, y_0, …, y_{n−1}] on entry and the phase
+/// x_0 … x_n on return, the same bits as [`phase`] of y (the same sums in the same order).
+pub fn phase_in_place(held: &mut [f64]) {
+    use rayon::prelude::*;
+    let Some((first, y)) = held.split_first_mut() else {
+        return;
+    };
+    let ybar = mean(y);
+    let totals: Vec<f64> = y
+        .par_chunks(PHASE_STRETCH)
+        .map(|c| c.iter().map(|v| v - ybar).sum::<f64>())
+        .collect();
+    let mut starts = Vec::with_capacity(totals.len());
+    let mut s = 0.0;
+    for t in &totals {
+        starts.push(s);
+        s += t;
+    }
+    *first = 0.0;
+    y.par_chunks_mut(PHASE_STRETCH)
+        .zip(starts)
+        .for_each(|(chunk, start)| {
+            let mut s = start;
+            for o in chunk.iter_mut() {
+                s += *o - ybar;
+                *o = s;
+            }
+        });
+}
+
 /// Σ_{k=0}^{M−1} (x_{k+2m} − 2x_{k+m} + x_k)² over the phase `x`, M = len(x) − 2m (zero if
 /// M ≤ 0).
 pub fn second_difference_sum(x: &[f64], m: usize) -> f64 {
@@ -119,18 +149,8 @@ pub fn overlapping_avar(x: &[f64], m: usize) -> f64 {
 /// Phase points k per stretch of [`overlapping_avars`]: the unit of work of one thread.
 pub const STRETCH: usize = 1 << 16;
 
-/// Σ over one block of k of the squared second differences at m, with eight running sums.
-#[inline(always)]
-fn block_sum(x: &[f64], m: usize, start: usize, end: usize) -> f64 {
-    block_sum_of(
-        &x[start..end],
-        &x[start + m..end + m],
-        &x[start + 2 * m..end + 2 * m],
-    )
-}
-
 /// Σ (c_i − 2b_i + a_i)² over one block of equal-length slices (the phase at k, k + m and
-/// k + 2m), with eight running sums: [`block_sum`]'s arithmetic for slices held apart.
+/// k + 2m), with eight running sums.
 #[inline(always)]
 pub(crate) fn block_sum_of(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
     let len = a.len();
@@ -154,31 +174,108 @@ pub(crate) fn block_sum_of(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
         + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]))
 }
 
-/// The sums of one stretch [from, to) of k at every factor, block by block.
+/// The sums of one stretch [from, to) of k at every factor, block by block, each block's by
+/// `block` (the arithmetic of [`block_sum_of`]).
 #[inline(always)]
 fn stretch_sums_plain(
     x: &[f64],
     factors: &[usize],
     terms: &[usize],
-    from: usize,
-    to: usize,
+    (from, to): (usize, usize),
+    block: impl Fn(&[f64], &[f64], &[f64]) -> f64,
 ) -> Vec<f64> {
     let mut sums = vec![0.0; factors.len()];
     for start in (from..to).step_by(BLOCK) {
         for (j, &m) in factors.iter().enumerate() {
             let end = (start + BLOCK).min(to).min(terms[j]);
             if start < end {
-                sums[j] += block_sum(x, m, start, end);
+                sums[j] += block(
+                    &x[start..end],
+                    &x[start + m..end + m],
+                    &x[start + 2 * m..end + 2 * m],
+                );
             }
         }
     }
     sums
 }
 
-crate::lanes::vectorized! {
-    /// [`stretch_sums_plain`], compiled for AVX2 when the processor has it (the same bits:
-    /// Rust contracts no product and sum into an FMA).
-    pub(crate) fn stretch_sums(x: &[f64], factors: &[usize], terms: &[usize], from: usize, to: usize) -> Vec<f64> => stretch_sums_plain
+/// [`stretch_sums_plain`], with the AVX2 form of the blocks when the processor has it (the
+/// same bits: the same operations lane by lane, in the same order).
+pub(crate) fn stretch_sums(
+    x: &[f64],
+    factors: &[usize],
+    terms: &[usize],
+    from: usize,
+    to: usize,
+) -> Vec<f64> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the processor supports AVX2, checked just above.
+        return unsafe { stretch_sums_avx2(x, factors, terms, (from, to)) };
+    }
+    stretch_sums_plain(x, factors, terms, (from, to), block_sum_of)
+}
+
+/// [`stretch_sums_plain`] with [`block_sum_avx2`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn stretch_sums_avx2(
+    x: &[f64],
+    factors: &[usize],
+    terms: &[usize],
+    stretch: (usize, usize),
+) -> Vec<f64> {
+    stretch_sums_plain(x, factors, terms, stretch, |a, b, c| {
+        block_sum_avx2(a, b, c)
+    })
+}
+
+/// [`block_sum_of`] in 256-bit operations: its eight running sums as two vectors of four,
+/// each lane's d = (c − 2b) + a and sum + d·d exactly as there (no fused multiply-add).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn block_sum_avx2(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
+    use std::arch::x86_64::{
+        _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setzero_pd,
+        _mm256_storeu_pd, _mm256_sub_pd,
+    };
+    let len = a.len();
+    let (b, c) = (&b[..len], &c[..len]);
+    let whole = len / 8 * 8;
+    let two = _mm256_set1_pd(2.0);
+    let (mut low, mut high) = (_mm256_setzero_pd(), _mm256_setzero_pd());
+    let mut i = 0;
+    while i < whole {
+        // SAFETY: i + 8 <= whole <= len, the length of a, b and c: every load is within them.
+        let (a0, b0, c0, a1, b1, c1) = unsafe {
+            (
+                _mm256_loadu_pd(a.as_ptr().add(i)),
+                _mm256_loadu_pd(b.as_ptr().add(i)),
+                _mm256_loadu_pd(c.as_ptr().add(i)),
+                _mm256_loadu_pd(a.as_ptr().add(i + 4)),
+                _mm256_loadu_pd(b.as_ptr().add(i + 4)),
+                _mm256_loadu_pd(c.as_ptr().add(i + 4)),
+            )
+        };
+        let d0 = _mm256_add_pd(_mm256_sub_pd(c0, _mm256_mul_pd(two, b0)), a0);
+        let d1 = _mm256_add_pd(_mm256_sub_pd(c1, _mm256_mul_pd(two, b1)), a1);
+        low = _mm256_add_pd(low, _mm256_mul_pd(d0, d0));
+        high = _mm256_add_pd(high, _mm256_mul_pd(d1, d1));
+        i += 8;
+    }
+    let mut lanes = [0.0f64; 8];
+    // SAFETY: `lanes` holds eight f64: two stores of four.
+    unsafe {
+        _mm256_storeu_pd(lanes.as_mut_ptr(), low);
+        _mm256_storeu_pd(lanes.as_mut_ptr().add(4), high);
+    }
+    for i in whole..len {
+        let d = c[i] - 2.0 * b[i] + a[i];
+        lanes[0] += d * d;
+    }
+    ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3]))
+        + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]))
 }
 
 /// The overlapping Allan variance at every factor of `factors` from the phase `x` (in

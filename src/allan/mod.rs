@@ -331,6 +331,36 @@ pub fn analyse_cancellable(
     analyse_points(points, y.len(), tau0_s, confidence)
 }
 
+/// [`analyse`] of the rate samples held one place in: `held` is [_, y_0, …, y_{n−1}] (the first
+/// place free), and the phase is summed where the samples are, the same bits as [`analyse`]
+/// of y.
+///
+/// # Errors
+/// As [`analyse`].
+pub fn analyse_in_place(
+    mut held: Vec<f64>,
+    tau0_s: f64,
+    confidence: f64,
+) -> Result<Analysis, AllanError> {
+    let y = held.get(1..).unwrap_or_default();
+    if !(confidence > 0.0 && confidence < 1.0) {
+        return Err(AllanError::Confidence(confidence));
+    }
+    if y.len() < MIN_SAMPLES {
+        return Err(AllanError::TooFewSamples {
+            found: y.len(),
+            needed: MIN_SAMPLES,
+        });
+    }
+    if y.iter().all(|&v| v == y[0]) {
+        return Err(AllanError::Constant);
+    }
+    let n = y.len();
+    deviation::phase_in_place(&mut held);
+    let points = points(&held, tau0_s, confidence, &Cancel::new())?;
+    analyse_points(points, n, tau0_s, confidence)
+}
+
 /// Analyses the rate samples of a log read once ([`stream::AllanStream`]): `grid` holds each
 /// octave τ's (m, σ̂², the noise of its block means) for `samples` samples τ₀ = `tau0_s` apart.
 /// The rest is [`analyse`]'s: the same analysis wherever the grid holds the same numbers. A

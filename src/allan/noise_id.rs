@@ -8,6 +8,10 @@
 //! +2 white phase (quantization), 0 white rate (velocity random walk), −1 flicker (bias
 //! instability), −2 random walk of the rate (acceleration random walk).
 
+mod lag;
+
+use lag::{Consecutive, Held, IOTA, Line, PIECE, Series, Strided, lag1_of};
+
 /// Fewest block means the identification accepts (Riley & Greenhall's recommended minimum).
 pub const MIN_POINTS: usize = 30;
 /// Most differences taken (2 for the Allan variance).
@@ -29,82 +33,90 @@ pub struct NoiseId {
 /// Identifies the noise of the block means `means` (rate data averaged over τ); `None` with
 /// fewer than [`MIN_POINTS`] means or a series without variation.
 pub fn identify(means: &[f64]) -> Option<NoiseId> {
-    identify_with(means.len(), |i| means[i])
+    identify_with(means.len(), Held(means))
 }
 
 /// [`identify`] of the block means of m samples of the rate data whose phase (in samples) is
 /// `x` ([`block_means`]), taken from the phase as they are needed: nothing is allocated.
 pub fn identify_phase(x: &[f64], m: usize) -> Option<NoiseId> {
+    identify_phase_vectorized(x, m)
+}
+
+/// [`identify_phase`]'s arithmetic, inlined into each variant of [`identify_phase_vectorized`].
+#[inline(always)]
+fn identify_phase_plain(x: &[f64], m: usize) -> Option<NoiseId> {
     let scale = 1.0 / m as f64;
-    identify_with((x.len() - 1) / m, |k| (x[(k + 1) * m] - x[k * m]) * scale)
+    let len = (x.len() - 1) / m;
+    if m == 1 {
+        return identify_with(len, Consecutive { points: x, scale });
+    }
+    if m < GATHERED_FROM {
+        return identify_with(len, Strided { x, m, scale });
+    }
+    // Far apart, each point is a cache line of its own: gathered once for the passes.
+    let points: Vec<f64> = x.iter().step_by(m).take(len + 1).copied().collect();
+    identify_with(
+        len,
+        Consecutive {
+            points: &points,
+            scale,
+        },
+    )
 }
 
-/// r₁ of the series w_0 … w_{L−1} given by `at`, L = `len` ≥ 2, in one pass.
-///
-/// # Formula
-/// Riley & Greenhall (2004), eq. (2), with the sums Σw, Σw², Σ w_i w_{i+1} of one pass:
-/// Σ_{i<L−1} (w_i − w̄)(w_{i+1} − w̄) = Σ w_i w_{i+1} − w̄ (2Σw − w_0 − w_{L−1}) + (L − 1) w̄²
-/// and Σ (w_i − w̄)² = Σw² − w̄ Σw. Every series identified has a mean near zero (a line
-/// removed, or differences of one), so the expansion loses nothing to cancellation.
-fn lag1_of(len: usize, at: impl Fn(usize) -> f64) -> f64 {
-    // Four running sums of each kind (the additions of one do not wait on the other three).
-    let first = at(0);
-    let (mut sum, mut squares, mut lagged) = (
-        [first, 0.0, 0.0, 0.0],
-        [first * first, 0.0, 0.0, 0.0],
-        [0.0; 4],
-    );
-    let mut previous = first;
-    let mut i = 1;
-    while i + 4 <= len {
-        let w = [at(i), at(i + 1), at(i + 2), at(i + 3)];
-        for j in 0..4 {
-            sum[j] += w[j];
-            squares[j] += w[j] * w[j];
-        }
-        lagged[0] += previous * w[0];
-        lagged[1] += w[0] * w[1];
-        lagged[2] += w[1] * w[2];
-        lagged[3] += w[2] * w[3];
-        previous = w[3];
-        i += 4;
-    }
-    for k in i..len {
-        let w = at(k);
-        sum[0] += w;
-        squares[0] += w * w;
-        lagged[0] += previous * w;
-        previous = w;
-    }
-    let total = |a: [f64; 4]| (a[0] + a[1]) + (a[2] + a[3]);
-    let (sum, squares, lagged) = (total(sum), total(squares), total(lagged));
-    let l = len as f64;
-    let mean = sum / l;
-    let num = lagged - mean * (2.0 * sum - first - previous) + (l - 1.0) * mean * mean;
-    num / (squares - mean * sum)
+/// The averaging factor from which [`identify_phase`] gathers the phase points of its block
+/// means before its passes (each point then on a cache line of its own).
+const GATHERED_FROM: usize = 8;
+
+crate::lanes::vectorized! {
+    /// [`identify_phase_plain`], compiled for AVX2 when the processor has it (the same bits:
+    /// the same operations in the same order, no product and sum contracted).
+    fn identify_phase_vectorized(x: &[f64], m: usize) -> Option<NoiseId> => identify_phase_plain
 }
 
-/// [`identify`] of the series u_0 … u_{L−1} given by `at`: the line removed by its
-/// least-squares fit over the index (numpy's `polyfit(t, u, 1)`), then differenced while
-/// δ ≥ 0.25, each series taken from `at` as it is needed.
-fn identify_with(len: usize, at: impl Fn(usize) -> f64) -> Option<NoiseId> {
+/// [`identify`] of the series u_0 … u_{L−1} that `fill(start, out)` writes from u_start on:
+/// the line removed by its least-squares fit over the index (numpy's `polyfit(t, u, 1)`), then
+/// differenced while δ ≥ 0.25, each series taken from `fill` piece by piece as it is needed.
+#[inline(always)]
+fn identify_with(len: usize, fill: impl Series) -> Option<NoiseId> {
     if len < MIN_POINTS {
         return None;
     }
     let l = len as f64;
     let t_mean = (l - 1.0) / 2.0;
+    // u_i in lane i mod 4.
     let (mut sum, mut moment) = ([0.0f64; 4], [0.0f64; 4]);
-    for i in 0..len {
-        let u = at(i);
-        sum[i % 4] += u;
-        moment[i % 4] += (i as f64 - t_mean) * u;
+    let mut u = [0.0; PIECE];
+    let mut start = 0;
+    while start < len {
+        let n = PIECE.min(len - start);
+        let u = &mut u[..n];
+        fill.fill(start, u);
+        let t0 = start as f64;
+        let whole = n / 4 * 4;
+        for (g, t) in u[..whole].chunks_exact(4).zip(IOTA.chunks_exact(4)) {
+            for j in 0..4 {
+                sum[j] += g[j];
+                moment[j] += ((t0 + t[j]) - t_mean) * g[j];
+            }
+        }
+        for (i, &v) in u.iter().enumerate().skip(whole) {
+            sum[i % 4] += v;
+            moment[i % 4] += ((start + i) as f64 - t_mean) * v;
+        }
+        start += n;
     }
     let total = |a: [f64; 4]| (a[0] + a[1]) + (a[2] + a[3]);
     let (sum, moment) = (total(sum), total(moment));
     let u_mean = sum / l;
     // Σ (i − ī)² = L (L² − 1) / 12; Σ (i − ī)(u_i − ū) = Σ (i − ī) u_i.
     let slope = moment / (l * (l * l - 1.0) / 12.0);
-    let z = |i: usize| at(i) - u_mean - slope * (i as f64 - t_mean);
+    let line = Line {
+        fill,
+        u_mean,
+        slope,
+        t_mean,
+    };
     let mut d = 0u32;
     loop {
         // The series differenced d times, d ≤ MAX_DIFFERENCES = 2.
@@ -112,11 +124,7 @@ fn identify_with(len: usize, at: impl Fn(usize) -> f64) -> Option<NoiseId> {
             MAX_DIFFERENCES == 2,
             "identify_with differences at most twice"
         );
-        let r1 = match d {
-            0 => lag1_of(len, z),
-            1 => lag1_of(len - 1, |i| z(i + 1) - z(i)),
-            _ => lag1_of(len - 2, |i| z(i + 2) - 2.0 * z(i + 1) + z(i)),
-        };
+        let r1 = lag1_of(len - d as usize, d as usize, &line);
         if !r1.is_finite() {
             return None;
         }

@@ -9,15 +9,14 @@
 //! whose Footer points at it. The `mcap` crate's linear reader splits the file into records;
 //! chunks are opened here (`input::mcap_chunks`: lz4, zstd, CRC32).
 
-use std::cell::{Cell, RefCell};
 use std::collections::BTreeMap;
 use std::io::Read as _;
 
 use super::container::{Container, expansion_limit};
-use super::mcap_chunks::{self, Ahead, ChunkError, Opened};
+use super::mcap_chunks::{self, Ahead, ChunkError, MESSAGE_HEADER, Opened, Piece};
 use super::mcap_summary::{Counts, summary, topic_of};
-use super::records::{Channel, ImuRecords, Record};
-use super::{LogError, LogProblem, unreadable};
+use super::messages::ImuMessage;
+use super::{LogError, unreadable};
 
 pub use super::container::MCAP_MAGIC;
 pub(super) use super::mcap_summary::Topic;
@@ -36,13 +35,36 @@ pub(super) enum McapEvent<'a> {
     Channel(&'a Topic),
     /// A message: its channel and its bytes.
     Message(&'a Topic, &'a [u8]),
+    /// Consecutive messages of one channel, each decoded as a CDR `Imu` on the pool (only
+    /// when [`visit_mcap`] is asked to sort the chunks).
+    Messages(&'a Topic, MessageRun<'a>),
+}
+
+/// Consecutive messages of one channel as [`McapEvent::Messages`] hands them on.
+pub(super) struct MessageRun<'a> {
+    /// Each message decoded as a CDR `sensor_msgs/msg/Imu`.
+    pub rows: &'a [ImuMessage],
+    /// Their records (opcode, length and data each).
+    records: &'a [u8],
+}
+
+impl<'a> MessageRun<'a> {
+    /// Each message's bytes (after its header), in order: what [`McapEvent::Message`] would
+    /// have handed on.
+    pub fn payloads(&self) -> impl Iterator<Item = &'a [u8]> + 'a {
+        mcap_chunks::records(self.records, u64::MAX)
+            .filter_map(|r| r.ok())
+            .map(|(_, data)| &data[MESSAGE_HEADER..])
+    }
 }
 
 /// Reads the records of the MCAP file `source` in order (chunks decompressed on the thread
 /// pool while earlier ones are handed on, [`mcap_chunks`]; their CRCs
 /// checked when `check_crcs`; records no longer than [`RECORD_LIMIT`] nor than the file's
 /// [`expansion_limit`]), handing channels and messages to `visit`. Records other than schemas,
-/// channels, messages and chunks are skipped unread.
+/// channels, messages and chunks are skipped unread. With `sorting`, each chunk's runs of
+/// messages that decode as CDR `Imu` messages are decoded on the pool and handed on as
+/// [`McapEvent::Messages`] (the other records as without).
 ///
 /// # Errors
 /// [`LogError`] for a file the `mcap` crate refuses (naming the message it stopped at), a
@@ -50,7 +72,7 @@ pub(super) enum McapEvent<'a> {
 /// `visit`'s error: the first in the file's order.
 pub(super) fn visit_mcap(
     source: &Container,
-    check_crcs: bool,
+    (check_crcs, sorting): (bool, bool),
     visit: &mut dyn FnMut(McapEvent<'_>) -> Result<(), LogError>,
 ) -> Result<(), LogError> {
     use mcap::records::op;
@@ -80,7 +102,7 @@ pub(super) fn visit_mcap(
         index: 0,
         visit,
     };
-    let mut ahead = Ahead::new(check_crcs, limit);
+    let mut ahead = Ahead::new(check_crcs, limit, sorting);
     while let Some(event) = reader.next_event() {
         let event = match event {
             Ok(event) => event,
@@ -165,25 +187,54 @@ impl Reading<'_, '_> {
     }
 
     /// Hands on the records of an opened chunk, its buffers then back to `ahead`.
-    fn chunk(&mut self, (opened, copy): Opened, ahead: &mut Ahead) -> Result<(), LogError> {
+    fn chunk(&mut self, opened: Opened, ahead: &mut Ahead) -> Result<(), LogError> {
         let error = |r: &Self, e: ChunkError| match e {
             ChunkError::TooLarge { opcode, len } => r.too_large(opcode, len),
             ChunkError::Broken(e) => r.broken(&e),
         };
-        let bytes = opened.map_err(|e| error(self, e))?;
-        for record in mcap_chunks::records(&bytes, self.limit) {
-            let (opcode, data) = record.map_err(|e| error(self, e))?;
-            self.record(opcode, data)?;
+        let Opened {
+            bytes,
+            copy,
+            sorted,
+        } = opened;
+        let bytes = bytes.map_err(|e| error(self, e))?;
+        let Some(mut sorted) = sorted else {
+            for record in mcap_chunks::records(&bytes, self.limit) {
+                let (opcode, data) = record.map_err(|e| error(self, e))?;
+                self.record(opcode, data)?;
+            }
+            ahead.recycle([bytes, copy], None);
+            return Ok(());
+        };
+        for piece in sorted.pieces.drain(..) {
+            match piece {
+                Piece::Run {
+                    channel,
+                    records,
+                    rows,
+                } => {
+                    let Some(topic) = self.channels.get(&channel) else {
+                        let e = format!("channel {channel} is not defined before it");
+                        return Err(self.broken(&e));
+                    };
+                    self.index += rows.len();
+                    let run = MessageRun {
+                        rows: &sorted.rows[rows],
+                        records: &bytes[records],
+                    };
+                    (self.visit)(McapEvent::Messages(topic, run))?;
+                }
+                Piece::Record { opcode, data } => self.record(opcode, &bytes[data])?,
+                Piece::Error(e) => return Err(error(self, e)),
+            }
         }
-        ahead.recycle([bytes, copy]);
+        ahead.recycle([bytes, copy], Some(sorted));
         Ok(())
     }
 
     /// Hands on a schema, channel or message record (others are skipped).
     fn record(&mut self, opcode: u8, data: &[u8]) -> Result<(), LogError> {
         use mcap::records::{Record, op};
-        // A message's header: channel id (u16), sequence (u32), log and publish times (u64).
-        const MESSAGE_HEADER: usize = 2 + 4 + 8 + 8;
         if opcode == op::MESSAGE && data.len() >= MESSAGE_HEADER {
             let id = u16::from_le_bytes([data[0], data[1]]);
             self.index += 1;
@@ -211,112 +262,6 @@ impl Reading<'_, '_> {
     }
 }
 
-/// One MCAP file to read: where it is, and what its summary counts (when it does).
-pub(super) type McapFile = (Container, Option<Counts>);
-
-/// The chosen `Imu` topic of MCAP files read in sequence, as records of the six channels.
-pub struct McapRecords {
-    /// The recording's name in messages.
-    name: String,
-    files: Vec<McapFile>,
-    topic: String,
-    /// The first message's whole second, once read.
-    sec0: Cell<Option<i64>>,
-    /// Whether a read went through every file: its chunks' CRCs were checked then, and are
-    /// not again (13 % of a read's time).
-    read_once: Cell<bool>,
-    /// What the first whole read found amiss, in words.
-    warnings: RefCell<Vec<String>>,
-}
-
-impl McapRecords {
-    /// The `Imu` topic `topic` of `files` (the parts of the recording `name`).
-    pub(super) fn new(name: String, files: Vec<McapFile>, topic: String) -> Self {
-        Self {
-            name,
-            files,
-            topic,
-            sec0: Cell::new(None),
-            read_once: Cell::new(false),
-            warnings: RefCell::new(Vec::new()),
-        }
-    }
-
-    /// The warning of a file whose summary counts other than `read` messages of the topic.
-    fn compare(&self, file: &str, counts: &Counts, read: u64) -> Option<String> {
-        let listed = counts.messages.get(&self.topic).copied()?;
-        (listed != read).then(|| {
-            format!(
-                "{file}: its summary lists {} chunk(s) and {listed} message(s) on topic {}; {read} \
-                 were read (a record of an unknown kind or a damaged part was skipped)",
-                counts.chunks, self.topic
-            )
-        })
-    }
-}
-
-impl ImuRecords for McapRecords {
-    fn channels(&self) -> &[Channel] {
-        &Channel::ALL
-    }
-
-    fn read(&self, visit: &mut dyn FnMut(&Record) -> Result<(), LogError>) -> Result<(), LogError> {
-        // Messages per `Imu` topic: every one is decoded, as the whole-series reader does.
-        let mut counts: BTreeMap<String, u64> = BTreeMap::new();
-        let first = !self.read_once.get();
-        for (f, summary) in &self.files {
-            let before = counts.get(&self.topic).copied().unwrap_or(0);
-            visit_mcap(f, first, &mut |event| {
-                let McapEvent::Message(topic, data) = event else {
-                    return Ok(());
-                };
-                if !topic.is_imu() {
-                    return Ok(());
-                }
-                let name = topic.topic.as_str();
-                // A lookup by the borrowed name: no allocation per message.
-                if !counts.contains_key(name) {
-                    counts.insert(name.to_string(), 0);
-                }
-                let k = counts.get_mut(name).expect("inserted");
-                let m = topic.decode(data).map_err(|e| {
-                    let at = format!("{}, topic {name}, message {k}", f.name());
-                    unreadable(&at, e)
-                })?;
-                let at = *k;
-                *k += 1;
-                if name != self.topic {
-                    return Ok(());
-                }
-                visit(&m.record(&self.sec0, at))
-            })?;
-            let read = counts.get(&self.topic).copied().unwrap_or(0) - before;
-            if first
-                && let Some(w) = summary
-                    .as_ref()
-                    .and_then(|c| self.compare(f.name(), c, read))
-            {
-                self.warnings.borrow_mut().push(w);
-            }
-        }
-        self.read_once.set(true);
-        Ok(())
-    }
-
-    fn error_at(&self, at: u64, problem: LogProblem) -> LogError {
-        let at = format!("{}, topic {}, message {at}", self.name, self.topic);
-        LogError::of_file(&at, problem)
-    }
-
-    fn error(&self, problem: LogProblem) -> LogError {
-        LogError::of_file(&format!("{}, topic {}", self.name, self.topic), problem)
-    }
-
-    fn warnings(&self) -> Vec<String> {
-        self.warnings.borrow().clone()
-    }
-}
-
 /// Every topic of the MCAP file `source`, from its summary section when it has one (the
 /// footer's `summary_start`, MCAP specification § Footer), else by reading it through; and
 /// what the summary counts, when it does.
@@ -330,7 +275,7 @@ pub(super) fn topics(
         return Ok((t, counts));
     }
     let mut out = BTreeMap::new();
-    visit_mcap(source, true, &mut |event| {
+    visit_mcap(source, (true, false), &mut |event| {
         if let McapEvent::Channel(topic) = event {
             out.entry(topic.topic.clone()).or_insert(topic.clone());
         }

@@ -11,7 +11,10 @@
 //! own, an opcode (u8), a length (u64) and their data each.
 
 use std::collections::VecDeque;
+use std::ops::Range;
 use std::sync::mpsc::{Receiver, sync_channel};
+
+use super::messages::{ImuMessage, decode_imu};
 
 /// Chunks opened ahead of the one whose records are handed on, per thread of the pool.
 const AHEAD: usize = 4;
@@ -29,8 +32,98 @@ pub(super) enum ChunkError {
     Broken(String),
 }
 
-/// A chunk's records decompressed, and the buffer its record was copied to (for the next).
-pub(super) type Opened = (Result<Vec<u8>, ChunkError>, Vec<u8>);
+/// A chunk opened on the pool: its records decompressed, the buffer its record was copied to
+/// (for the next), and its records sorted when asked ([`Ahead::new`]).
+pub(super) struct Opened {
+    /// The decompressed records, or why the chunk cannot be read.
+    pub bytes: Result<Vec<u8>, ChunkError>,
+    /// The buffer the chunk's record was copied to.
+    pub copy: Vec<u8>,
+    /// The records sorted ([`sort`]), when asked and the chunk opened.
+    pub sorted: Option<Sorted>,
+}
+
+/// A message's header: channel id (u16), sequence (u32), log and publish times (u64).
+pub(super) const MESSAGE_HEADER: usize = 2 + 4 + 8 + 8;
+
+/// A piece of a chunk's records, in their order ([`sort`]).
+#[derive(Debug)]
+pub(super) enum Piece {
+    /// Consecutive messages of one channel, each decoded as a CDR `sensor_msgs/msg/Imu`: their
+    /// records' bytes (opcodes and lengths included) and their rows of [`Sorted::rows`].
+    Run {
+        channel: u16,
+        records: Range<usize>,
+        rows: Range<usize>,
+    },
+    /// Any other record the reader hands on (a schema, a channel, a message that is not such an
+    /// `Imu`): its opcode and its data's bytes.
+    Record { opcode: u8, data: Range<usize> },
+    /// The chunk's records end here on this error.
+    Error(ChunkError),
+}
+
+/// A chunk's records sorted on the worker that opened it: the runs of `Imu` messages decoded,
+/// everything else left for the reader in order.
+#[derive(Debug, Default)]
+pub(super) struct Sorted {
+    /// The pieces in the records' order.
+    pub pieces: Vec<Piece>,
+    /// The decoded messages of the runs.
+    pub rows: Vec<ImuMessage>,
+}
+
+/// Sorts the decompressed records `bytes` (none longer than `limit`) into `out`: each message
+/// that decodes as a CDR `Imu` joins the run of its channel's messages just before it, every
+/// schema, channel or other message is a record of its own (other records are skipped: the
+/// reader skips them), a broken record ends them.
+pub(super) fn sort(bytes: &[u8], limit: u64, out: &mut Sorted) {
+    use mcap::records::op;
+    out.pieces.clear();
+    out.rows.clear();
+    let base = bytes.as_ptr() as usize;
+    for record in records(bytes, limit) {
+        let (opcode, data) = match record {
+            Ok(r) => r,
+            Err(e) => {
+                out.pieces.push(Piece::Error(e));
+                return;
+            }
+        };
+        let start = data.as_ptr() as usize - base;
+        let (head, end) = (start - 9, start + data.len());
+        if opcode == op::MESSAGE && data.len() >= MESSAGE_HEADER {
+            let channel = u16::from_le_bytes([data[0], data[1]]);
+            if let Ok(m) = decode_imu(&data[MESSAGE_HEADER..]) {
+                out.rows.push(m);
+                let row = out.rows.len();
+                if let Some(Piece::Run {
+                    channel: c,
+                    records,
+                    rows,
+                }) = out.pieces.last_mut()
+                    && *c == channel
+                {
+                    records.end = end;
+                    rows.end = row;
+                } else {
+                    out.pieces.push(Piece::Run {
+                        channel,
+                        records: head..end,
+                        rows: row - 1..row,
+                    });
+                }
+                continue;
+            }
+        }
+        if matches!(opcode, op::SCHEMA | op::CHANNEL | op::MESSAGE) {
+            out.pieces.push(Piece::Record {
+                opcode,
+                data: start..end,
+            });
+        }
+    }
+}
 
 /// The chunk record `body` (after its opcode and length) decompressed into `out` (cleared
 /// first), its CRC checked when `check_crc` and the CRC is not 0; no more than `limit` bytes
@@ -53,6 +146,7 @@ fn open(body: &[u8], check_crc: bool, limit: u64, mut out: Vec<u8>) -> Result<Ve
     let want = usize::try_from(cap).unwrap_or(usize::MAX).saturating_add(1);
     let read = match header.compression.as_str() {
         "" => fill(&mut &data[..], &mut out, want),
+        "lz4" if lz4_whole(&data, &mut out, cap) => Ok(()),
         "lz4" => lz4::Decoder::new(&data[..]).and_then(|mut d| fill(&mut d, &mut out, want)),
         "zstd" => zstd::stream::read::Decoder::with_buffer(&data[..])
             .and_then(|mut d| fill(&mut d, &mut out, want)),
@@ -86,6 +180,59 @@ fn open(body: &[u8], check_crc: bool, limit: u64, mut out: Vec<u8>) -> Result<Ve
         ))));
     }
     Ok(out)
+}
+
+/// Room past the declared size handed to the LZ4 frame decoder: its largest block (4 MiB),
+/// so that every block is decoded where it belongs. Only reserved: pages never written are
+/// never touched.
+const LZ4_ROOM: usize = 4 << 20;
+
+/// The LZ4 frame `data` decompressed into `out` (cleared first) by one call of the frame
+/// decoder over the whole input, into the buffer itself (the streaming decoder copies the input
+/// through a 32 KiB buffer and much of the output through its own, 10 % of a read's time);
+/// `true` when the frame decodes whole to at most `cap` bytes, else `false` with `out` cleared,
+/// for the streaming decoder to tell what it finds (the same bytes either way).
+fn lz4_whole(data: &[u8], out: &mut Vec<u8>, cap: u64) -> bool {
+    use lz4::liblz4::{
+        LZ4F_VERSION, LZ4F_createDecompressionContext, LZ4F_decompress,
+        LZ4F_freeDecompressionContext, LZ4F_isError, LZ4FDecompressionContext,
+    };
+    out.clear();
+    let Ok(cap) = usize::try_from(cap) else {
+        return false;
+    };
+    let Some(room) = cap.checked_add(LZ4_ROOM) else {
+        return false;
+    };
+    if out.try_reserve(room).is_err() {
+        return false;
+    }
+    let mut ctx = LZ4FDecompressionContext(std::ptr::null_mut());
+    // SAFETY: the context is created, used once over the input (`data.len()` bytes readable)
+    // into `out`'s spare capacity (`room` bytes writable, reserved above), and freed; only
+    // the bytes the decoder reports written are taken into `out`.
+    unsafe {
+        if LZ4F_isError(LZ4F_createDecompressionContext(&mut ctx, LZ4F_VERSION)) != 0 {
+            return false;
+        }
+        let (mut written, mut read) = (room, data.len());
+        let hint = LZ4F_decompress(
+            ctx,
+            out.as_mut_ptr(),
+            &mut written,
+            data.as_ptr(),
+            &mut read,
+            std::ptr::null(),
+        );
+        LZ4F_freeDecompressionContext(ctx);
+        // A whole frame (hint 0) within the declared size; anything else is the streaming
+        // decoder's to tell.
+        if LZ4F_isError(hint) != 0 || hint != 0 || written > cap {
+            return false;
+        }
+        out.set_len(written);
+    }
+    true
 }
 
 /// Reads `reader` to its end into `out`, at most `want` bytes. The buffer's bytes from an
@@ -154,25 +301,31 @@ pub(super) struct Ahead {
     bytes: usize,
     check_crc: bool,
     limit: u64,
+    /// Whether each chunk's records are sorted on the pool ([`sort`]).
+    sorting: bool,
     free: Vec<Vec<u8>>,
+    free_sorted: Vec<Sorted>,
 }
 
 impl Ahead {
-    /// None yet; chunks will be checked against their CRC when `check_crc`, and decompressed
-    /// to at most `limit` bytes.
-    pub fn new(check_crc: bool, limit: u64) -> Self {
+    /// None yet; chunks will be checked against their CRC when `check_crc`, decompressed to
+    /// at most `limit` bytes, and their records sorted when `sorting`.
+    pub fn new(check_crc: bool, limit: u64, sorting: bool) -> Self {
         Self {
             queue: VecDeque::new(),
             bytes: 0,
             check_crc,
             limit,
+            sorting,
             free: Vec::new(),
+            free_sorted: Vec::new(),
         }
     }
 
     /// Takes back the buffers of a chunk whose records were handed on.
-    pub fn recycle(&mut self, buffers: [Vec<u8>; 2]) {
+    pub fn recycle(&mut self, buffers: [Vec<u8>; 2], sorted: Option<Sorted>) {
         self.free.extend(buffers);
+        self.free_sorted.extend(sorted);
     }
 
     /// Starts opening the chunk record `body` on the pool; returns the oldest chunk opened
@@ -184,12 +337,27 @@ impl Ahead {
         copy.clear();
         copy.extend_from_slice(body);
         let out = self.free.pop().unwrap_or_default();
+        let mut sorted = self
+            .sorting
+            .then(|| self.free_sorted.pop().unwrap_or_default());
         let (check_crc, limit, len) = (self.check_crc, self.limit, body.len());
         self.bytes += len;
         rayon::spawn(move || {
-            let opened = open(&copy, check_crc, limit, out);
+            let bytes = open(&copy, check_crc, limit, out);
+            let sorted = match (&bytes, sorted.as_mut()) {
+                (Ok(b), Some(s)) => {
+                    sort(b, limit, s);
+                    sorted
+                }
+                _ => None,
+            };
+            let opened = Opened {
+                bytes,
+                copy,
+                sorted,
+            };
             // The reader may have stopped at an earlier error: nobody waits then.
-            let _ = send.send((opened, copy));
+            let _ = send.send(opened);
         });
         self.queue.push_back((len, receive));
         let full = self.queue.len() > AHEAD * rayon::current_num_threads().max(1)
@@ -203,7 +371,11 @@ impl Ahead {
         self.bytes -= len;
         Some(receive.recv().unwrap_or_else(|_| {
             let e = "the worker opening the chunk ended without a result";
-            (Err(ChunkError::Broken(e.into())), Vec::new())
+            Opened {
+                bytes: Err(ChunkError::Broken(e.into())),
+                copy: Vec::new(),
+                sorted: None,
+            }
         }))
     }
 }

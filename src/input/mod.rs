@@ -24,6 +24,7 @@ pub mod imu_channels_csv;
 pub mod imu_csv;
 pub mod mcap;
 mod mcap_chunks;
+pub mod mcap_records;
 mod mcap_summary;
 pub mod messages;
 pub mod read_ahead;

@@ -15,7 +15,8 @@ use std::path::Path;
 
 use super::container::{Container, Kind};
 use super::csv::static_log::{first_gap, median_step};
-use super::mcap::{MCAP_MAGIC, McapEvent, McapRecords, visit_mcap};
+use super::mcap::{MCAP_MAGIC, McapEvent, visit_mcap};
+use super::mcap_records::McapRecords;
 use super::messages::{ImuMessage, ROS1_IMU_TYPE, decode_ros1_message};
 use super::records::{Channel, ImuRecords, ImuSamples};
 use super::rosbag2::bag_files;
@@ -42,7 +43,7 @@ const ROS1_IMU: (&str, &str) = (ROS1_IMU_TYPE, "");
 /// Reads the messages of one MCAP file into `topics` (every `Imu` topic's decoded).
 fn read_mcap(source: &Container, topics: &mut Topics) -> Result<(), LogError> {
     let file = source.name();
-    visit_mcap(source, true, &mut |event| match event {
+    visit_mcap(source, (true, false), &mut |event| match event {
         McapEvent::Channel(topic) => {
             topics
                 .types
@@ -62,6 +63,7 @@ fn read_mcap(source: &Container, topics: &mut Topics) -> Result<(), LogError> {
             list.push(decoded);
             Ok(())
         }
+        McapEvent::Messages(..) => unreachable!("runs are handed on only when asked"),
     })
 }
 

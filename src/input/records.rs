@@ -103,6 +103,81 @@ pub struct Record {
     pub at: u64,
 }
 
+/// Consecutive records of a log, column by column: what [`ImuRecords::read_blocks`] hands on.
+/// Record i of the block is `at + i` in the log (its line or its message's index).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RecordBlock {
+    /// Each record's time stamp, s.
+    pub t_s: Vec<f64>,
+    /// Each record's values, in the order of [`ImuRecords::channels`].
+    pub values: Vec<[f64; 6]>,
+    /// The first record's line or message index.
+    pub at: u64,
+}
+
+impl RecordBlock {
+    /// Records in the block.
+    pub fn len(&self) -> usize {
+        self.t_s.len()
+    }
+
+    /// Whether it holds no record.
+    pub fn is_empty(&self) -> bool {
+        self.t_s.is_empty()
+    }
+
+    /// Empties it, its buffers kept.
+    pub fn clear(&mut self) {
+        self.t_s.clear();
+        self.values.clear();
+    }
+
+    /// Adds `r`, which must follow the block's last record (`r.at` one past it) unless the
+    /// block is empty.
+    pub fn push(&mut self, r: &Record) {
+        if self.is_empty() {
+            self.at = r.at;
+        }
+        self.t_s.push(r.t_s);
+        self.values.push(r.values);
+    }
+}
+
+/// Records [`ImuRecords::read_blocks`] gathers per block at most by default.
+const DEFAULT_BLOCK: usize = 4096;
+
+/// [`ImuRecords::read_blocks`] made from [`ImuRecords::read`]: the records gathered in blocks of
+/// consecutive `at`, each handed on before the reading's next error.
+pub fn blocks_of_records(
+    records: &(impl ImuRecords + ?Sized),
+    visit: &mut dyn FnMut(&RecordBlock) -> Result<(), LogError>,
+) -> Result<(), LogError> {
+    let mut block = RecordBlock::default();
+    // Whether `visit` itself stopped the reading (its error is then the reading's).
+    let mut stopped = false;
+    let read = records.read(&mut |r| {
+        let follows = block.at.checked_add(block.len() as u64) == Some(r.at);
+        if !block.is_empty() && (block.len() == DEFAULT_BLOCK || !follows) {
+            let handed = visit(&block);
+            stopped = handed.is_err();
+            handed?;
+            block.clear();
+        }
+        block.push(r);
+        Ok(())
+    });
+    match read {
+        Err(e) if stopped => Err(e),
+        read => {
+            // The records before the reading's error come first, as record by record.
+            if !block.is_empty() {
+                visit(&block)?;
+            }
+            read
+        }
+    }
+}
+
 /// A log that can be read from its start more than once, record by record.
 pub trait ImuRecords {
     /// The channels present, in [`Channel::ALL`]'s order.
@@ -113,6 +188,24 @@ pub trait ImuRecords {
     /// # Errors
     /// [`LogError`] of the reading (a malformed row or message) or of `visit`.
     fn read(&self, visit: &mut dyn FnMut(&Record) -> Result<(), LogError>) -> Result<(), LogError>;
+
+    /// [`ImuRecords::read`] in blocks of consecutive records: the same records in the same
+    /// order, each block handed on before the error of the reading that follows it.
+    ///
+    /// # Errors
+    /// As [`ImuRecords::read`].
+    fn read_blocks(
+        &self,
+        visit: &mut dyn FnMut(&RecordBlock) -> Result<(), LogError>,
+    ) -> Result<(), LogError> {
+        blocks_of_records(self, visit)
+    }
+
+    /// How many records a read hands on, when the log says so before it is read (a
+    /// recording's summary); a hint for the buffers, not a promise.
+    fn count_hint(&self) -> Option<u64> {
+        None
+    }
 
     /// The error of `problem` at the record `at` (its line or its message).
     fn error_at(&self, at: u64, problem: LogProblem) -> LogError;

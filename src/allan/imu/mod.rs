@@ -13,11 +13,12 @@
 //! read again from disk; [`stream`] analyses the records; [`export`] writes the files.
 
 pub mod export;
+mod held;
 pub mod stream;
 
 use thiserror::Error;
 
-use super::{AllanError, Analysis, Reading, Term, TermEstimate, analyse};
+use super::{AllanError, Analysis, Reading, Term, TermEstimate, analyse, analyse_in_place};
 use crate::input::records::{Channel, ImuSamples, Sensor};
 
 /// The words of the sensors' terms in the files and on the page.
@@ -212,6 +213,38 @@ pub fn analyse_imu(log: &ImuSamples, confidence: f64) -> Result<ImuAnalysis, Imu
     Ok(ImuAnalysis {
         samples: log.channels.first().map_or(0, |c| c.1.len()),
         sample_period_s: log.sample_period_s,
+        confidence,
+        channels,
+    })
+}
+
+/// [`analyse_imu`] of channels held one place in (`(channel, [_, y_0, …, y_{n−1}])`, the first
+/// place free): each channel's phase summed where its values are, the same analysis.
+///
+/// # Errors
+/// As [`analyse_imu`].
+pub(crate) fn analyse_held(
+    channels: Vec<(Channel, Vec<f64>)>,
+    sample_period_s: f64,
+    confidence: f64,
+) -> Result<ImuAnalysis, ImuError> {
+    use rayon::prelude::*;
+    let samples = channels.first().map_or(0, |c| c.1.len() - 1);
+    let analysed: Vec<_> = channels
+        .into_par_iter()
+        .map(|(channel, held)| {
+            analyse_in_place(held, sample_period_s, confidence)
+                .map(|analysis| ChannelAnalysis { channel, analysis })
+                .map_err(|reason| ImuError {
+                    column: channel.column(),
+                    reason,
+                })
+        })
+        .collect();
+    let channels = analysed.into_iter().collect::<Result<Vec<_>, _>>()?;
+    Ok(ImuAnalysis {
+        samples,
+        sample_period_s,
         confidence,
         channels,
     })

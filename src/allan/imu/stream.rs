@@ -2,7 +2,7 @@
 //!
 //! - A log of at most the rows the caller lets it hold ([`DEFAULT_HOLD_BYTES`], 64 bytes a
 //!   six-channel row: the stamp, its place and the values, [`held_row_bytes`]) is read once into memory and analysed as the
-//!   whole-series form does ([`analyse_imu`]).
+//!   whole-series form does ([`analyse_held`], as [`super::analyse_imu`]).
 //! - A longer one is read twice: a first read finds each channel's mean (the phase subtracts
 //!   it, as the whole-series form does), the count and the median step, a second checks every
 //!   step against that median and feeds each channel's [`AllanStream`]. Memory is that of the
@@ -16,11 +16,12 @@
 
 use rayon::prelude::*;
 
-use super::{ChannelAnalysis, ImuAnalysis, ImuError, analyse_imu};
+use super::held::{checked, held_read};
+use super::{ChannelAnalysis, ImuAnalysis, ImuError, analyse_held};
 use crate::allan::stream::{AllanStream, StreamingMean};
 use crate::allan::{AllanError, analyse_grid};
 use crate::input::csv::steps::{ACCEPTED_STEP_RATIO, StepMedian};
-use crate::input::records::{Channel, ImuRecords, ImuSamples, Record};
+use crate::input::records::ImuRecords;
 use crate::input::{LogError, LogProblem};
 
 /// Samples of each channel handed to the streams at once.
@@ -45,33 +46,6 @@ pub enum StreamError {
     Channel(ImuError),
     /// The temporary file of a long log's phase (creating, writing or reading it).
     Spill(std::io::Error),
-}
-
-/// The checks of one read: strictly increasing stamps, finite values.
-fn checked(
-    records: &dyn ImuRecords,
-    r: &Record,
-    previous_s: &mut Option<f64>,
-) -> Result<Option<f64>, LogError> {
-    if let Some(p) = *previous_s
-        && r.t_s <= p
-    {
-        let problem = LogProblem::NotIncreasing {
-            t_s: r.t_s,
-            previous_s: p,
-        };
-        return Err(records.error_at(r.at, problem));
-    }
-    for (c, v) in records.channels().iter().zip(&r.values) {
-        if !v.is_finite() {
-            let problem = LogProblem::NotFinite {
-                column: c.column(),
-                text: v.to_string(),
-            };
-            return Err(records.error_at(r.at, problem));
-        }
-    }
-    Ok(previous_s.replace(r.t_s).map(|p| r.t_s - p))
 }
 
 /// What the first read finds: each channel's mean and whether its samples differ, the count
@@ -125,91 +99,11 @@ pub fn analyse_records(
     hold_bytes: usize,
 ) -> Result<ImuAnalysis, StreamError> {
     let row_bytes = held_row_bytes(records.channels().len());
-    let Some(held) = held_read(records, hold_bytes / row_bytes)? else {
+    let Some(held) = held_read(records, hold_bytes / row_bytes).map_err(StreamError::Log)? else {
         return analyse_streamed(records, confidence, spill_dir);
     };
-    let samples = held.check_steps(records).map_err(StreamError::Log)?;
-    analyse_imu(&samples, confidence).map_err(StreamError::Channel)
-}
-
-/// A log held whole: its stamps, their places, each channel's values.
-struct Held {
-    t_s: Vec<f64>,
-    at: Vec<u64>,
-    values: Vec<Vec<f64>>,
-    channels: Vec<Channel>,
-}
-
-/// The log read once and held, its stamps and values checked; `None` once it has more than
-/// `max_rows` rows (the read stops there).
-fn held_read(records: &dyn ImuRecords, max_rows: usize) -> Result<Option<Held>, StreamError> {
-    let channels = records.channels().to_vec();
-    let mut held = Held {
-        t_s: Vec::new(),
-        at: Vec::new(),
-        values: vec![Vec::new(); channels.len()],
-        channels,
-    };
-    let mut previous_s = None;
-    let mut too_long = false;
-    let read = records.read(&mut |r| {
-        if held.t_s.len() == max_rows {
-            // Stops the read; the error itself is never shown.
-            too_long = true;
-            return Err(records.error(LogProblem::Changed));
-        }
-        checked(records, r, &mut previous_s)?;
-        held.t_s.push(r.t_s);
-        held.at.push(r.at);
-        for (h, v) in held.values.iter_mut().zip(&r.values) {
-            h.push(*v);
-        }
-        Ok(())
-    });
-    match read {
-        _ if too_long => Ok(None),
-        Err(e) => Err(StreamError::Log(e)),
-        Ok(()) => Ok(Some(held)),
-    }
-}
-
-impl Held {
-    /// The samples, every step checked against the band around their median.
-    ///
-    /// # Errors
-    /// [`LogProblem::TooFewRows`] for fewer than two rows, [`LogProblem::Gap`] at the first
-    /// step outside the band.
-    fn check_steps(self, records: &dyn ImuRecords) -> Result<ImuSamples, LogError> {
-        let mut steps = StepMedian::new();
-        for w in self.t_s.windows(2) {
-            steps.add(w[1] - w[0]);
-        }
-        let Some(median_s) = steps.median() else {
-            let problem = LogProblem::TooFewRows {
-                found: self.t_s.len() as u64,
-                needed: 2,
-            };
-            return Err(records.error(problem));
-        };
-        let band = ACCEPTED_STEP_RATIO.0 * median_s..=ACCEPTED_STEP_RATIO.1 * median_s;
-        for (k, w) in self.t_s.windows(2).enumerate() {
-            let step_s = w[1] - w[0];
-            if !band.contains(&step_s) {
-                let problem = LogProblem::Gap {
-                    previous_s: w[0],
-                    t_s: w[1],
-                    step_s,
-                    ratio: step_s / median_s,
-                    median_s,
-                };
-                return Err(records.error_at(self.at[k + 1], problem));
-            }
-        }
-        Ok(ImuSamples {
-            channels: self.channels.into_iter().zip(self.values).collect(),
-            sample_period_s: median_s,
-        })
-    }
+    let (channels, median_s) = held.check_steps(records).map_err(StreamError::Log)?;
+    analyse_held(channels, median_s, confidence).map_err(StreamError::Channel)
 }
 
 /// [`analyse_records`] reading the log twice, holding none of it.
