@@ -1,6 +1,6 @@
 //! An MCAP file or a ROS 2 bag of MCAP files read record by record from disk (the `mcap`
 //! crate's linear reader fed in pieces: no file is held whole), and the chosen `Imu` topic's
-//! messages as [`Record`]s read again from disk as often as an analysis needs.
+//! messages as [`Record`](super::records::Record)s read again from disk as often as an analysis needs.
 //!
 //! # Format
 //! MCAP (mcap.dev/spec, version 0): the magic bytes, then records of an opcode, a u64 length and

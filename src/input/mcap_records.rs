@@ -1,4 +1,4 @@
-//! The chosen `Imu` topic of MCAP files read in sequence ([`super::mcap::visit_mcap`]), as
+//! The chosen `Imu` topic of MCAP files read in sequence (`visit_mcap`), as
 //! [`Record`]s read again from disk as often as an analysis needs: record by record, or in
 //! blocks whose messages were decoded on the thread pool beside the chunks' decompression.
 

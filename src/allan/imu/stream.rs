@@ -1,8 +1,9 @@
 //! `allan --imu` on a log read once and held, or read twice and held nowhere.
 //!
 //! - A log of at most the rows the caller lets it hold ([`DEFAULT_HOLD_BYTES`], 64 bytes a
-//!   six-channel row: the stamp, its place and the values, [`held_row_bytes`]) is read once into memory and analysed as the
-//!   whole-series form does ([`analyse_held`], as [`super::analyse_imu`]).
+//!   six-channel row: the stamp, its place and the values, [`held_row_bytes`]) is read once
+//!   into memory and analysed as the whole-series form does (`analyse_held`, as
+//!   [`super::analyse_imu`]).
 //! - A longer one is read twice: a first read finds each channel's mean (the phase subtracts
 //!   it, as the whole-series form does), the count and the median step, a second checks every
 //!   step against that median and feeds each channel's [`AllanStream`]. Memory is that of the
