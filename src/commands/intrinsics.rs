@@ -182,23 +182,7 @@ fn accel_lines(x: &Intrinsics) -> String {
     for (e, pair) in a.misalignment_rad.iter().zip(["xy", "xz", "yz"]) {
         s += &format!("  non-orthogonality {pair}: {}\n", shown(e, 1e3, "mrad"));
     }
-    match a.p_value {
-        Some(p) => {
-            s += &format!(
-                "  goodness: χ² = {} on {} degrees of freedom, p = {} ({} at α = {})\n",
-                sig(a.chi_squared, 4),
-                sig(a.dof, 3),
-                sig(p, 3),
-                if p < x.settings.alpha {
-                    "rejected"
-                } else {
-                    "not rejected"
-                },
-                sig(x.settings.alpha, 2)
-            );
-        }
-        None => s += "  goodness: not testable (no degree of freedom left)\n",
-    }
+    s += &goodness_line("", a.chi_squared, a.dof, a.p_value, x.settings.alpha);
     if a.p_value.is_some_and(|p| p < x.settings.alpha) {
         s += &format!(
             "  the poses' magnitudes scatter {}× more than the noise measured in them explains (a \
@@ -251,23 +235,31 @@ fn gyro_lines(x: &Intrinsics) -> String {
         .map(|(e, n)| format!("{n} {}", shown(e, 1e3, "mrad")))
         .collect();
     s += &format!("  misalignment: {}\n", leans.join(", "));
-    match m.p_value {
-        Some(p) => {
-            s += &format!(
-                "  goodness of {} turns and the poses' magnitudes together: χ² = {} on {} degrees of freedom, p = {} ({} at α = {})\n",
-                m.turns,
-                sig(m.chi_squared, 4),
-                sig(m.dof, 3),
-                sig(p, 3),
-                if p < x.settings.alpha {
-                    "rejected"
-                } else {
-                    "not rejected"
-                },
-                sig(x.settings.alpha, 2)
-            );
-        }
-        None => s += "  goodness: not testable (no degree of freedom left)\n",
-    }
+    s += &goodness_line(
+        &format!(" of {} turns and the poses' magnitudes together", m.turns),
+        m.chi_squared,
+        m.dof,
+        m.p_value,
+        x.settings.alpha,
+    );
     s
+}
+
+/// A goodness test's line: χ², its degrees of freedom, p and the verdict at `alpha`.
+fn goodness_line(what: &str, chi: f64, dof: f64, p: Option<f64>, alpha: f64) -> String {
+    match p {
+        Some(p) => format!(
+            "  goodness{what}: χ² = {} on {} degrees of freedom, p = {} ({} at α = {})\n",
+            sig(chi, 4),
+            sig(dof, 3),
+            sig(p, 3),
+            if p < alpha {
+                "rejected"
+            } else {
+                "not rejected"
+            },
+            sig(alpha, 2)
+        ),
+        None => "  goodness: not testable (no degree of freedom left)\n".to_string(),
+    }
 }

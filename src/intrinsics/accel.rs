@@ -266,7 +266,7 @@ pub fn fit(detection: &Detection, settings: &Settings) -> AccelFit {
 }
 
 /// P(χ²(dof) > x).
-fn chi_squared_sf(x: f64, dof: f64) -> f64 {
+pub(super) fn chi_squared_sf(x: f64, dof: f64) -> f64 {
     use statrs::distribution::{ChiSquared, ContinuousCDF};
     ChiSquared::new(dof).map_or(f64::NAN, |c| c.sf(x))
 }

@@ -81,10 +81,7 @@ pub fn bias(detection: &Detection, accel: &AccelFit, settings: &Settings) -> Gyr
         })
         .sum();
     let dof = 3 * (terms.len() - 1);
-    let p_value = (dof > 0).then(|| {
-        use statrs::distribution::{ChiSquared, ContinuousCDF};
-        ChiSquared::new(dof as f64).map_or(f64::NAN, |c| c.sf(chi_squared))
-    });
+    let p_value = (dof > 0).then(|| super::accel::chi_squared_sf(chi_squared, dof as f64));
     let z = normal_bound(1.0 - settings.confidence);
     GyroBias {
         bias: std::array::from_fn(|i| {

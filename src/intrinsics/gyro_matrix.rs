@@ -294,10 +294,7 @@ pub fn fit(
     });
     let p_eff = (covariance * info).trace();
     let dof = (2 * turns.len() + detection.intervals.len()) as f64 - p_eff;
-    let p_value = (dof >= 0.5).then(|| {
-        use statrs::distribution::{ChiSquared, ContinuousCDF};
-        ChiSquared::new(dof).map_or(f64::NAN, |c| c.sf(chi_squared))
-    });
+    let p_value = (dof >= 0.5).then(|| super::accel::chi_squared_sf(chi_squared, dof));
     let z = normal_bound(1.0 - settings.confidence);
     let (scale_ppm, misalignment_rad) = derived_estimates(&theta, &covariance, &prior, z);
     let estimate = |p: usize| {
